@@ -1,0 +1,17 @@
+"""Registers PSO: the paper's particle-swarm-only baseline (random initial waypoints)."""
+
+from rrtpso_ompl.pso_planner import PSOPlanner
+from rrtpso_ompl.registry import PlannerEntry
+from rrtpso_ompl.rrtstar_pso import check_swarm_values
+
+PLANNERS = [
+    PlannerEntry(
+        name="PSO",
+        factory=PSOPlanner,
+        params=PSOPlanner.PARAMS,
+        description="Particle swarm over random waypoints (the paper's PSO baseline, Table 3)",
+        aliases=("geometric::PSO",),
+        optimizing=True,
+        check=check_swarm_values,
+    )
+]

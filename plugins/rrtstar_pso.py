@@ -1,0 +1,16 @@
+"""Registers RRTstarPSO: OMPL's RRT* followed by the particle swarm over its waypoints."""
+
+from rrtpso_ompl.registry import PlannerEntry
+from rrtpso_ompl.rrtstar_pso import RRTstarPSO, check_swarm_values
+
+PLANNERS = [
+    PlannerEntry(
+        name="RRTstarPSO",
+        factory=RRTstarPSO,
+        params=RRTstarPSO.PARAMS,
+        description="RRT* for a share of the budget, then PSO over its waypoints (the paper)",
+        aliases=("geometric::RRTstarPSO", "RRT*PSO"),
+        optimizing=True,
+        check=check_swarm_values,
+    )
+]

@@ -1,0 +1,198 @@
+"""The ``rrtpso`` command line: a thin layer over :mod:`rrtpso_ompl.solve` and the registry.
+
+Exit status: 0 solved, 1 no valid path within the time limit, 2 bad input or usage (one message on
+stderr, no traceback, nothing written).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import math
+import sys
+from collections.abc import Sequence
+from typing import Any
+
+__all__ = ["main"]
+
+EXIT_SOLVED, EXIT_UNSOLVED, EXIT_BAD_INPUT = 0, 1, 2
+
+
+class InputError(Exception):
+    """Bad input found before planning: reported as ``rrtpso: error: <message>``, exit 2."""
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="rrtpso",
+        description="Plan 2-D paths for wheeled robots with RRT*PSO and OMPL's planners.",
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    p = sub.add_parser("solve", help="solve one problem file",
+                       description="Solve one problem file and report the path.")
+    p.add_argument("problem", help="problem file (YAML, see docs/problem-format.md)")
+    p.add_argument("--planner", help="planner name (default: the file's planner.type, else "
+                   "RRTstarPSO); see 'rrtpso planners'")
+    p.add_argument("--time", type=float, metavar="SECONDS",
+                   help="time limit (default: the file's planner.time_limit, else 1.0)")
+    p.add_argument("--seed", type=int, help="random seed (default: the file's planner.seed)")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                   help="planner parameter, repeatable (e.g. --param swarm_size=50)")
+    p.add_argument("--json", metavar="OUT", help="write the result as JSON")
+    p.add_argument("--plot", metavar="OUT.png", help="draw the world, the paths and the PSO "
+                   "best-cost curve")
+    p.add_argument("--simplify", action="store_true",
+                   help="run OMPL's path simplifier on the result within the time limit")
+    p.add_argument("-v", "--verbose", action="count", default=0,
+                   help="show OMPL's Info (-v) and Debug (-vv) messages")
+    p.set_defaults(func=_cmd_solve)
+
+    q = sub.add_parser("planners", help="list the planners and their parameters",
+                       description="List the registered planners and their parameters.")
+    q.add_argument("name", nargs="?", help="show only this planner")
+    q.add_argument("--json", action="store_true", help="machine-readable output")
+    q.set_defaults(func=_cmd_planners)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit status."""
+    parser = _build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(
+        level=logging.INFO if getattr(args, "verbose", 0) else logging.WARNING,
+        format="%(levelname)s: %(name)s: %(message)s",
+    )
+    try:
+        return args.func(args)
+    except InputError as exc:
+        print(f"rrtpso: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("rrtpso: interrupted", file=sys.stderr)
+        return 130
+
+
+# --------------------------------------------------------------------------------------------
+def _cmd_solve(args: argparse.Namespace) -> int:
+    from .ompl_setup import set_ompl_log_level
+    from .problem import ProblemError, load_problem
+    from .registry import UnknownPlannerError, default_registry
+    from .solve import DEFAULT_PLANNER
+
+    set_ompl_log_level(args.verbose)
+    try:
+        problem = load_problem(args.problem)
+    except ProblemError as exc:
+        raise InputError(str(exc)) from None
+    src = args.problem
+    registry = default_registry()
+
+    # Everything is validated here, before planning, so that each error names its origin.
+    name = args.planner or problem.planner.type or DEFAULT_PLANNER
+    origin = "--planner" if args.planner else ("planner.type" if problem.planner.type else "")
+    try:
+        entry = registry.get(name)
+    except UnknownPlannerError as exc:
+        raise InputError(f"{src}: {origin or 'planner'}: {exc}") from None
+    if args.time is not None and not (args.time > 0 and math.isfinite(args.time)):
+        raise InputError(f"{src}: --time: must be a positive number of seconds, got {args.time}")
+    cli_params = _parse_params(args.param, src)
+    for key, value in problem.planner.params.items():
+        _check_param(entry, key, value, f"{src}: planner.params.{key}")
+    for key, value in cli_params.items():
+        _check_param(entry, key, value, f"{src}: --param {key}")
+    try:
+        entry.validate({**problem.planner.params, **cli_params})
+    except ValueError as exc:
+        raise InputError(f"{src}: planner parameters: {exc}") from None
+
+    from .solve import solve
+
+    result = solve(problem, name, args.time, args.seed, cli_params, simplify=args.simplify)
+    if args.plot:
+        from .plotting import plot_solution, save_figure
+
+        save_figure(plot_solution(problem, result), args.plot)
+    if args.json:
+        from .results import write_json_atomic
+
+        write_json_atomic(result.to_dict(), args.json)
+    length = f"{result.length:.3f}" if result.length is not None else "-"
+    print(f"{problem.name}: {result.planner} {result.status} length={length} "
+          f"time={result.time:.3f}s", file=sys.stderr)
+    return EXIT_SOLVED if result.solved else EXIT_UNSOLVED
+
+
+def _parse_params(items: list[str], src: str) -> dict[str, str]:
+    params: dict[str, str] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise InputError(f"{src}: --param: expected NAME=VALUE, got '{item}'")
+        params[key.strip()] = value.strip()
+    return params
+
+
+def _check_param(entry: Any, key: str, value: Any, where: str) -> None:
+    try:
+        entry.param(key).convert(value)
+    except KeyError as exc:
+        raise InputError(f"{where}: {exc.args[0]}") from None
+    except ValueError as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
+# --------------------------------------------------------------------------------------------
+def _cmd_planners(args: argparse.Namespace) -> int:
+    from .registry import UnknownPlannerError, default_registry
+
+    registry = default_registry()
+    try:
+        entries = [registry.get(args.name)] if args.name else registry.entries()
+    except UnknownPlannerError as exc:
+        raise InputError(str(exc)) from None
+    if args.json:
+        rows = [
+            {
+                "name": e.name,
+                "aliases": list(e.aliases),
+                "description": e.description,
+                "optimizing": e.optimizing,
+                "source": e.source,
+                "params": [
+                    {"name": p.name, "type": p.type.__name__, "default": p.default,
+                     "unit": p.unit, "range": p.range_text(), "doc": p.doc}
+                    for p in e.params
+                ],
+            }
+            for e in entries
+        ]
+        print(json.dumps(rows, indent=2))
+        return EXIT_SOLVED
+    for e in entries:
+        aliases = f"  (also: {', '.join(e.aliases)})" if e.aliases else ""
+        print(f"{e.name}{aliases}\n    {e.description}  [{e.source}]")
+        for p in e.params:
+            unit = f" {p.unit}" if p.unit else ""
+            print(f"    {p.name:<28} {p.type.__name__:<5} default {p.default!s:<8}{unit} "
+                  f"in {p.range_text()}")
+            if args.name:
+                print(f"        {p.doc}")
+    return EXIT_SOLVED
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("rrtpso-ompl")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+if __name__ == "__main__":
+    sys.exit(main())

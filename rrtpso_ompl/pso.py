@@ -1,0 +1,209 @@
+"""A vectorised global-best particle swarm optimiser (paper eqs. 4-5).
+
+Each particle ``i`` has a position ``X_i`` and a velocity ``V_i`` in ``R^dims``. One iteration is
+
+.. math::
+
+    V_i(k+1) = w V_i(k) + c_1 r_1 (P_{i,best}(k) - X_i(k)) + c_2 r_2 (G_{best}(k) - X_i(k))   (4)
+
+    X_i(k+1) = X_i(k) + V_i(k+1)                                                         (5)
+
+with ``r_1, r_2 ~ U[0, 1]`` drawn per particle and per dimension. Two standard options the paper
+does not need but long runs do: an inertia damping factor (``w`` is multiplied by ``w_damping``
+after each iteration) and a velocity clamp (``|V| <= v_max`` per dimension). Positions are clipped
+to the box ``[lower, upper]`` and the velocity component that pushed a particle out is zeroed.
+
+The whole swarm is updated with array operations; the cost function receives the whole swarm,
+``(n_particles, dims) -> (n_particles,)``, so it can be vectorised too.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["PSOOptions", "PSOResult", "minimize"]
+
+CostFunction = Callable[[np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True, kw_only=True)
+class PSOOptions:
+    """Settings of the particle swarm (paper Table 2).
+
+    Parameters
+    ----------
+    swarm_size : int
+        Number of particles, >= 2.
+    iterations : int
+        Maximum number of iterations (velocity and position updates), >= 0.
+    w : float
+        Inertia weight of the velocity (eq. 4), in [0, 1.5].
+    c1, c2 : float
+        Cognitive and social acceleration coefficients (eq. 4); the paper requires c1 + c2 < 4.
+    w_damping : float
+        Factor applied to ``w`` after each iteration, in (0, 1]; 1 keeps ``w`` constant.
+    v_max : float or None
+        Velocity clamp per dimension, in the unit of the positions; None for no clamp.
+    tolerance : float
+        Stop early when the best cost improved by less than ``tolerance`` (relative) over the
+        last ``patience`` iterations; 0 disables early stopping.
+    patience : int
+        Window for ``tolerance``, in iterations.
+    """
+
+    swarm_size: int = 30
+    iterations: int = 100
+    w: float = 0.7298
+    c1: float = 1.49618
+    c2: float = 1.49618
+    w_damping: float = 1.0
+    v_max: float | None = None
+    tolerance: float = 0.0
+    patience: int = 20
+
+    def __post_init__(self) -> None:
+        if self.swarm_size < 2:
+            raise ValueError(f"swarm_size must be >= 2, got {self.swarm_size}")
+        if self.iterations < 0:
+            raise ValueError(f"iterations must be >= 0, got {self.iterations}")
+        if not 0.0 <= self.w <= 1.5:
+            raise ValueError(f"w must be in [0, 1.5], got {self.w}")
+        if self.c1 < 0 or self.c2 < 0 or self.c1 + self.c2 >= 4.0:
+            raise ValueError(f"need c1, c2 >= 0 and c1 + c2 < 4, got c1={self.c1}, c2={self.c2}")
+        if not 0.0 < self.w_damping <= 1.0:
+            raise ValueError(f"w_damping must be in (0, 1], got {self.w_damping}")
+        if self.v_max is not None and self.v_max <= 0:
+            raise ValueError(f"v_max must be > 0 or None, got {self.v_max}")
+        if self.tolerance < 0 or self.patience < 1:
+            raise ValueError("tolerance must be >= 0 and patience >= 1")
+
+
+@dataclass(frozen=True)
+class PSOResult:
+    """Outcome of :func:`minimize`.
+
+    Attributes
+    ----------
+    position : ndarray, shape (dims,)
+        The global best position ``G_best``.
+    cost : float
+        Its cost.
+    history : ndarray, shape (n_iterations + 1,)
+        Best cost after initialisation and after each iteration (never increasing).
+    n_iterations : int
+        Iterations performed.
+    n_evaluations : int
+        Particle evaluations (swarm size times the number of cost calls).
+    time : float
+        Wall-clock seconds.
+    stopped_by : str
+        ``"iterations"``, ``"tolerance"`` or ``"terminate"``.
+    """
+
+    position: np.ndarray
+    cost: float
+    history: np.ndarray = field(repr=False)
+    n_iterations: int
+    n_evaluations: int
+    time: float
+    stopped_by: str
+
+
+def minimize(
+    cost: CostFunction,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    options: PSOOptions,
+    rng: np.random.Generator,
+    *,
+    init: np.ndarray | None = None,
+    init_velocity: np.ndarray | None = None,
+    terminate: Callable[[], bool] | None = None,
+) -> PSOResult:
+    """Minimise ``cost`` over the box ``[lower, upper]`` with a global-best PSO.
+
+    Parameters
+    ----------
+    cost : callable
+        ``cost(X)`` with ``X`` of shape ``(n_particles, dims)`` returns ``(n_particles,)`` costs.
+    lower, upper : (dims,) array_like
+        Box bounds of the positions.
+    options : PSOOptions
+        Swarm settings.
+    rng : numpy.random.Generator
+        The only source of randomness (``r_1``, ``r_2`` and the initial swarm).
+    init : (n_particles, dims) array_like, optional
+        Initial positions; uniform in the box when omitted. Its rows are clipped to the box.
+    init_velocity : (n_particles, dims) array_like, optional
+        Initial velocities; zero when omitted (the paper's step 1 uses random velocities; zero is
+        the standard choice when the swarm is seeded around a known solution, as RRT*PSO does).
+    terminate : callable, optional
+        Polled once per iteration; the run stops when it returns True (e.g. OMPL's
+        ``PlannerTerminationCondition``).
+
+    Returns
+    -------
+    PSOResult
+    """
+    t0 = time.perf_counter()
+    lower = np.asarray(lower, dtype=float)
+    upper = np.asarray(upper, dtype=float)
+    dims = lower.shape[0]
+    n = options.swarm_size
+    if init is None:
+        x = rng.uniform(lower, upper, size=(n, dims))
+    else:
+        x = np.clip(np.asarray(init, dtype=float).reshape(n, dims), lower, upper)
+    v = np.zeros((n, dims)) if init_velocity is None else np.asarray(init_velocity, float).copy()
+    v_max = options.v_max
+
+    f = np.asarray(cost(x), dtype=float)
+    pbest_x, pbest_f = x.copy(), f.copy()
+    g = int(np.argmin(pbest_f))
+    gbest_x, gbest_f = pbest_x[g].copy(), float(pbest_f[g])
+    history = [gbest_f]
+    n_eval = n
+    w = options.w
+    stopped_by = "iterations"
+    for k in range(1, options.iterations + 1):
+        if terminate is not None and terminate():
+            stopped_by = "terminate"
+            break
+        r1 = rng.random((n, dims))
+        r2 = rng.random((n, dims))
+        v = w * v + options.c1 * r1 * (pbest_x - x) + options.c2 * r2 * (gbest_x - x)  # eq. 4
+        if v_max is not None:
+            np.clip(v, -v_max, v_max, out=v)
+        x = x + v  # eq. 5
+        out = (x < lower) | (x > upper)
+        if out.any():
+            np.clip(x, lower, upper, out=x)
+            v[out] = 0.0  # a particle stopped by the wall keeps no momentum into it
+        f = np.asarray(cost(x), dtype=float)
+        n_eval += n
+        better = f < pbest_f
+        pbest_x[better] = x[better]
+        pbest_f[better] = f[better]
+        g = int(np.argmin(pbest_f))
+        if pbest_f[g] < gbest_f:
+            gbest_x, gbest_f = pbest_x[g].copy(), float(pbest_f[g])
+        history.append(gbest_f)
+        w *= options.w_damping
+        if options.tolerance > 0 and k >= options.patience:
+            old = history[-1 - options.patience]
+            if old - gbest_f <= options.tolerance * max(abs(old), 1e-300):
+                stopped_by = "tolerance"
+                break
+    return PSOResult(
+        position=gbest_x,
+        cost=gbest_f,
+        history=np.asarray(history),
+        n_iterations=len(history) - 1,
+        n_evaluations=n_eval,
+        time=time.perf_counter() - t0,
+        stopped_by=stopped_by,
+    )

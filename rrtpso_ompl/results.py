@@ -1,0 +1,114 @@
+"""Typed results: what a solve returns and what ``rrtpso solve --json`` writes."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["SolveResult", "write_json_atomic"]
+
+
+@dataclass(frozen=True)
+class SolveResult:
+    """The outcome of solving one problem with one planner.
+
+    Attributes
+    ----------
+    problem : str
+        Problem name.
+    planner : str
+        Planner name as selected.
+    status : str
+        ``"exact"``, ``"approximate"`` or ``"none"`` (the contract's three values).
+    ompl_status : str
+        OMPL's own status text (``"Exact solution"``, ``"Timeout"``, ``"Crash"``, ...).
+    solved : bool
+        True only for an exact path that passed the exact validity check.
+    length : float or None
+        Euclidean length of ``path`` in problem units.
+    time : float
+        Wall-clock seconds spent in the planner.
+    seed : int or None
+        The seed OMPL and numpy ran with.
+    path : (n, 2) ndarray
+        The returned polyline (empty when there is none).
+    time_limit : float
+        The budget, seconds.
+    params : dict
+        Planner parameters as applied.
+    stages : dict
+        Per-stage figures (for RRTstarPSO: RRT* and PSO lengths, times, iterations, PSO best cost
+        per iteration).
+    clearance : float or None
+        Smallest distance from the path to an obstacle, minus the robot radius (>= 0 when valid).
+    valid : bool
+        Whether ``path`` passed the exact check (bounds, every segment, robot radius).
+    """
+
+    problem: str
+    planner: str
+    status: str
+    ompl_status: str
+    solved: bool
+    length: float | None
+    time: float
+    seed: int | None
+    path: np.ndarray = field(repr=False)
+    time_limit: float = 0.0
+    params: dict[str, Any] = field(default_factory=dict)
+    stages: dict[str, Any] = field(default_factory=dict)
+    clearance: float | None = None
+    valid: bool = False
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dictionary with the contract's keys first."""
+        return {
+            "problem": self.problem,
+            "planner": self.planner,
+            "status": self.status,
+            "solved": self.solved,
+            "length": self.length,
+            "time": self.time,
+            "seed": self.seed,
+            "path": np.asarray(self.path, dtype=float).reshape(-1, 2).tolist(),
+            "ompl_status": self.ompl_status,
+            "time_limit": self.time_limit,
+            "valid": self.valid,
+            "clearance": _finite(self.clearance),
+            "params": self.params,
+            "stages": self.stages,
+        }
+
+
+def _finite(x: float | None) -> float | None:
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
+def write_json_atomic(data: Any, path: str | Path) -> None:
+    """Write JSON through a temporary file and a rename, so a reader never sees half a file."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w") as fh:
+            json.dump(data, fh, indent=2, allow_nan=False, default=_json_default)
+            fh.write("\n")
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _json_default(obj: Any) -> Any:
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")

@@ -1,0 +1,151 @@
+"""The `rrtpso` command as a user runs it: real processes, real files, exit codes, JSON."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from pathlib import Path
+
+import pytest
+import yaml
+from conftest import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
+
+CONTRACT_KEYS = {"problem", "planner", "status", "solved", "length", "time", "seed", "path"}
+
+
+def run(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
+    return subprocess.run([*rrtpso_exe(), *args], capture_output=True, text=True,
+                          timeout=timeout)
+
+
+@pytest.fixture
+def circle_file(tmp_path: Path) -> Path:
+    path = tmp_path / "single_circle.yaml"
+    path.write_text(yaml.safe_dump(SINGLE_CIRCLE))
+    return path
+
+
+def test_solve_writes_contract_json_and_plot(circle_file, tmp_path):
+    out, png = tmp_path / "r.json", tmp_path / "p.png"
+    proc = run("solve", str(circle_file), "--time", "0.3", "--seed", "3", "--json", str(out),
+               "--plot", str(png))
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(out.read_text())
+    assert data.keys() >= CONTRACT_KEYS
+    assert data["status"] == "exact" and data["solved"] is True
+    assert data["planner"] == "RRTstarPSO" and data["seed"] == 3
+    assert data["path"][0] == [20, 20] and data["path"][-1] == [450, 450]
+    assert data["length"] == pytest.approx(647.45, rel=0.01)
+    assert data["stages"]["pso_length"] <= data["stages"]["rrt_length"]
+    assert png.stat().st_size > 10_000 and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # Quiet by default: no OMPL Info/Debug lines, no nanobind leak report.
+    assert "Info:" not in proc.stdout + proc.stderr
+    assert "leaked" not in proc.stderr
+
+
+def test_verbose_shows_ompl_info(circle_file):
+    proc = run("solve", str(circle_file), "--time", "0.1", "--planner", "RRTstar", "-v")
+    assert "Info:" in proc.stdout + proc.stderr
+
+
+def test_unsolved_exit_1_still_writes_json(tmp_path):
+    problem = {
+        "bounds": [[0, 0], [500, 500]], "start": [50, 50], "goal": [380, 380],
+        "robot": {"radius": 10},
+        "obstacles": [
+            {"type": "rectangle", "min": [300, 300], "max": [460, 310]},
+            {"type": "rectangle", "min": [300, 450], "max": [460, 460]},
+            {"type": "rectangle", "min": [300, 300], "max": [310, 460]},
+            {"type": "rectangle", "min": [450, 300], "max": [460, 460]},
+        ],
+    }
+    f = tmp_path / "boxed.yaml"
+    f.write_text(yaml.safe_dump(problem))
+    out = tmp_path / "r.json"
+    proc = run("solve", str(f), "--time", "0.2", "--planner", "RRTstar", "--json", str(out))
+    assert proc.returncode == 1, proc.stderr
+    data = json.loads(out.read_text())
+    assert data["solved"] is False and data["status"] in ("none", "approximate")
+
+
+BAD_INPUT = {
+    "unknown-planner": (["--planner", "NoSuchPlanner"], "NoSuchPlanner"),
+    "zero-time": (["--time", "0"], "--time"),
+    "negative-time": (["--time", "-1"], "--time"),
+    "unknown-param": (["--param", "no_such=1"], "no_such"),
+    "bad-param-value": (["--param", "goal_bias=2"], "goal_bias"),
+    "malformed-param": (["--param", "swarm_size"], "--param"),
+}
+
+
+@pytest.mark.parametrize("flags,needle", BAD_INPUT.values(), ids=BAD_INPUT.keys())
+def test_bad_flags_exit_2_without_output(circle_file, tmp_path, flags, needle):
+    out = tmp_path / "r.json"
+    proc = run("solve", str(circle_file), *flags, "--json", str(out))
+    assert proc.returncode == 2
+    assert needle in proc.stderr and circle_file.name in proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_bad_file_exit_2_names_file_and_key(tmp_path):
+    bad = dict(SINGLE_CIRCLE, robot={"radius": -3})
+    f = tmp_path / "neg.yaml"
+    f.write_text(yaml.safe_dump(bad))
+    out = tmp_path / "r.json"
+    proc = run("solve", str(f), "--json", str(out))
+    assert proc.returncode == 2
+    assert "neg.yaml" in proc.stderr and "robot.radius" in proc.stderr
+    assert "Traceback" not in proc.stderr and not out.exists()
+
+
+def test_unknown_planner_in_file_names_the_key(tmp_path):
+    f = tmp_path / "p.yaml"
+    f.write_text(yaml.safe_dump(dict(SINGLE_CIRCLE, planner={"type": "Nope"})))
+    proc = run("solve", str(f))
+    assert proc.returncode == 2 and "planner.type" in proc.stderr and "RRTstarPSO" in proc.stderr
+
+
+def test_missing_file_exit_2(tmp_path):
+    proc = run("solve", str(tmp_path / "nope.yaml"))
+    assert proc.returncode == 2 and "nope.yaml" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_same_seed_same_path_iteration_bounded(circle_file, tmp_path):
+    """Reproducibility across processes: OMPL is seeded once per process, so each run is its own
+    process; the run is bounded by iterations, not by time, so machine speed does not matter."""
+    paths = []
+    for i, seed in enumerate((11, 11, 12)):
+        out = tmp_path / f"r{i}.json"
+        proc = run("solve", str(circle_file), "--seed", str(seed), "--time", "30",
+                   "--param", "rrt_max_iterations=600", "--param", "iterations=30",
+                   "--json", str(out))
+        assert proc.returncode == 0, proc.stderr
+        paths.append(json.loads(out.read_text())["path"])
+    assert paths[0] == paths[1]
+    assert paths[0] != paths[2]
+
+
+def test_planners_lists_everything_with_params():
+    proc = run("planners", "--json")
+    assert proc.returncode == 0
+    rows = {r["name"]: r for r in json.loads(proc.stdout)}
+    for name in ("RRTstarPSO", "PSO", "RRTstar", "BITstar", "RRTConnect", "InformedRRTstar"):
+        assert name in rows
+    assert "geometric::RRTstar" in rows["RRTstar"]["aliases"]
+    params = {p["name"]: p for p in rows["RRTstarPSO"]["params"]}
+    for name in ("range", "goal_bias", "rewire_factor", "rrt_time_fraction", "swarm_size",
+                 "iterations", "w", "c1", "c2"):
+        assert name in params
+    text = run("planners", "RRTstarPSO")
+    assert text.returncode == 0 and "swarm_size" in text.stdout
+    assert run("planners", "Nope").returncode == 2
+
+
+@pytest.mark.parametrize("path", sorted(PROBLEMS.glob("*.yaml")), ids=lambda p: p.stem)
+def test_every_shipped_problem_solves(path, tmp_path):
+    out = tmp_path / "r.json"
+    proc = run("solve", str(path), "--time", "0.5", "--seed", "1", "--json", str(out))
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(out.read_text())["solved"]
