@@ -214,15 +214,20 @@ class PlannerEntry:
 
 
 class UnknownPlannerError(KeyError):
-    """No planner of that name; the message lists the known names."""
+    """No usable planner of that name; the message lists the known names (and says why a
+    planner that exists but is excluded cannot be used)."""
 
-    def __init__(self, name: str, known: Iterable[str]) -> None:
+    def __init__(self, name: str, known: Iterable[str], reason: str = "") -> None:
         self.name = name
         self.known = sorted(known, key=str.lower)
+        self.reason = reason
         super().__init__(name)
 
     def __str__(self) -> str:
-        return f"unknown planner '{self.name}'; known planners: {', '.join(self.known)}"
+        known = ", ".join(self.known)
+        if self.reason:
+            return f"planner '{self.name}' is unavailable ({self.reason}); known planners: {known}"
+        return f"unknown planner '{self.name}'; known planners: {known}"
 
 
 class PlannerRegistry:
@@ -231,6 +236,8 @@ class PlannerRegistry:
     def __init__(self) -> None:
         self._entries: dict[str, PlannerEntry] = {}
         self._lookup: dict[str, str] = {}
+        #: Names that exist but cannot be used, with the reason (reported on selection).
+        self.unavailable: dict[str, str] = {}
 
     def register(self, entry: PlannerEntry, source: str = "") -> PlannerEntry:
         """Add ``entry``; ``ValueError`` when its name or an alias is taken or it is malformed."""
@@ -262,7 +269,8 @@ class PlannerRegistry:
         try:
             return self._entries[self._lookup[name]]
         except KeyError:
-            raise UnknownPlannerError(name, self._entries) from None
+            reason = self.unavailable.get(name.removeprefix("geometric::"), "")
+            raise UnknownPlannerError(name, self._entries, reason) from None
 
     def __contains__(self, name: object) -> bool:
         return name in self._lookup
@@ -288,6 +296,7 @@ class PlannerRegistry:
         for mod_name in FIRST_PARTY_PLUGINS:
             module = _import_first_party(mod_name)
             self.register_plugin(module.PLANNERS, source=f"rrtpso_ompl.plugins.{mod_name}")
+            self.unavailable.update(getattr(module, "UNAVAILABLE", {}))
 
     def load_entry_points(self, group: str = ENTRY_POINT_GROUP) -> None:
         """Register third-party planners from the entry-point group; warn about broken ones."""
