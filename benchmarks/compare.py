@@ -75,8 +75,13 @@ def main(argv: list[str] | None = None) -> int:
     problems = [Path(p) for p in args.problems] or sorted((REPO / "problems").glob("*.yaml"))
     planners = args.planners.split(",")
     budgets = [float(b) for b in args.budgets.split(",")]
-    tasks = [(str(p), pl, b, s) for p in problems for b in budgets for pl in planners
-             for s in range(1, args.seeds + 1)]
+    tasks = [
+        (str(p), pl, b, s)
+        for p in problems
+        for b in budgets
+        for pl in planners
+        for s in range(1, args.seeds + 1)
+    ]
 
     from tqdm import tqdm
 
@@ -86,8 +91,9 @@ def main(argv: list[str] | None = None) -> int:
     ctx = mp.get_context("spawn")
     with ProcessPoolExecutor(args.jobs, mp_context=ctx, max_tasks_per_child=1) as pool:
         futures = [pool.submit(run_one, *t) for t in tasks]
-        for fut in tqdm(as_completed(futures), total=len(futures), file=sys.stderr,
-                        disable=None, desc="runs"):
+        for fut in tqdm(
+            as_completed(futures), total=len(futures), file=sys.stderr, disable=None, desc="runs"
+        ):
             rows.append(fut.result())
     total = time.perf_counter() - t0
 
@@ -127,9 +133,12 @@ def report(rows: list[dict], planners: list[str], budgets: list[float], args, to
         lengths = [r["length"] for r in prs if r["solved"]]
         ref = KNOWN_OPTIMA.get(name, min(lengths) if lengths else math.nan)
         kind = "optimum" if name in KNOWN_OPTIMA else "best found"
-        lines += [f"## {name} (ref = {ref:.2f}, {kind})", "",
-                  "| planner | " + " | ".join(f"{b:g} s" for b in budgets) + " |",
-                  "|---|" + "---|" * len(budgets)]
+        lines += [
+            f"## {name} (ref = {ref:.2f}, {kind})",
+            "",
+            "| planner | " + " | ".join(f"{b:g} s" for b in budgets) + " |",
+            "|---|" + "---|" * len(budgets),
+        ]
         med: dict[tuple[str, float], float] = {}
         for pl in planners:
             cells = []
@@ -143,8 +152,12 @@ def report(rows: list[dict], planners: list[str], budgets: list[float], args, to
                 if pl in PSO_PLANNERS and cell and cell[0]["pso_time"] is not None:
                     share = _median([r["pso_time"] / b for r in cell if r["pso_time"]])
                     extra = f", PSO {100 * share:.1f}% of budget"
-                cells.append(f"{m:.2f} (+{100 * (m / ref - 1):.2f}%) [{len(ok)}/{len(cell)}] "
-                             f"{t:.2f} s{extra}" if ok else f"– [0/{len(cell)}]")
+                cells.append(
+                    f"{m:.2f} (+{100 * (m / ref - 1):.2f}%) [{len(ok)}/{len(cell)}] "
+                    f"{t:.2f} s{extra}"
+                    if ok
+                    else f"– [0/{len(cell)}]"
+                )
             lines.append(f"| {pl} | " + " | ".join(cells) + " |")
         lines.append("")
         for b in budgets:
@@ -153,13 +166,60 @@ def report(rows: list[dict], planners: list[str], budgets: list[float], args, to
                 if b >= from_budget and (other, b) in med:
                     theirs = med[other, b]
                     ok = ours < theirs
-                    checks.append(f"- {name}, {b:g} s: RRTstarPSO {ours:.2f} vs {other} "
-                                  f"{theirs:.2f}: {'met' if ok else '**not met**'}")
+                    checks.append(
+                        f"- {name}, {b:g} s: RRTstarPSO {ours:.2f} vs {other} "
+                        f"{theirs:.2f}: {'met' if ok else '**not met**'}"
+                    )
             if name in KNOWN_OPTIMA:
                 ok = ours <= 1.01 * ref
-                checks.append(f"- {name}, {b:g} s: within 1% of the optimum ({ours:.2f} vs "
-                              f"{ref:.2f}): {'met' if ok else '**not met**'}")
+                checks.append(
+                    f"- {name}, {b:g} s: within 1% of the optimum ({ours:.2f} vs "
+                    f"{ref:.2f}): {'met' if ok else '**not met**'}"
+                )
     lines += ["## Targets", "", *checks, ""]
+    lines += ["## Where RRTstarPSO is not the shortest", ""]
+    beaten = []
+    for name, prs in sorted(by_problem.items()):
+        for b in budgets:
+            meds = {
+                pl: _median(
+                    [
+                        r["length"]
+                        for r in prs
+                        if r["planner"] == pl and r["budget"] == b and r["solved"]
+                    ]
+                )
+                for pl in planners
+            }
+            ours = meds.get("RRTstarPSO", math.nan)
+            for pl, m in sorted(meds.items(), key=lambda kv: kv[1]):
+                if pl != "RRTstarPSO" and m < ours:
+                    beaten.append(
+                        f"- {name}, {b:g} s: {pl} {m:.2f} < RRTstarPSO {ours:.2f} "
+                        f"({100 * (ours / m - 1):.2f}% longer)"
+                    )
+    lines += beaten or ["- nowhere: RRTstarPSO has the shortest median path in every cell."]
+    gains = [
+        (r["rrt_length"] - r["length"]) / r["rrt_length"]
+        for r in rows
+        if r["planner"] == "RRTstarPSO" and r["solved"] and r["rrt_length"]
+    ]
+    shares = [
+        r["pso_time"] / r["budget"]
+        for r in rows
+        if r["planner"] == "RRTstarPSO" and r["pso_time"] is not None
+    ]
+    if gains:
+        lines += [
+            "",
+            "## The PSO stage",
+            "",
+            f"Over {len(gains)} RRTstarPSO runs the PSO stage shortened RRT*'s path by "
+            f"{100 * statistics.median(gains):.2f}% in the median (max {100 * max(gains):.2f}%), "
+            f"using {100 * statistics.median(shares):.1f}% of the budget in the median "
+            f"(max {100 * max(shares):.1f}%).",
+        ]
+    lines.append("")
     return "\n".join(lines)
 
 

@@ -14,8 +14,10 @@ def table(name: str) -> str:
     entry = default_registry().get(name)
     rows = ["| name | type | default | unit | range | meaning |", "|---|---|---|---|---|---|"]
     for p in entry.params:
-        rows.append(f"| `{p.name}` | {p.type.__name__} | {p.default} | {p.unit or '–'} | "
-                    f"{p.range_text()} | {p.doc} |")
+        rows.append(
+            f"| `{p.name}` | {p.type.__name__} | {p.default} | {p.unit or '–'} | "
+            f"{p.range_text()} | {p.doc} |"
+        )
     return "\n".join(rows)
 
 

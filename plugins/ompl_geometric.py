@@ -14,96 +14,304 @@ from ompl import geometric as og
 from rrtpso_ompl.registry import ParamSpec, PlannerEntry
 
 # --- parameters shared by several planners (OMPL's names) --------------------------------------
-RANGE = ParamSpec("range", float, 0.0, "Longest motion added to the tree; 0 lets OMPL choose "
-                  "(20% of the space's extent).", unit="length", low=0.0,
-                  setter="setRange", getter="getRange")
-GOAL_BIAS = ParamSpec("goal_bias", float, 0.05, "Probability of sampling the goal.",
-                      low=0.0, high=1.0, setter="setGoalBias", getter="getGoalBias")
-INTERMEDIATE = ParamSpec("intermediate_states", bool, False, "Add the intermediate states of "
-                         "each motion to the tree.", setter="setIntermediateStates",
-                         getter="getIntermediateStates")
-REWIRE = ParamSpec("rewire_factor", float, 1.1, "Scale of the rewiring radius/number of "
-                   "neighbours (> 1 keeps asymptotic optimality).", low=1.0, high=10.0,
-                   setter="setRewireFactor", getter="getRewireFactor")
-K_NEAREST = ParamSpec("use_k_nearest", bool, True, "Rewire with the k nearest neighbours instead "
-                      "of a radius.", setter="setKNearest", getter="getKNearest")
-DELAY_CC = ParamSpec("delay_collision_checking", bool, True, "Check motions for collision only "
-                     "when they could improve the cost.", setter="setDelayCC",
-                     getter="getDelayCC")
-BORDER = ParamSpec("border_fraction", float, 0.9, "Fraction of time spent on the border of the "
-                   "explored region.", low=0.0, high=1.0, setter="setBorderFraction",
-                   getter="getBorderFraction")
-MIN_VALID = ParamSpec("min_valid_path_fraction", float, 0.5, "Fraction of a motion that must be "
-                      "valid to be kept.", low=0.0, high=1.0, setter="setMinValidPathFraction",
-                      getter="getMinValidPathFraction")
-FAILED_SCORE = ParamSpec("failed_expansion_score_factor", float, 0.5, "Score factor of a cell "
-                         "whose expansion failed.", low=0.0, high=1.0,
-                         setter="setFailedExpansionCellScoreFactor",
-                         getter="getFailedExpansionCellScoreFactor")
-MAX_NN = ParamSpec("max_nearest_neighbors", int, 10, "Neighbours each roadmap vertex tries to "
-                   "connect to.", low=1, high=1000, setter="setMaxNearestNeighbors",
-                   getter=None)
+RANGE = ParamSpec(
+    "range",
+    float,
+    0.0,
+    "Longest motion added to the tree; 0 lets OMPL choose (20% of the space's extent).",
+    unit="length",
+    low=0.0,
+    setter="setRange",
+    getter="getRange",
+)
+GOAL_BIAS = ParamSpec(
+    "goal_bias",
+    float,
+    0.05,
+    "Probability of sampling the goal.",
+    low=0.0,
+    high=1.0,
+    setter="setGoalBias",
+    getter="getGoalBias",
+)
+INTERMEDIATE = ParamSpec(
+    "intermediate_states",
+    bool,
+    False,
+    "Add the intermediate states of each motion to the tree.",
+    setter="setIntermediateStates",
+    getter="getIntermediateStates",
+)
+REWIRE = ParamSpec(
+    "rewire_factor",
+    float,
+    1.1,
+    "Scale of the rewiring radius/number of neighbours (> 1 keeps asymptotic optimality).",
+    low=1.0,
+    high=10.0,
+    setter="setRewireFactor",
+    getter="getRewireFactor",
+)
+K_NEAREST = ParamSpec(
+    "use_k_nearest",
+    bool,
+    True,
+    "Rewire with the k nearest neighbours instead of a radius.",
+    setter="setKNearest",
+    getter="getKNearest",
+)
+DELAY_CC = ParamSpec(
+    "delay_collision_checking",
+    bool,
+    True,
+    "Check motions for collision only when they could improve the cost.",
+    setter="setDelayCC",
+    getter="getDelayCC",
+)
+BORDER = ParamSpec(
+    "border_fraction",
+    float,
+    0.9,
+    "Fraction of time spent on the border of the explored region.",
+    low=0.0,
+    high=1.0,
+    setter="setBorderFraction",
+    getter="getBorderFraction",
+)
+MIN_VALID = ParamSpec(
+    "min_valid_path_fraction",
+    float,
+    0.5,
+    "Fraction of a motion that must be valid to be kept.",
+    low=0.0,
+    high=1.0,
+    setter="setMinValidPathFraction",
+    getter="getMinValidPathFraction",
+)
+FAILED_SCORE = ParamSpec(
+    "failed_expansion_score_factor",
+    float,
+    0.5,
+    "Score factor of a cell whose expansion failed.",
+    low=0.0,
+    high=1.0,
+    setter="setFailedExpansionCellScoreFactor",
+    getter="getFailedExpansionCellScoreFactor",
+)
+MAX_NN = ParamSpec(
+    "max_nearest_neighbors",
+    int,
+    10,
+    "Neighbours each roadmap vertex tries to connect to.",
+    low=1,
+    high=1000,
+    setter="setMaxNearestNeighbors",
+    getter=None,
+)
 
 RRTSTAR_FAMILY = (
-    RANGE, GOAL_BIAS, REWIRE, K_NEAREST, DELAY_CC,
-    ParamSpec("tree_pruning", bool, False, "Prune tree vertices that cannot improve the solution.",
-              setter="setTreePruning", getter="getTreePruning"),
-    ParamSpec("prune_threshold", float, 0.05, "Relative cost improvement that triggers pruning.",
-              low=0.0, high=1.0, setter="setPruneThreshold", getter="getPruneThreshold"),
-    ParamSpec("informed_sampling", bool, False, "Sample only the informed set (ellipse) once a "
-              "solution exists.", setter="setInformedSampling", getter="getInformedSampling"),
-    ParamSpec("sample_rejection", bool, False, "Reject samples that cannot improve the solution.",
-              setter="setSampleRejection", getter="getSampleRejection"),
-    ParamSpec("new_state_rejection", bool, False, "Reject new states that cannot improve the "
-              "solution.", setter="setNewStateRejection", getter="getNewStateRejection"),
-    ParamSpec("use_admissible_heuristic", bool, True, "Use an admissible cost-to-come heuristic "
-              "when pruning.", setter="setAdmissibleCostToCome",
-              getter="getAdmissibleCostToCome"),
-    ParamSpec("focus_search", bool, False, "Focus the search on the current solution's "
-              "neighbourhood.", setter="setFocusSearch", getter="getFocusSearch"),
-    ParamSpec("number_sampling_attempts", int, 100, "Attempts to draw an informed sample.",
-              low=1, high=100000, setter="setNumSamplingAttempts",
-              getter="getNumSamplingAttempts"),
+    RANGE,
+    GOAL_BIAS,
+    REWIRE,
+    K_NEAREST,
+    DELAY_CC,
+    ParamSpec(
+        "tree_pruning",
+        bool,
+        False,
+        "Prune tree vertices that cannot improve the solution.",
+        setter="setTreePruning",
+        getter="getTreePruning",
+    ),
+    ParamSpec(
+        "prune_threshold",
+        float,
+        0.05,
+        "Relative cost improvement that triggers pruning.",
+        low=0.0,
+        high=1.0,
+        setter="setPruneThreshold",
+        getter="getPruneThreshold",
+    ),
+    ParamSpec(
+        "informed_sampling",
+        bool,
+        False,
+        "Sample only the informed set (ellipse) once a solution exists.",
+        setter="setInformedSampling",
+        getter="getInformedSampling",
+    ),
+    ParamSpec(
+        "sample_rejection",
+        bool,
+        False,
+        "Reject samples that cannot improve the solution.",
+        setter="setSampleRejection",
+        getter="getSampleRejection",
+    ),
+    ParamSpec(
+        "new_state_rejection",
+        bool,
+        False,
+        "Reject new states that cannot improve the solution.",
+        setter="setNewStateRejection",
+        getter="getNewStateRejection",
+    ),
+    ParamSpec(
+        "use_admissible_heuristic",
+        bool,
+        True,
+        "Use an admissible cost-to-come heuristic when pruning.",
+        setter="setAdmissibleCostToCome",
+        getter="getAdmissibleCostToCome",
+    ),
+    ParamSpec(
+        "focus_search",
+        bool,
+        False,
+        "Focus the search on the current solution's neighbourhood.",
+        setter="setFocusSearch",
+        getter="getFocusSearch",
+    ),
+    ParamSpec(
+        "number_sampling_attempts",
+        int,
+        100,
+        "Attempts to draw an informed sample.",
+        low=1,
+        high=100000,
+        setter="setNumSamplingAttempts",
+        getter="getNumSamplingAttempts",
+    ),
 )
 
 
 BITSTAR = (
     REWIRE,
-    ParamSpec("samples_per_batch", int, 100, "Samples added per batch.", low=1, high=1_000_000,
-              setter="setSamplesPerBatch", getter="getSamplesPerBatch"),
-    ParamSpec("use_k_nearest", bool, True, "Use k nearest neighbours instead of a radius.",
-              setter="setUseKNearest", getter="getUseKNearest"),
-    ParamSpec("use_graph_pruning", bool, True, "Prune the graph when the solution improves.",
-              setter="setPruning", getter="getPruning"),
-    ParamSpec("prune_threshold_as_fractional_cost_change", float, 0.05, "Relative improvement "
-              "that triggers pruning.", low=0.0, high=1.0, setter="setPruneThresholdFraction",
-              getter="getPruneThresholdFraction"),
-    ParamSpec("use_just_in_time_sampling", bool, False, "Generate samples only when needed.",
-              setter="setJustInTimeSampling", getter="getJustInTimeSampling"),
-    ParamSpec("drop_unconnected_samples_on_prune", bool, False, "Drop unconnected samples when "
-              "pruning.", setter="setDropSamplesOnPrune", getter="getDropSamplesOnPrune"),
-    ParamSpec("stop_on_each_solution_improvement", bool, False, "Return after every improvement.",
-              setter="setStopOnSolnImprovement", getter="getStopOnSolnImprovement"),
-    ParamSpec("find_approximate_solutions", bool, False, "Report approximate solutions.",
-              setter="setConsiderApproximateSolutions",
-              getter="getConsiderApproximateSolutions"),
+    ParamSpec(
+        "samples_per_batch",
+        int,
+        100,
+        "Samples added per batch.",
+        low=1,
+        high=1_000_000,
+        setter="setSamplesPerBatch",
+        getter="getSamplesPerBatch",
+    ),
+    ParamSpec(
+        "use_k_nearest",
+        bool,
+        True,
+        "Use k nearest neighbours instead of a radius.",
+        setter="setUseKNearest",
+        getter="getUseKNearest",
+    ),
+    ParamSpec(
+        "use_graph_pruning",
+        bool,
+        True,
+        "Prune the graph when the solution improves.",
+        setter="setPruning",
+        getter="getPruning",
+    ),
+    ParamSpec(
+        "prune_threshold_as_fractional_cost_change",
+        float,
+        0.05,
+        "Relative improvement that triggers pruning.",
+        low=0.0,
+        high=1.0,
+        setter="setPruneThresholdFraction",
+        getter="getPruneThresholdFraction",
+    ),
+    ParamSpec(
+        "use_just_in_time_sampling",
+        bool,
+        False,
+        "Generate samples only when needed.",
+        setter="setJustInTimeSampling",
+        getter="getJustInTimeSampling",
+    ),
+    ParamSpec(
+        "drop_unconnected_samples_on_prune",
+        bool,
+        False,
+        "Drop unconnected samples when pruning.",
+        setter="setDropSamplesOnPrune",
+        getter="getDropSamplesOnPrune",
+    ),
+    ParamSpec(
+        "stop_on_each_solution_improvement",
+        bool,
+        False,
+        "Return after every improvement.",
+        setter="setStopOnSolnImprovement",
+        getter="getStopOnSolnImprovement",
+    ),
+    ParamSpec(
+        "find_approximate_solutions",
+        bool,
+        False,
+        "Report approximate solutions.",
+        setter="setConsiderApproximateSolutions",
+        getter="getConsiderApproximateSolutions",
+    ),
 )
 
 FMT_FAMILY = (
-    ParamSpec("num_samples", int, 1000, "Samples drawn up front.", low=10, high=1_000_000,
-              setter="setNumSamples", getter="getNumSamples"),
-    ParamSpec("radius_multiplier", float, 1.1, "Scale of the connection radius.", low=0.1,
-              high=10.0, setter="setRadiusMultiplier", getter="getRadiusMultiplier"),
-    ParamSpec("nearest_k", bool, True, "Use k nearest neighbours instead of a radius.",
-              setter="setNearestK", getter="getNearestK"),
-    ParamSpec("cache_cc", bool, True, "Cache collision-check results.", setter="setCacheCC",
-              getter="getCacheCC"),
-    ParamSpec("heuristics", bool, False, "Order the search with a cost-to-go heuristic.",
-              setter="setHeuristics", getter="getHeuristics"),
-    ParamSpec("extended_fmt", bool, True, "Add samples when the search fails.",
-              setter="setExtendedFMT", getter="getExtendedFMT"),
+    ParamSpec(
+        "num_samples",
+        int,
+        1000,
+        "Samples drawn up front.",
+        low=10,
+        high=1_000_000,
+        setter="setNumSamples",
+        getter="getNumSamples",
+    ),
+    ParamSpec(
+        "radius_multiplier",
+        float,
+        1.1,
+        "Scale of the connection radius.",
+        low=0.1,
+        high=10.0,
+        setter="setRadiusMultiplier",
+        getter="getRadiusMultiplier",
+    ),
+    ParamSpec(
+        "nearest_k",
+        bool,
+        True,
+        "Use k nearest neighbours instead of a radius.",
+        setter="setNearestK",
+        getter="getNearestK",
+    ),
+    ParamSpec(
+        "cache_cc",
+        bool,
+        True,
+        "Cache collision-check results.",
+        setter="setCacheCC",
+        getter="getCacheCC",
+    ),
+    ParamSpec(
+        "heuristics",
+        bool,
+        False,
+        "Order the search with a cost-to-go heuristic.",
+        setter="setHeuristics",
+        getter="getHeuristics",
+    ),
+    ParamSpec(
+        "extended_fmt",
+        bool,
+        True,
+        "Add samples when the search fails.",
+        setter="setExtendedFMT",
+        getter="getExtendedFMT",
+    ),
 )
-
 
 
 def _defaults(params: tuple[ParamSpec, ...], **defaults) -> tuple[ParamSpec, ...]:
@@ -120,14 +328,29 @@ BFMT_PARAMS = _defaults(FMT_FAMILY, radius_multiplier=1.0, heuristics=True)
 _TABLE = [
     ("BFMT", BFMT_PARAMS, True, "Bidirectional Fast Marching Tree", None),
     ("BITstar", BITSTAR, True, "Batch Informed Trees", None),
-    ("BKPIECE1", (RANGE, BORDER, FAILED_SCORE, MIN_VALID), False,
-     "Bidirectional KPIECE", "geometric::BKPIECE"),
+    (
+        "BKPIECE1",
+        (RANGE, BORDER, FAILED_SCORE, MIN_VALID),
+        False,
+        "Bidirectional KPIECE",
+        "geometric::BKPIECE",
+    ),
     ("FMT", FMT_FAMILY, True, "Fast Marching Tree", None),
     ("InformedRRTstar", INFORMED_RRTSTAR, True, "RRT* with informed sampling", None),
-    ("KPIECE1", (RANGE, GOAL_BIAS, BORDER, FAILED_SCORE, replace(MIN_VALID, default=0.2)), False,
-     "Kinodynamic Planning by Interior-Exterior Cell Exploration", "geometric::KPIECE"),
-    ("LBKPIECE1", (RANGE, BORDER, MIN_VALID), False, "Lazy bidirectional KPIECE",
-     "geometric::LBKPIECE"),
+    (
+        "KPIECE1",
+        (RANGE, GOAL_BIAS, BORDER, FAILED_SCORE, replace(MIN_VALID, default=0.2)),
+        False,
+        "Kinodynamic Planning by Interior-Exterior Cell Exploration",
+        "geometric::KPIECE",
+    ),
+    (
+        "LBKPIECE1",
+        (RANGE, BORDER, MIN_VALID),
+        False,
+        "Lazy bidirectional KPIECE",
+        "geometric::LBKPIECE",
+    ),
     ("PRM", (MAX_NN,), False, "Probabilistic Roadmap", None),
     ("PRMstar", (), True, "Asymptotically optimal PRM", None),
     ("RRT", (RANGE, GOAL_BIAS, INTERMEDIATE), False, "Rapidly-exploring Random Tree", None),

@@ -31,27 +31,54 @@ def _build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = sub.add_parser("solve", help="solve one problem file",
-                       description="Solve one problem file and report the path.")
+    p = sub.add_parser(
+        "solve",
+        help="solve one problem file",
+        description="Solve one problem file and report the path.",
+    )
     p.add_argument("problem", help="problem file (YAML, see docs/problem-format.md)")
-    p.add_argument("--planner", help="planner name (default: the file's planner.type, else "
-                   "RRTstarPSO); see 'rrtpso planners'")
-    p.add_argument("--time", type=float, metavar="SECONDS",
-                   help="time limit (default: the file's planner.time_limit, else 1.0)")
+    p.add_argument(
+        "--planner",
+        help="planner name (default: the file's planner.type, else "
+        "RRTstarPSO); see 'rrtpso planners'",
+    )
+    p.add_argument(
+        "--time",
+        type=float,
+        metavar="SECONDS",
+        help="time limit (default: the file's planner.time_limit, else 1.0)",
+    )
     p.add_argument("--seed", type=int, help="random seed (default: the file's planner.seed)")
-    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
-                   help="planner parameter, repeatable (e.g. --param swarm_size=50)")
+    p.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="planner parameter, repeatable (e.g. --param swarm_size=50)",
+    )
     p.add_argument("--json", metavar="OUT", help="write the result as JSON")
-    p.add_argument("--plot", metavar="OUT.png", help="draw the world, the paths and the PSO "
-                   "best-cost curve")
-    p.add_argument("--simplify", action="store_true",
-                   help="run OMPL's path simplifier on the result within the time limit")
-    p.add_argument("-v", "--verbose", action="count", default=0,
-                   help="show OMPL's Info (-v) and Debug (-vv) messages")
+    p.add_argument(
+        "--plot", metavar="OUT.png", help="draw the world, the paths and the PSO best-cost curve"
+    )
+    p.add_argument(
+        "--simplify",
+        action="store_true",
+        help="run OMPL's path simplifier on the result within the time limit",
+    )
+    p.add_argument(
+        "-v",
+        "--verbose",
+        action="count",
+        default=0,
+        help="show OMPL's Info (-v) and Debug (-vv) messages",
+    )
     p.set_defaults(func=_cmd_solve)
 
-    q = sub.add_parser("planners", help="list the planners and their parameters",
-                       description="List the registered planners and their parameters.")
+    q = sub.add_parser(
+        "planners",
+        help="list the planners and their parameters",
+        description="List the registered planners and their parameters.",
+    )
     q.add_argument("name", nargs="?", help="show only this planner")
     q.add_argument("--json", action="store_true", help="machine-readable output")
     q.set_defaults(func=_cmd_planners)
@@ -122,8 +149,10 @@ def _cmd_solve(args: argparse.Namespace) -> int:
 
         write_json_atomic(result.to_dict(), args.json)
     length = f"{result.length:.3f}" if result.length is not None else "-"
-    print(f"{problem.name}: {result.planner} {result.status} length={length} "
-          f"time={result.time:.3f}s", file=sys.stderr)
+    print(
+        f"{problem.name}: {result.planner} {result.status} length={length} time={result.time:.3f}s",
+        file=sys.stderr,
+    )
     return EXIT_SOLVED if result.solved else EXIT_UNSOLVED
 
 
@@ -164,8 +193,14 @@ def _cmd_planners(args: argparse.Namespace) -> int:
                 "optimizing": e.optimizing,
                 "source": e.source,
                 "params": [
-                    {"name": p.name, "type": p.type.__name__, "default": p.default,
-                     "unit": p.unit, "range": p.range_text(), "doc": p.doc}
+                    {
+                        "name": p.name,
+                        "type": p.type.__name__,
+                        "default": p.default,
+                        "unit": p.unit,
+                        "range": p.range_text(),
+                        "doc": p.doc,
+                    }
                     for p in e.params
                 ],
             }
@@ -178,8 +213,10 @@ def _cmd_planners(args: argparse.Namespace) -> int:
         print(f"{e.name}{aliases}\n    {e.description}  [{e.source}]")
         for p in e.params:
             unit = f" {p.unit}" if p.unit else ""
-            print(f"    {p.name:<28} {p.type.__name__:<5} default {p.default!s:<8}{unit} "
-                  f"in {p.range_text()}")
+            print(
+                f"    {p.name:<28} {p.type.__name__:<5} default {p.default!s:<8}{unit} "
+                f"in {p.range_text()}"
+            )
             if args.name:
                 print(f"        {p.doc}")
     return EXIT_SOLVED

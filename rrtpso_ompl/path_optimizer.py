@@ -267,8 +267,9 @@ def _pso_round(
         seg_hi = np.maximum(pt_hi[:-1], pt_hi[1:])
         local_model = world.local_model(seg_lo, seg_hi)
         violation = local_model.violation
-    round_cost = PathCost(cost_model.start, cost_model.goal, world,
-                          cost_model.smoothness_weight, violation)
+    round_cost = PathCost(
+        cost_model.start, cost_model.goal, world, cost_model.smoothness_weight, violation
+    )
 
     n = options.pso.swarm_size
     x0 = interior.reshape(-1)
@@ -282,8 +283,9 @@ def _pso_round(
 
     v_max = options.pso.v_max or options.v_max_fraction * float(seg_len.mean())
     swarm = replace(options.pso, v_max=v_max)
-    res = pso.minimize(cost, lo.reshape(-1), hi.reshape(-1), swarm, rng, init=init,
-                       terminate=terminate)
+    res = pso.minimize(
+        cost, lo.reshape(-1), hi.reshape(-1), swarm, rng, init=init, terminate=terminate
+    )
     best = np.vstack([seed_path[:1], res.position.reshape(k, 2), seed_path[-1:]])
     return best, res
 

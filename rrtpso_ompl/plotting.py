@@ -42,11 +42,15 @@ def draw_world(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> None
         if isinstance(obs, Circle):
             ax.add_patch(CirclePatch(obs.center, obs.radius, color=OBSTACLE, zorder=2))
             if safety_zones and r > 0:
-                ax.add_patch(CirclePatch(obs.center, obs.radius + r, fill=False, ls="--",
-                                         lw=0.9, ec=SAFETY, zorder=1))
+                ax.add_patch(
+                    CirclePatch(
+                        obs.center, obs.radius + r, fill=False, ls="--", lw=0.9, ec=SAFETY, zorder=1
+                    )
+                )
         elif isinstance(obs, Polygon):
-            ax.add_patch(PolygonPatch(np.asarray(obs.points), closed=True, color=OBSTACLE,
-                                      zorder=2))
+            ax.add_patch(
+                PolygonPatch(np.asarray(obs.points), closed=True, color=OBSTACLE, zorder=2)
+            )
             if safety_zones and r > 0:
                 # Drawing only: the checks use exact distances, never this buffered outline.
                 grown = shapely.Polygon(obs.points).buffer(r, quad_segs=32)
@@ -54,8 +58,16 @@ def draw_world(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> None
     (xmin, ymin), (xmax, ymax) = problem.bounds
     ax.plot([xmin, xmax, xmax, xmin, xmin], [ymin, ymin, ymax, ymax, ymin], color="k", lw=0.8)
     ax.add_patch(CirclePatch(problem.start, r, fill=False, ec="tab:green", lw=1.0, zorder=4))
-    ax.add_patch(CirclePatch(problem.goal, max(r, problem.goal_tolerance), fill=False,
-                             ec="tab:blue", lw=1.0, zorder=4))
+    ax.add_patch(
+        CirclePatch(
+            problem.goal,
+            max(r, problem.goal_tolerance),
+            fill=False,
+            ec="tab:blue",
+            lw=1.0,
+            zorder=4,
+        )
+    )
     ax.plot(*problem.start, "o", color="tab:green", zorder=5, label="start")
     ax.plot(*problem.goal, "*", color="tab:blue", ms=11, zorder=5, label="goal")
     pad = 0.02 * max(xmax - xmin, ymax - ymin)
@@ -72,18 +84,35 @@ def plot_solution(problem: Problem, result: SolveResult) -> Figure:
     best cost per iteration (b) when the planner ran a swarm."""
     stages: dict[str, Any] = result.stages or {}
     history = stages.get("pso_history") or []
-    fig, axes = plt.subplots(1, 2 if history else 1, figsize=(12 if history else 6.5, 6),
-                             squeeze=False)
+    fig, axes = plt.subplots(
+        1, 2 if history else 1, figsize=(12 if history else 6.5, 6), squeeze=False
+    )
     ax = axes[0, 0]
     draw_world(ax, problem)
     raw = np.asarray(stages.get("rrt_path") or [], dtype=float).reshape(-1, 2)
     if len(raw):
-        ax.plot(raw[:, 0], raw[:, 1], "o--", color=RRT_COLOUR, ms=3, lw=1.2, zorder=3,
-                label=f"RRT* path ({stages.get('rrt_length', float('nan')):.1f})")
+        ax.plot(
+            raw[:, 0],
+            raw[:, 1],
+            "o--",
+            color=RRT_COLOUR,
+            ms=3,
+            lw=1.2,
+            zorder=3,
+            label=f"RRT* path ({stages.get('rrt_length', float('nan')):.1f})",
+        )
     path = np.asarray(result.path, dtype=float).reshape(-1, 2)
     if len(path):
-        ax.plot(path[:, 0], path[:, 1], "o-", color=PATH_COLOUR, ms=3, lw=1.8, zorder=4,
-                label=f"{result.planner} path ({result.length:.1f})")
+        ax.plot(
+            path[:, 0],
+            path[:, 1],
+            "o-",
+            color=PATH_COLOUR,
+            ms=3,
+            lw=1.8,
+            zorder=4,
+            label=f"{result.planner} path ({result.length:.1f})",
+        )
     title = f"{problem.name}: {result.planner}, {result.status}"
     if result.length is not None:
         title += f", length {result.length:.2f}"
@@ -105,8 +134,9 @@ def save_figure(fig: Figure, path: str | Path, dpi: int = 120) -> None:
     """Save ``fig`` atomically (temporary file, then rename) and close it."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix or ".png",
-                               dir=path.parent)
+    fd, tmp = tempfile.mkstemp(
+        prefix=f".{path.stem}.", suffix=path.suffix or ".png", dir=path.parent
+    )
     os.close(fd)
     try:
         fig.savefig(tmp, dpi=dpi)

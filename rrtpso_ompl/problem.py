@@ -240,8 +240,17 @@ def problem_from_dict(data: Any, source: str = "<dict>", name: str | None = None
 # Validation helpers: each takes the key path it is checking, so every error can name it.
 # ----------------------------------------------------------------------------------------------
 _TOP_KEYS = (
-    "name", "description", "units", "bounds", "start", "goal", "goal_tolerance", "robot",
-    "obstacles", "moving_obstacles", "planner",
+    "name",
+    "description",
+    "units",
+    "bounds",
+    "start",
+    "goal",
+    "goal_tolerance",
+    "robot",
+    "obstacles",
+    "moving_obstacles",
+    "planner",
 )
 _ROBOT_KEYS = ("radius", "wheel_radius", "track_width", "speed", "sample_time", "sensor_range")
 _PLANNER_KEYS = ("type", "time_limit", "seed", "params")
@@ -266,14 +275,16 @@ class _Validator:
     ) -> Mapping[str, Any]:
         if not isinstance(value, Mapping):
             what = "the file" if not key else "this key"
-            raise self.error(key, f"{what} must be a mapping of keys to values, got "
-                                  f"{_describe(value)}")
+            raise self.error(
+                key, f"{what} must be a mapping of keys to values, got {_describe(value)}"
+            )
         for k in value:
             if not isinstance(k, str) or k not in allowed:
                 hint = difflib.get_close_matches(str(k), allowed, n=1)
                 did = f" (did you mean '{hint[0]}'?)" if hint else ""
-                raise self.error(_join(key, str(k)), f"unknown key{did}; allowed keys: "
-                                                     f"{', '.join(allowed)}")
+                raise self.error(
+                    _join(key, str(k)), f"unknown key{did}; allowed keys: {', '.join(allowed)}"
+                )
         for k in required:
             if k not in value or value[k] is None:
                 raise self.error(_join(key, k), "required key is missing")
@@ -288,9 +299,7 @@ class _Validator:
         return value
 
     # -- scalars -----------------------------------------------------------------------------------
-    def number(
-        self, value: Any, key: str, low: float | None = None, strict: bool = False
-    ) -> float:
+    def number(self, value: Any, key: str, low: float | None = None, strict: bool = False) -> float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.error(key, f"must be a number, got {_describe(value)}")
         x = float(value)
@@ -302,8 +311,9 @@ class _Validator:
 
     def string(self, value: Any, key: str, empty: bool = False) -> str:
         if not isinstance(value, str) or (not empty and not value.strip()):
-            raise self.error(key, f"must be a {'' if empty else 'non-empty '}string, got "
-                                  f"{_describe(value)}")
+            raise self.error(
+                key, f"must be a {'' if empty else 'non-empty '}string, got {_describe(value)}"
+            )
         return value
 
     def point(self, value: Any, key: str) -> Point:
@@ -340,8 +350,9 @@ class _Validator:
             limit = self.number(limit, f"{key}.time_limit", low=0.0, strict=True)
         seed = doc.get("seed")
         if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
-            raise self.error(f"{key}.seed", f"must be a non-negative integer, got "
-                                            f"{_describe(seed)}")
+            raise self.error(
+                f"{key}.seed", f"must be a non-negative integer, got {_describe(seed)}"
+            )
         params = doc.get("params") or {}
         if not isinstance(params, Mapping) or not all(isinstance(k, str) for k in params):
             raise self.error(f"{key}.params", "must be a mapping of parameter names to values")
@@ -352,11 +363,15 @@ class _Validator:
             raise self.error(key, f"must be a mapping with a 'type', got {_describe(value)}")
         kind = value.get("type")
         if kind is None:
-            raise self.error(f"{key}.type", "required key is missing (circle, rectangle or "
-                                            "polygon)")
-        if kind not in _OBSTACLE_KEYS:
-            raise self.error(f"{key}.type", f"unknown obstacle type {_describe(kind)}; known "
-                                            f"types: {', '.join(_OBSTACLE_KEYS)}")
+            raise self.error(
+                f"{key}.type", "required key is missing (circle, rectangle or polygon)"
+            )
+        if not isinstance(kind, str) or kind not in _OBSTACLE_KEYS:
+            raise self.error(
+                f"{key}.type",
+                f"unknown obstacle type {_describe(kind)}; known "
+                f"types: {', '.join(_OBSTACLE_KEYS)}",
+            )
         doc = self.mapping(value, key, _OBSTACLE_KEYS[kind], required=_OBSTACLE_KEYS[kind])
         if kind == "circle":
             center = self.point(doc["center"], f"{key}.center")
@@ -380,9 +395,7 @@ class _Validator:
         if len(pts) < 3:
             raise self.error(key, f"a polygon needs at least 3 distinct vertices, got {len(pts)}")
         ring = shapely.Polygon(pts)
-        if _signed_area(pts) == 0.0 and all(
-            _cross3(pts[0], pts[1], p) == 0.0 for p in pts[2:]
-        ):
+        if _signed_area(pts) == 0.0 and all(_cross3(pts[0], pts[1], p) == 0.0 for p in pts[2:]):
             raise self.error(key, "degenerate polygon: all vertices are collinear (zero area)")
         if not ring.is_valid:
             reason = shapely.is_valid_reason(ring)
@@ -408,13 +421,18 @@ class _Validator:
         x, y = getattr(problem, key)
         (xmin, ymin), (xmax, ymax) = problem.bounds
         if not (xmin <= x <= xmax and ymin <= y <= ymax):
-            raise self.error(key, f"({x:g}, {y:g}) lies outside the bounds "
-                                  f"[{xmin:g}, {xmax:g}] x [{ymin:g}, {ymax:g}]")
+            raise self.error(
+                key,
+                f"({x:g}, {y:g}) lies outside the bounds "
+                f"[{xmin:g}, {xmax:g}] x [{ymin:g}, {ymax:g}]",
+            )
+        from .world import clearance_threshold  # world imports this module's types
+
         r = problem.robot.radius
-        tol = 1e-9 * max(xmax - xmin, ymax - ymin, 1.0)
+        need = clearance_threshold(r, 1e-9 * max(xmax - xmin, ymax - ymin, 1.0))
         for i, obs in enumerate(problem.obstacles):
             d = _clearance(obs, x, y)
-            if d < r - tol:
+            if d < need:
                 raise self.error(
                     key,
                     f"the robot disc (radius {r:g}) at ({x:g}, {y:g}) overlaps obstacles[{i}] "
@@ -431,7 +449,9 @@ def _clearance(obstacle: Obstacle, x: float, y: float) -> float:
 
 
 def _signed_area(pts: list[Point]) -> float:
-    return 0.5 * sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1]))
+    return 0.5 * sum(
+        x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1], strict=True)
+    )
 
 
 def _cross3(o: Point, a: Point, b: Point) -> float:

@@ -28,23 +28,48 @@ from .rrtstar_pso import SWARM_PARAMS
 __all__ = ["PSO_PARAMS", "PSOPlanner", "PSOPlannerStats"]
 
 _BASELINE_OVERRIDES = {
-    "iterations": ParamSpec("iterations", int, 200, "PSO iterations per swarm (eqs. 4-5).",
-                            low=1, high=1_000_000),
-    "tolerance": ParamSpec("tolerance", float, 0.0, "End a swarm early when the best cost "
-                           "improved by less than this (relative) over `patience` iterations; "
-                           "0 = always run all iterations.", low=0.0, high=1.0),
-    "v_max_fraction": ParamSpec("v_max_fraction", float, 0.1, "Velocity clamp per coordinate, "
-                                "as a fraction of the workspace's larger side.", low=1e-6,
-                                high=10.0),
+    "iterations": ParamSpec(
+        "iterations", int, 200, "PSO iterations per swarm (eqs. 4-5).", low=1, high=1_000_000
+    ),
+    "tolerance": ParamSpec(
+        "tolerance",
+        float,
+        0.0,
+        "End a swarm early when the best cost "
+        "improved by less than this (relative) over `patience` iterations; "
+        "0 = always run all iterations.",
+        low=0.0,
+        high=1.0,
+    ),
+    "v_max_fraction": ParamSpec(
+        "v_max_fraction",
+        float,
+        0.1,
+        "Velocity clamp per coordinate, as a fraction of the workspace's larger side.",
+        low=1e-6,
+        high=10.0,
+    ),
 }
 
 PSO_PARAMS: tuple[ParamSpec, ...] = (
-    ParamSpec("n_waypoints", int, 5, "Free interior waypoints per candidate path.", low=1,
-              high=1000),
-    ParamSpec("budget", float, 0.0, "Total time the caller gives solve() (0 = unknown: only the "
-              "termination condition and the iterations bound the run).", unit="s", low=0.0),
-    ParamSpec("restarts", bool, True, "Start a new random swarm when one ends without a valid "
-              "path and time remains."),
+    ParamSpec(
+        "n_waypoints", int, 5, "Free interior waypoints per candidate path.", low=1, high=1000
+    ),
+    ParamSpec(
+        "budget",
+        float,
+        0.0,
+        "Total time the caller gives solve() (0 = unknown: only the "
+        "termination condition and the iterations bound the run).",
+        unit="s",
+        low=0.0,
+    ),
+    ParamSpec(
+        "restarts",
+        bool,
+        True,
+        "Start a new random swarm when one ends without a valid path and time remains.",
+    ),
     # The baseline runs a fixed number of iterations per swarm, as in the paper, and its particles
     # roam the whole workspace, so its velocity clamp is relative to the workspace.
     *(_BASELINE_OVERRIDES.get(p.name, p) for p in SWARM_PARAMS),
@@ -148,6 +173,7 @@ class PSOPlanner(PythonPlanner):
         stats.pso_length = path_length(best)
         pdef = self.getProblemDefinition()
         pdef.clearSolutionPaths()
-        pdef.addSolutionPath(array_to_path(self.getSpaceInformation(), best), False, 0.0,
-                             self.getName())
+        pdef.addSolutionPath(
+            array_to_path(self.getSpaceInformation(), best), False, 0.0, self.getName()
+        )
         return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)

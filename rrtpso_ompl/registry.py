@@ -322,7 +322,8 @@ def _import_first_party(mod_name: str) -> Any:
                 raise
             folder = Path(__file__).resolve().parent.parent / "plugins"
             spec = importlib.util.spec_from_file_location(
-                "rrtpso_ompl.plugins", folder / "__init__.py",
+                "rrtpso_ompl.plugins",
+                folder / "__init__.py",
                 submodule_search_locations=[str(folder)],
             )
             if spec is None or spec.loader is None:

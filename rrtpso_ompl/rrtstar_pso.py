@@ -38,60 +38,169 @@ __all__ = ["RRTSTAR_PSO_PARAMS", "SWARM_PARAMS", "RRTstarPSO", "RRTstarPSOStats"
 
 #: Parameters of the swarm and of the path optimiser, shared with the PSO baseline planner.
 SWARM_PARAMS: tuple[ParamSpec, ...] = (
-    ParamSpec("swarm_size", int, 30, "Number of particles (candidate paths) in the swarm.",
-              low=2, high=10000),
-    ParamSpec("iterations", int, 100, "PSO iterations per optimisation round (eqs. 4-5).",
-              low=0, high=1_000_000),
-    ParamSpec("w", float, 0.7298, "Inertia weight of the particle velocity (eq. 4).",
-              low=0.0, high=1.5),
-    ParamSpec("c1", float, 1.49618, "Cognitive coefficient: pull to the particle's best (eq. 4); "
-              "c1 + c2 < 4.", low=0.0, high=4.0),
-    ParamSpec("c2", float, 1.49618, "Social coefficient: pull to the swarm's best (eq. 4); "
-              "c1 + c2 < 4.", low=0.0, high=4.0),
-    ParamSpec("tolerance", float, 1e-6, "End a PSO round early when the best cost improved by less "
-              "than this (relative) over `patience` iterations; 0 = always run all iterations.",
-              low=0.0, high=1.0),
-    ParamSpec("patience", int, 15, "Window of the early stop, in iterations.", low=1,
-              high=1_000_000),
-    ParamSpec("w_damping", float, 1.0, "Factor applied to w after every iteration (1 = constant).",
-              low=1e-6, high=1.0),
-    ParamSpec("v_max_fraction", float, 0.1, "Velocity clamp per coordinate, as a fraction of the "
-              "mean segment length of the seed path.", low=1e-6, high=10.0),
-    ParamSpec("smoothness_weight", float, 0.0, "Cost per squared radian of turning at a waypoint "
-              "(0 = shortest path only).", unit="length/rad^2", low=0.0),
-    ParamSpec("violation_weight", float, 10.0, "Penalty per unit of intrusion of a candidate "
-              "segment into an obstacle's safety zone.", low=1e-9),
-    ParamSpec("seed", int, -1, "Seed of the PSO's numpy Generator; -1 draws it from OMPL's RNG "
-              "(so ompl.util.RNG.setSeed makes the whole run reproducible).", low=-1,
-              high=2**32 - 1),
+    ParamSpec(
+        "swarm_size",
+        int,
+        30,
+        "Number of particles (candidate paths) in the swarm.",
+        low=2,
+        high=10000,
+    ),
+    ParamSpec(
+        "iterations",
+        int,
+        100,
+        "PSO iterations per optimisation round (eqs. 4-5).",
+        low=0,
+        high=1_000_000,
+    ),
+    ParamSpec(
+        "w", float, 0.7298, "Inertia weight of the particle velocity (eq. 4).", low=0.0, high=1.5
+    ),
+    ParamSpec(
+        "c1",
+        float,
+        1.49618,
+        "Cognitive coefficient: pull to the particle's best (eq. 4); c1 + c2 < 4.",
+        low=0.0,
+        high=4.0,
+    ),
+    ParamSpec(
+        "c2",
+        float,
+        1.49618,
+        "Social coefficient: pull to the swarm's best (eq. 4); c1 + c2 < 4.",
+        low=0.0,
+        high=4.0,
+    ),
+    ParamSpec(
+        "tolerance",
+        float,
+        1e-6,
+        "End a PSO round early when the best cost improved by less "
+        "than this (relative) over `patience` iterations; 0 = always run all iterations.",
+        low=0.0,
+        high=1.0,
+    ),
+    ParamSpec(
+        "patience", int, 15, "Window of the early stop, in iterations.", low=1, high=1_000_000
+    ),
+    ParamSpec(
+        "w_damping",
+        float,
+        1.0,
+        "Factor applied to w after every iteration (1 = constant).",
+        low=1e-6,
+        high=1.0,
+    ),
+    ParamSpec(
+        "v_max_fraction",
+        float,
+        0.1,
+        "Velocity clamp per coordinate, as a fraction of the mean segment length of the seed path.",
+        low=1e-6,
+        high=10.0,
+    ),
+    ParamSpec(
+        "smoothness_weight",
+        float,
+        0.0,
+        "Cost per squared radian of turning at a waypoint (0 = shortest path only).",
+        unit="length/rad^2",
+        low=0.0,
+    ),
+    ParamSpec(
+        "violation_weight",
+        float,
+        10.0,
+        "Penalty per unit of intrusion of a candidate segment into an obstacle's safety zone.",
+        low=1e-9,
+    ),
+    ParamSpec(
+        "seed",
+        int,
+        -1,
+        "Seed of the PSO's numpy Generator; -1 draws it from OMPL's RNG "
+        "(so ompl.util.RNG.setSeed makes the whole run reproducible).",
+        low=-1,
+        high=2**32 - 1,
+    ),
 )
 
 RRTSTAR_PSO_PARAMS: tuple[ParamSpec, ...] = (
-    ParamSpec("range", float, 0.0, "RRT*: longest motion added to the tree; 0 lets OMPL choose "
-              "(20% of the space's extent).", unit="length", low=0.0),
-    ParamSpec("goal_bias", float, 0.05, "RRT*: probability of sampling the goal.",
-              low=0.0, high=1.0),
-    ParamSpec("rewire_factor", float, 1.1, "RRT*: scale of the rewiring radius (>= 1 keeps "
-              "asymptotic optimality).", low=1.0, high=10.0),
-    ParamSpec("budget", float, 0.0, "Total time the caller gives solve(); 0 = unknown: RRT* then "
-              "runs until the termination condition and the PSO runs its iterations after it.",
-              unit="s", low=0.0),
-    ParamSpec("rrt_time_fraction", float, 0.9, "Share of the budget given to RRT*; the PSO gets "
-              "the rest.", low=1e-3, high=1.0),
-    ParamSpec("rrt_max_iterations", int, 0, "Stop RRT* after this many iterations (0 = no limit); "
-              "with a bounded PSO this makes runs reproducible regardless of machine speed.",
-              low=0),
+    ParamSpec(
+        "range",
+        float,
+        0.0,
+        "RRT*: longest motion added to the tree; 0 lets OMPL choose (20% of the space's extent).",
+        unit="length",
+        low=0.0,
+    ),
+    ParamSpec(
+        "goal_bias", float, 0.05, "RRT*: probability of sampling the goal.", low=0.0, high=1.0
+    ),
+    ParamSpec(
+        "rewire_factor",
+        float,
+        1.1,
+        "RRT*: scale of the rewiring radius (>= 1 keeps asymptotic optimality).",
+        low=1.0,
+        high=10.0,
+    ),
+    ParamSpec(
+        "budget",
+        float,
+        0.0,
+        "Total time the caller gives solve(); 0 = unknown: RRT* then "
+        "runs until the termination condition and the PSO runs its iterations after it.",
+        unit="s",
+        low=0.0,
+    ),
+    ParamSpec(
+        "rrt_time_fraction",
+        float,
+        0.9,
+        "Share of the budget given to RRT*; the PSO gets the rest.",
+        low=1e-3,
+        high=1.0,
+    ),
+    ParamSpec(
+        "rrt_max_iterations",
+        int,
+        0,
+        "Stop RRT* after this many iterations (0 = no limit); "
+        "with a bounded PSO this makes runs reproducible regardless of machine speed.",
+        low=0,
+    ),
     *SWARM_PARAMS,
-    ParamSpec("init_spread", float, 0.05, "Spread of the initial swarm around the RRT* path, as a "
-              "fraction of the shorter segment next to each waypoint.", low=0.0, high=10.0),
-    ParamSpec("box_fraction", float, 0.5, "Each PSO round keeps every waypoint within this "
-              "fraction of its longer segment from its seed position (exact obstacle culling).",
-              low=1e-3, high=100.0),
+    ParamSpec(
+        "init_spread",
+        float,
+        0.05,
+        "Spread of the initial swarm around the RRT* path, as a "
+        "fraction of the shorter segment next to each waypoint.",
+        low=0.0,
+        high=10.0,
+    ),
+    ParamSpec(
+        "box_fraction",
+        float,
+        0.5,
+        "Each PSO round keeps every waypoint within this "
+        "fraction of its longer segment from its seed position (exact obstacle culling).",
+        low=1e-3,
+        high=100.0,
+    ),
     ParamSpec("prune", bool, True, "Shortcut RRT*'s waypoints (exactly) before the swarm runs."),
-    ParamSpec("refine_rounds", int, 4, "Extra PSO rounds with mid-points inserted on segments "
-              "that run along an obstacle.", low=0, high=20),
-    ParamSpec("max_waypoints", int, 48, "Most waypoints refinement may create.", low=2,
-              high=10000),
+    ParamSpec(
+        "refine_rounds",
+        int,
+        4,
+        "Extra PSO rounds with mid-points inserted on segments that run along an obstacle.",
+        low=0,
+        high=20,
+    ),
+    ParamSpec("max_waypoints", int, 48, "Most waypoints refinement may create.", low=2, high=10000),
 )
 
 
@@ -175,8 +284,11 @@ class RRTstarPSO(PythonPlanner):
         super().set_param(name, value)
         if getattr(self, "_inner_ready", False) and name in ("range", "goal_bias", "rewire_factor"):
             # Keep the inner RRT* in step when a parameter changes after setup().
-            setter = {"range": "setRange", "goal_bias": "setGoalBias",
-                      "rewire_factor": "setRewireFactor"}[name]
+            setter = {
+                "range": "setRange",
+                "goal_bias": "setGoalBias",
+                "rewire_factor": "setRewireFactor",
+            }[name]
             getattr(self.inner, setter)(self._values[name])
 
     # ------------------------------------------------------------------------------------------

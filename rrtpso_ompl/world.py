@@ -33,7 +33,18 @@ import shapely
 
 from .problem import Circle, Polygon, Problem
 
-__all__ = ["World"]
+__all__ = ["World", "clearance_threshold"]
+
+
+def clearance_threshold(robot_radius: float, tol: float) -> float:
+    """The smallest distance to an obstacle that still counts as free.
+
+    ``robot_radius - tol``: touching at exactly the radius is allowed, up to round-off. For a point
+    robot (radius 0) that would let a segment *enter* an obstacle (its distance is then 0, like a
+    touch), so the threshold never drops below ``+tol``: still within the round-off tolerance of
+    the radius, and every penetration is caught.
+    """
+    return max(robot_radius - tol, tol)
 
 
 @dataclass(frozen=True, eq=False)
@@ -92,8 +103,11 @@ class World:
             self._vertices = np.empty((0, 2))
             self._poly_union = None
 
+        #: Distance to every obstacle that a free configuration or segment needs.
+        self.threshold = clearance_threshold(self.robot_radius, self.tol)
+
         # --- scalar data (plain Python floats: no numpy scalars in the hot loop) -----------------
-        r_need = self.robot_radius - self.tol
+        r_need = self.threshold
         self._circles_py = [
             (float(cx), float(cy), float(r) + r_need, (float(r) + r_need) ** 2)
             for cx, cy, r in circ
@@ -147,7 +161,7 @@ class World:
             if dx * dx + dy * dy < rr2:
                 return False
         if self._polys_py:
-            r_need = self.robot_radius - self.tol
+            r_need = self.threshold
             for poly in self._polys_py:
                 x0, y0, x1, y1 = poly.bbox
                 if x < x0 or x > x1 or y < y0 or y > y1:
@@ -177,7 +191,7 @@ class World:
             if ex * ex + ey * ey < rr2:
                 return False
         if self._polys_py:
-            r_need = self.robot_radius - self.tol
+            r_need = self.threshold
             for poly in self._polys_py:
                 x0, y0, x1, y1 = poly.bbox
                 if sx1 < x0 or sx0 > x1 or sy1 < y0 or sy0 > y1:
@@ -243,7 +257,7 @@ class World:
         shape = a.shape[:-1]
         a = a.reshape(-1, 2)
         b = b.reshape(-1, 2)
-        r_need = self.robot_radius - self.tol
+        r_need = self.threshold
         v = np.zeros(a.shape[0])
         if len(self.circles):
             v += np.maximum(0.0, r_need - self._segment_circle_distance(a, b)).sum(axis=1)
@@ -253,7 +267,7 @@ class World:
 
     def segments_free(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Boolean array: whether each segment ``a[i]-b[i]`` is free (bounds not checked)."""
-        return self.segment_distance(a, b) >= self.robot_radius - self.tol
+        return self.segment_distance(a, b) >= self.threshold
 
     def points_in_bounds(self, points: np.ndarray) -> np.ndarray:
         """Boolean array: whether each point lies in the bounds (inclusive, with tolerance)."""
@@ -301,8 +315,11 @@ class World:
     def _segment_circle_distance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """(n, m) distance from n segments to the boundaries of m circles (0 when inside)."""
         c = self.circles[:, :2]
-        return np.maximum(0.0, _point_segment_distance(c[None, :, :], a[:, None, :], b[:, None, :])
-                          - self.circles[None, :, 2])
+        return np.maximum(
+            0.0,
+            _point_segment_distance(c[None, :, :], a[:, None, :], b[:, None, :])
+            - self.circles[None, :, 2],
+        )
 
     def _segment_polygon_distance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """(n,) distance from n segments to the union of the polygons (0 when touching/inside)."""
@@ -332,7 +349,7 @@ class LocalViolation:
 
     def __init__(self, world: World, seg_lo: np.ndarray, seg_hi: np.ndarray) -> None:
         self.world = world
-        r_need = world.robot_radius - world.tol
+        r_need = world.threshold
         n_seg = len(seg_lo)
         far = 1e6 * max(1.0, *(abs(v) for b in world.bounds for v in b))
 
@@ -364,7 +381,7 @@ class LocalViolation:
     def violation(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Same as :meth:`World.segment_violation` for ``a, b`` of shape ``(P, S, 2)``."""
         world = self.world
-        r_need = world.robot_radius - world.tol
+        r_need = world.threshold
         v = np.zeros(a.shape[:2])
         A = a[:, :, None, :]
         B = b[:, :, None, :]

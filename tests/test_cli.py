@@ -14,8 +14,7 @@ CONTRACT_KEYS = {"problem", "planner", "status", "solved", "length", "time", "se
 
 
 def run(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
-    return subprocess.run([*rrtpso_exe(), *args], capture_output=True, text=True,
-                          timeout=timeout)
+    return subprocess.run([*rrtpso_exe(), *args], capture_output=True, text=True, timeout=timeout)
 
 
 @pytest.fixture
@@ -27,8 +26,18 @@ def circle_file(tmp_path: Path) -> Path:
 
 def test_solve_writes_contract_json_and_plot(circle_file, tmp_path):
     out, png = tmp_path / "r.json", tmp_path / "p.png"
-    proc = run("solve", str(circle_file), "--time", "0.3", "--seed", "3", "--json", str(out),
-               "--plot", str(png))
+    proc = run(
+        "solve",
+        str(circle_file),
+        "--time",
+        "0.3",
+        "--seed",
+        "3",
+        "--json",
+        str(out),
+        "--plot",
+        str(png),
+    )
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())
     assert data.keys() >= CONTRACT_KEYS
@@ -50,7 +59,9 @@ def test_verbose_shows_ompl_info(circle_file):
 
 def test_unsolved_exit_1_still_writes_json(tmp_path):
     problem = {
-        "bounds": [[0, 0], [500, 500]], "start": [50, 50], "goal": [380, 380],
+        "bounds": [[0, 0], [500, 500]],
+        "start": [50, 50],
+        "goal": [380, 380],
         "robot": {"radius": 10},
         "obstacles": [
             {"type": "rectangle", "min": [300, 300], "max": [460, 310]},
@@ -118,9 +129,20 @@ def test_same_seed_same_path_iteration_bounded(circle_file, tmp_path):
     paths = []
     for i, seed in enumerate((11, 11, 12)):
         out = tmp_path / f"r{i}.json"
-        proc = run("solve", str(circle_file), "--seed", str(seed), "--time", "30",
-                   "--param", "rrt_max_iterations=600", "--param", "iterations=30",
-                   "--json", str(out))
+        proc = run(
+            "solve",
+            str(circle_file),
+            "--seed",
+            str(seed),
+            "--time",
+            "30",
+            "--param",
+            "rrt_max_iterations=600",
+            "--param",
+            "iterations=30",
+            "--json",
+            str(out),
+        )
         assert proc.returncode == 0, proc.stderr
         paths.append(json.loads(out.read_text())["path"])
     assert paths[0] == paths[1]
@@ -135,8 +157,17 @@ def test_planners_lists_everything_with_params():
         assert name in rows
     assert "geometric::RRTstar" in rows["RRTstar"]["aliases"]
     params = {p["name"]: p for p in rows["RRTstarPSO"]["params"]}
-    for name in ("range", "goal_bias", "rewire_factor", "rrt_time_fraction", "swarm_size",
-                 "iterations", "w", "c1", "c2"):
+    for name in (
+        "range",
+        "goal_bias",
+        "rewire_factor",
+        "rrt_time_fraction",
+        "swarm_size",
+        "iterations",
+        "w",
+        "c1",
+        "c2",
+    ):
         assert name in params
     text = run("planners", "RRTstarPSO")
     assert text.returncode == 0 and "swarm_size" in text.stdout

@@ -87,8 +87,16 @@ def test_rrtstarpso_reaches_known_optimum(single_circle):
 def test_rrtstarpso_records_stages(single_circle):
     result = solve(single_circle, "RRTstarPSO", time_limit=0.3, seed=2)
     s = result.stages
-    for key in ("rrt_length", "rrt_time", "rrt_iterations", "pso_length", "pso_time",
-                "pso_iterations", "pso_history", "rrt_path"):
+    for key in (
+        "rrt_length",
+        "rrt_time",
+        "rrt_iterations",
+        "pso_length",
+        "pso_time",
+        "pso_iterations",
+        "pso_history",
+        "rrt_path",
+    ):
         assert key in s
     assert s["rrt_iterations"] > 0 and s["pso_iterations"] > 0
     assert s["rrt_time"] < 0.3  # RRT* stopped at its share, leaving time for the swarm
@@ -157,10 +165,15 @@ def test_unsolvable_problem_reports_no_solution():
         {"type": "rectangle", "min": [300, 300], "max": [310, 460]},
         {"type": "rectangle", "min": [450, 300], "max": [460, 460]},
     ]
-    problem = problem_from_dict({
-        "bounds": [[0, 0], [500, 500]], "start": [50, 50], "goal": [380, 380],
-        "robot": {"radius": 10}, "obstacles": walls,
-    })
+    problem = problem_from_dict(
+        {
+            "bounds": [[0, 0], [500, 500]],
+            "start": [50, 50],
+            "goal": [380, 380],
+            "robot": {"radius": 10},
+            "obstacles": walls,
+        }
+    )
     for name in ("RRTstarPSO", "PSO", "RRTstar"):
         result = solve(problem, name, time_limit=0.2, seed=1)
         assert not result.solved

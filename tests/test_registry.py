@@ -18,8 +18,21 @@ from rrtpso_ompl.registry import (
     default_registry,
 )
 
-OMPL_GEOMETRIC = ["BFMT", "BITstar", "BKPIECE1", "FMT", "InformedRRTstar", "KPIECE1",
-                  "LBKPIECE1", "PRM", "PRMstar", "RRT", "RRTConnect", "RRTstar", "SORRTstar"]
+OMPL_GEOMETRIC = [
+    "BFMT",
+    "BITstar",
+    "BKPIECE1",
+    "FMT",
+    "InformedRRTstar",
+    "KPIECE1",
+    "LBKPIECE1",
+    "PRM",
+    "PRMstar",
+    "RRT",
+    "RRTConnect",
+    "RRTstar",
+    "SORRTstar",
+]
 
 
 def test_every_ompl_geometric_planner_under_both_names():
@@ -39,7 +52,7 @@ def test_unknown_name_lists_known_ones():
 
 def test_excluded_planner_says_why():
     """AORRTC is bound by the wheel but crashes; selecting it explains that instead."""
-    with pytest.raises(UnknownPlannerError, match="unavailable.*segmentation fault"):
+    with pytest.raises(UnknownPlannerError, match=r"unavailable.*segmentation fault"):
         default_registry().get("AORRTC")
 
 
@@ -49,8 +62,11 @@ def test_duplicate_names_are_refused():
     with pytest.raises(ValueError, match="already registered"):
         reg.register(PlannerEntry("geometric::A", factory=object))
     with pytest.raises(ValueError, match="must be in"):
-        reg.register(PlannerEntry("B", factory=object,
-                                  params=(ParamSpec("x", float, 5.0, "", low=0, high=1),)))
+        reg.register(
+            PlannerEntry(
+                "B", factory=object, params=(ParamSpec("x", float, 5.0, "", low=0, high=1),)
+            )
+        )
 
 
 def test_ompl_table_defaults_match_ompl():
@@ -126,7 +142,8 @@ def test_entry_point_plugin_is_selectable_by_name(tmp_path):
     pkg = tmp_path / "tinyplug"
     (pkg / "tinyplug").mkdir(parents=True)
     (pkg / "tinyplug" / "__init__.py").write_text(PLUGIN_SRC)
-    (pkg / "pyproject.toml").write_text(textwrap.dedent("""
+    (pkg / "pyproject.toml").write_text(
+        textwrap.dedent("""
         [build-system]
         requires = ["setuptools"]
         build-backend = "setuptools.build_meta"
@@ -135,25 +152,58 @@ def test_entry_point_plugin_is_selectable_by_name(tmp_path):
         version = "0.1"
         [project.entry-points."rrtpso_ompl.planners"]
         tiny = "tinyplug:PLANNERS"
-    """))
+    """)
+    )
     target = tmp_path / "site"
-    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-deps",
-                    "--no-build-isolation", "--target", str(target), str(pkg)], check=True,
-                   capture_output=True)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--no-deps",
+            "--no-build-isolation",
+            "--target",
+            str(target),
+            str(pkg),
+        ],
+        check=True,
+        capture_output=True,
+    )
     import yaml
 
     empty = dict(SINGLE_CIRCLE, obstacles=[])
     problem = tmp_path / "empty.yaml"
     problem.write_text(yaml.safe_dump(empty))
     env = {"PYTHONPATH": str(target), "PATH": str(Path(sys.executable).parent)}
-    code = ("import sys; from rrtpso_ompl.cli import main; sys.exit(main(sys.argv[1:]))")
-    listed = subprocess.run([sys.executable, "-c", code, "planners", "TinyStraight"],
-                            capture_output=True, text=True, env=env)
+    code = "import sys; from rrtpso_ompl.cli import main; sys.exit(main(sys.argv[1:]))"
+    listed = subprocess.run(
+        [sys.executable, "-c", code, "planners", "TinyStraight"],
+        capture_output=True,
+        text=True,
+        env=env,
+    )
     assert listed.returncode == 0, listed.stderr
     assert "TinyStraight" in listed.stdout and "entry point" in listed.stdout
-    solved = subprocess.run([sys.executable, "-c", code, "solve", str(problem), "--planner",
-                             "TinyStraight", "--param", "scale=2", "--json",
-                             str(tmp_path / "r.json")], capture_output=True, text=True, env=env)
+    solved = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            code,
+            "solve",
+            str(problem),
+            "--planner",
+            "TinyStraight",
+            "--param",
+            "scale=2",
+            "--json",
+            str(tmp_path / "r.json"),
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+    )
     assert solved.returncode == 0, solved.stderr
     import json
 
