@@ -24,7 +24,7 @@ from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Polygon as PolygonPatch
 
 from .problem import Circle, Polygon, Problem
-from .results import SolveResult
+from .results import SolveResult, publish_atomic
 
 __all__ = ["draw_world", "plot_solution", "save_figure"]
 
@@ -140,7 +140,7 @@ def save_figure(fig: Figure, path: str | Path, dpi: int = 120) -> None:
     os.close(fd)
     try:
         fig.savefig(tmp, dpi=dpi)
-        os.replace(tmp, path)
+        publish_atomic(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

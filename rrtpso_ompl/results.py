@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["SolveResult", "write_json_atomic"]
+__all__ = ["SolveResult", "publish_atomic", "write_json_atomic"]
 
 
 @dataclass(frozen=True)
@@ -91,6 +91,18 @@ def _finite(x: float | None) -> float | None:
     return None if x is None or not math.isfinite(x) else float(x)
 
 
+def publish_atomic(tmp: str | Path, path: str | Path) -> None:
+    """Give a finished temporary file the usual permissions and rename it to ``path``.
+
+    ``tempfile.mkstemp`` creates files readable by their owner only; a result file should get the
+    permissions any new file gets (0666 less the umask).
+    """
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)
+    os.replace(tmp, path)
+
+
 def write_json_atomic(data: Any, path: str | Path) -> None:
     """Write JSON through a temporary file and a rename, so a reader never sees half a file."""
     path = Path(path)
@@ -100,7 +112,7 @@ def write_json_atomic(data: Any, path: str | Path) -> None:
         with os.fdopen(fd, "w") as fh:
             json.dump(data, fh, indent=2, allow_nan=False, default=_json_default)
             fh.write("\n")
-        os.replace(tmp, path)
+        publish_atomic(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

@@ -180,3 +180,12 @@ def test_every_shipped_problem_solves(path, tmp_path):
     proc = run("solve", str(path), "--time", "0.5", "--seed", "1", "--json", str(out))
     assert proc.returncode == 0, proc.stderr
     assert json.loads(out.read_text())["solved"]
+
+
+def test_output_files_get_normal_permissions(circle_file, tmp_path):
+    out, png = tmp_path / "r.json", tmp_path / "p.png"
+    proc = run("solve", str(circle_file), "--time", "0.1", "--json", str(out), "--plot", str(png))
+    assert proc.returncode == 0, proc.stderr
+    for f in (out, png):
+        assert f.stat().st_mode & 0o044, f"{f.name} is readable by its owner only"
+    assert not list(tmp_path.glob(".*"))  # no temporary file left behind
