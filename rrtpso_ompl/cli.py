@@ -10,8 +10,10 @@ import argparse
 import json
 import logging
 import math
+import os
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 __all__ = ["main"]
@@ -136,6 +138,8 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         entry.validate({**problem.planner.params, **cli_params})
     except ValueError as exc:
         raise InputError(f"{src}: planner parameters: {exc}") from None
+    _check_output(args.json, "--json")
+    _check_output(args.plot, "--plot", image=True)
 
     from .solve import solve
 
@@ -154,6 +158,30 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         file=sys.stderr,
     )
     return EXIT_SOLVED if result.solved else EXIT_UNSOLVED
+
+
+def _check_output(path: str | None, flag: str, image: bool = False) -> None:
+    """Refuse an output that cannot be written before spending the time budget on planning."""
+    if not path:
+        return
+    target = Path(path)
+    if target.is_dir():
+        raise InputError(f"{flag}: '{path}' is a directory")
+    parent = target.parent
+    while not parent.exists():
+        parent = parent.parent  # missing folders are created when the file is written
+    if not os.access(parent, os.W_OK):
+        raise InputError(f"{flag}: cannot write '{path}': '{parent}' is not writable")
+    if image:
+        from matplotlib.figure import Figure
+
+        kinds = Figure().canvas.get_supported_filetypes()
+        suffix = target.suffix.lower().lstrip(".")
+        if suffix not in kinds:
+            raise InputError(
+                f"{flag}: cannot draw '{path}': use one of the suffixes "
+                f"{', '.join('.' + k for k in sorted(kinds))}"
+            )
 
 
 def _parse_params(items: list[str], src: str) -> dict[str, str]:

@@ -315,7 +315,7 @@ def optimize_path(
     Returns
     -------
     PathOptimizationResult
-        Its ``path`` is valid and no longer than the input; it *is* the input when the input was
+        Its ``path`` is valid and no longer than the input; it equals the input when the input was
         invalid or nothing shorter was found.
     """
     t0 = time.perf_counter()
