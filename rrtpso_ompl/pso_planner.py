@@ -23,7 +23,7 @@ from .ompl_setup import array_to_path
 from .path_optimizer import PathCost, path_length, shortcut
 from .planner_base import PythonPlanner, collision_model_for
 from .registry import ParamSpec
-from .rrtstar_pso import SWARM_PARAMS
+from .rrtstar_pso import SWARM_PARAMS, swarm_options
 
 __all__ = ["PSO_PARAMS", "PSOPlanner", "PSOPlannerStats"]
 
@@ -141,17 +141,7 @@ class PSOPlanner(PythonPlanner):
         def terminate() -> bool:
             return ptc() or time.perf_counter() >= deadline
 
-        options = pso.PSOOptions(
-            swarm_size=values["swarm_size"],
-            iterations=values["iterations"],
-            w=values["w"],
-            c1=values["c1"],
-            c2=values["c2"],
-            w_damping=values["w_damping"],
-            tolerance=values["tolerance"],
-            patience=values["patience"],
-            v_max=values["v_max_fraction"] * max(xmax - xmin, ymax - ymin),
-        )
+        options = swarm_options(values, values["v_max_fraction"] * max(xmax - xmin, ymax - ymin))
         rng = self._rng()
         best: np.ndarray | None = None
         while not terminate():

@@ -191,6 +191,13 @@ RRTSTAR_PSO_PARAMS: tuple[ParamSpec, ...] = (
         low=1e-3,
         high=100.0,
     ),
+    ParamSpec(
+        "simplify",
+        bool,
+        True,
+        "Run OMPL's path simplifier (simplifyMax: vertex reduction and shortcutting through the "
+        "exact motion validator, about a millisecond) on RRT*'s path before the swarm.",
+    ),
     ParamSpec("prune", bool, True, "Shortcut RRT*'s waypoints (exactly) before the swarm runs."),
     ParamSpec(
         "refine_rounds",
@@ -217,6 +224,8 @@ class RRTstarPSOStats:
     rrt_waypoints: int = 0
     rrt_path: list[list[float]] = field(default_factory=list)
     rrt_progress: list[tuple[float, float]] = field(default_factory=list)
+    simplified_length: float | None = None
+    simplify_time: float = 0.0
     pso_length: float | None = None
     pso_time: float = 0.0
     pso_iterations: int = 0
@@ -231,6 +240,20 @@ class RRTstarPSOStats:
         d = asdict(self)
         d["rrt_progress"] = [list(p) for p in self.rrt_progress]
         return d
+
+
+def swarm_options(values: dict[str, Any], v_max: float | None = None) -> pso.PSOOptions:
+    """The :class:`~rrtpso_ompl.pso.PSOOptions` named by the :data:`SWARM_PARAMS` values."""
+    names = ("swarm_size", "iterations", "w", "c1", "c2", "w_damping", "tolerance", "patience")
+    return pso.PSOOptions(**{n: values[n] for n in names}, v_max=v_max)
+
+
+#: Our parameters that belong to the inner og.RRTstar, with its setter.
+_INNER_SETTERS = {
+    "range": "setRange",
+    "goal_bias": "setGoalBias",
+    "rewire_factor": "setRewireFactor",
+}
 
 
 def check_swarm_values(values: dict[str, Any]) -> None:
@@ -268,9 +291,8 @@ class RRTstarPSO(PythonPlanner):
     def setup(self) -> None:
         super().setup()
         self.inner.setProblemDefinition(self.getProblemDefinition())
-        self.inner.setRange(self._values["range"])
-        self.inner.setGoalBias(self._values["goal_bias"])
-        self.inner.setRewireFactor(self._values["rewire_factor"])
+        for name, setter in _INNER_SETTERS.items():
+            getattr(self.inner, setter)(self._values[name])
         self.inner.setup()
         if self._values["range"] == 0.0:
             self._values["range"] = self.inner.getRange()  # report what OMPL chose
@@ -282,14 +304,9 @@ class RRTstarPSO(PythonPlanner):
 
     def set_param(self, name: str, value: Any) -> None:
         super().set_param(name, value)
-        if getattr(self, "_inner_ready", False) and name in ("range", "goal_bias", "rewire_factor"):
+        if getattr(self, "_inner_ready", False) and name in _INNER_SETTERS:
             # Keep the inner RRT* in step when a parameter changes after setup().
-            setter = {
-                "range": "setRange",
-                "goal_bias": "setGoalBias",
-                "rewire_factor": "setRewireFactor",
-            }[name]
-            getattr(self.inner, setter)(self._values[name])
+            getattr(self.inner, _INNER_SETTERS[name])(self._values[name])
 
     # ------------------------------------------------------------------------------------------
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
@@ -314,19 +331,21 @@ class RRTstarPSO(PythonPlanner):
             # The tree never reached the goal: nothing to optimise between fixed end points.
             return ob.PlannerStatus(ob.PlannerStatus.APPROXIMATE_SOLUTION)
 
-        # --- stage 2: PSO over the candidate nodes --------------------------------------------
+        # --- stage 2: OMPL's simplifier, so the swarm starts from a locally shortened path ------
+        if values["simplify"] and not ptc():
+            t1 = time.perf_counter()
+            simplified = og.PathGeometric(raw)  # a copy: RRT*'s own path stays as it was
+            og.PathSimplifier(self.getSpaceInformation()).simplifyMax(simplified)
+            candidate = path_to_array(simplified)
+            if path_length(candidate) < path_length(xy):
+                xy = candidate
+            stats.simplify_time = time.perf_counter() - t1
+        stats.simplified_length = path_length(xy)
+
+        # --- stage 3: PSO over the candidate nodes --------------------------------------------
         model = collision_model_for(self.getSpaceInformation())
         options = PathOptimizerOptions(
-            pso=pso.PSOOptions(
-                swarm_size=values["swarm_size"],
-                iterations=values["iterations"],
-                w=values["w"],
-                c1=values["c1"],
-                c2=values["c2"],
-                w_damping=values["w_damping"],
-                tolerance=values["tolerance"],
-                patience=values["patience"],
-            ),
+            pso=swarm_options(values),
             smoothness_weight=values["smoothness_weight"],
             violation_weight=values["violation_weight"],
             init_spread=values["init_spread"],
