@@ -3,8 +3,8 @@
 Every run goes through :func:`rrtpso_ompl.solve.solve` (same OMPL setup, same exact collision
 checker) in a fresh process (OMPL's RNG can be seeded only once per process). Stock planners are
 followed by OMPL's path simplifier, as OMPL's Benchmark does, and their simplification time is
-reported separately (it is *not* charged to their budget); RRTstarPSO's PSO stage runs inside its
-budget.
+reported separately (it is *not* charged to their budget); RRTstarPSO's simplifier and PSO run
+inside its budget.
 
 Usage::
 
@@ -21,6 +21,7 @@ import json
 import math
 import multiprocessing as mp
 import platform
+import shlex
 import statistics
 import sys
 import time
@@ -35,8 +36,18 @@ PSO_PLANNERS = {"RRTstarPSO", "PSO"}
 KNOWN_OPTIMA = {"single_circle": 647.45}
 
 
-def run_one(problem_path: str, planner: str, budget: float, seed: int) -> dict:
-    """One run in a fresh worker process; returns a plain row."""
+def parse_spec(spec: str) -> tuple[str, dict[str, str]]:
+    """``"Name[k=v k2=v2]"`` -> ``("Name", {"k": "v", "k2": "v2"})`` (OMPL's planner-spec style,
+    as in AnytimePathShortening)."""
+    name, _, rest = spec.partition("[")
+    params = dict(item.split("=", 1) for item in rest.rstrip("]").split() if "=" in item)
+    return name.strip(), params
+
+
+def run_one(
+    problem_path: str, planner: str, budget: float, seed: int, simplify: bool = True
+) -> dict:
+    """One run in a fresh worker process; returns a plain row. ``planner`` may be a spec."""
     from rrtpso_ompl.ompl_setup import set_ompl_log_level
     from rrtpso_ompl.problem import load_problem
     from rrtpso_ompl.solve import solve
@@ -44,7 +55,10 @@ def run_one(problem_path: str, planner: str, budget: float, seed: int) -> dict:
     set_ompl_log_level(0)
     problem = load_problem(problem_path)
     t0 = time.perf_counter()
-    result = solve(problem, planner, budget, seed, simplify=planner not in PSO_PLANNERS)
+    name, params = parse_spec(planner)
+    result = solve(
+        problem, name, budget, seed, params, simplify=simplify and name not in PSO_PLANNERS
+    )
     wall = time.perf_counter() - t0
     stages = result.stages
     return {
@@ -70,14 +84,20 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--budgets", default="0.25,1,4", help="seconds, comma-separated")
     parser.add_argument("--seeds", type=int, default=5, help="runs per cell (seeds 1..N)")
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument(
+        "--no-simplify",
+        action="store_true",
+        help="report the stock planners' raw paths (the paper's Table 3), not simplified ones",
+    )
     parser.add_argument("--out", default=str(REPO / "docs" / "benchmark.md"))
     args = parser.parse_args(argv)
 
     problems = [Path(p) for p in args.problems] or sorted((REPO / "problems").glob("*.yaml"))
-    planners = args.planners.split(",")
+    planners = [p.strip() for p in args.planners.split(",")]
     budgets = [float(b) for b in args.budgets.split(",")]
+    simplify = not args.no_simplify
     tasks = [
-        (str(p), pl, b, s)
+        (str(p), pl, b, s, simplify)
         for p in problems
         for b in budgets
         for pl in planners
@@ -91,18 +111,39 @@ def main(argv: list[str] | None = None) -> int:
     # spawn + one task per process: every run gets a fresh, correctly seeded OMPL.
     ctx = mp.get_context("spawn")
     with ProcessPoolExecutor(args.jobs, mp_context=ctx, max_tasks_per_child=1) as pool:
-        futures = [pool.submit(run_one, *t) for t in tasks]
+        futures = {pool.submit(run_one, *t): t for t in tasks}
         for fut in tqdm(
             as_completed(futures), total=len(futures), file=sys.stderr, disable=None, desc="runs"
         ):
-            rows.append(fut.result())
+            try:
+                rows.append(fut.result())
+            except Exception as exc:  # one failed run is a data point, not the end of the study
+                path, planner, budget, seed, _ = futures[fut]
+                rows.append(
+                    {
+                        "problem": Path(path).stem,
+                        "planner": planner,
+                        "budget": budget,
+                        "seed": seed,
+                        "solved": False,
+                        "length": None,
+                        "time": math.nan,
+                        "error": f"{type(exc).__name__}: {exc}",
+                        "pso_time": None,
+                        "rrt_length": None,
+                        "simplified_length": None,
+                    }
+                )
     total = time.perf_counter() - t0
 
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     raw = out.with_suffix(".jsonl")
     raw.write_text("".join(json.dumps(r) + "\n" for r in rows))
-    out.write_text(report(rows, planners, budgets, args, total))
+    command = "python benchmarks/compare.py " + shlex.join(
+        argv if argv is not None else sys.argv[1:]
+    )
+    out.write_text(report(rows, planners, budgets, command, total, simplify))
     print(f"wrote {out} and {raw}", file=sys.stderr)
     return 0
 
@@ -111,7 +152,14 @@ def _median(xs: list[float]) -> float:
     return statistics.median(xs) if xs else math.nan
 
 
-def report(rows: list[dict], planners: list[str], budgets: list[float], args, total: float) -> str:
+def report(
+    rows: list[dict],
+    planners: list[str],
+    budgets: list[float],
+    command: str,
+    total: float,
+    simplify: bool = True,
+) -> str:
     """The markdown report: one table per problem, plus the targets checked."""
     by_problem: dict[str, list[dict]] = {}
     for r in rows:
@@ -119,14 +167,19 @@ def report(rows: list[dict], planners: list[str], budgets: list[float], args, to
     lines = [
         "# Benchmark: RRTstarPSO against OMPL's planners",
         "",
-        f"Generated by `python benchmarks/compare.py --seeds {args.seeds} --budgets "
-        f"{args.budgets} --planners {args.planners}` in {total:.0f} s on "
-        f"{platform.machine()} ({mp.cpu_count()} cores), Python {platform.python_version()}.",
+        f"Generated by `{command}` in {total:.0f} s on {platform.machine()} "
+        f"({mp.cpu_count()} cores, two runs at a time), Python {platform.python_version()}.",
         "",
-        "Cells: median path length over the solved runs (success rate), median planning time in "
-        "seconds. `ref` is the analytic optimum where known, else the shortest path any run "
-        "found. Stock planners are followed by OMPL's simplifier (its time is not charged to "
-        "the budget, as in OMPL's Benchmark); RRTstarPSO's PSO runs inside its budget.",
+        "Cells: median path length over the solved runs (+ excess over `ref`) [success rate], "
+        "median planning time in seconds. `ref` is the analytic optimum where known, else the "
+        "shortest path any run found. "
+        + (
+            "Stock planners are followed by OMPL's simplifier (its time is not charged to the "
+            "budget, as in OMPL's Benchmark); RRTstarPSO's simplifier and PSO run inside its "
+            "budget."
+            if simplify
+            else "Stock planners' raw paths, without simplification (as in the paper's Table 3)."
+        ),
         "",
     ]
     checks: list[str] = []
@@ -148,9 +201,9 @@ def report(rows: list[dict], planners: list[str], budgets: list[float], args, to
                 ok = [r["length"] for r in cell if r["solved"]]
                 m = _median(ok)
                 med[pl, b] = m
-                t = _median([r["time"] for r in cell])
+                t = _median([r["time"] for r in cell if math.isfinite(r["time"])])
                 extra = ""
-                if pl in PSO_PLANNERS and cell and cell[0]["pso_time"] is not None:
+                if parse_spec(pl)[0] in PSO_PLANNERS and cell and cell[0]["pso_time"] is not None:
                     share = _median([r["pso_time"] / b for r in cell if r["pso_time"]])
                     extra = f", PSO {100 * share:.1f}% of budget"
                 cells.append(
@@ -177,7 +230,15 @@ def report(rows: list[dict], planners: list[str], budgets: list[float], args, to
                     f"- {name}, {b:g} s: within 1% of the optimum ({ours:.2f} vs "
                     f"{ref:.2f}): {'met' if ok else '**not met**'}"
                 )
-    lines += ["## Targets", "", *checks, ""]
+    failed = [r for r in rows if r.get("error")]
+    if failed:
+        lines += [f"**{len(failed)} runs failed** (counted as unsolved):", ""]
+        lines += [
+            f"- {r['problem']}, {r['planner']}, seed {r['seed']}: {r['error']}" for r in failed
+        ]
+        lines.append("")
+    if checks:
+        lines += ["## Targets", "", *checks, ""]
     lines += ["## Where RRTstarPSO is not the shortest", ""]
     beaten = []
     for name, prs in sorted(by_problem.items()):

@@ -148,6 +148,20 @@ RRTSTAR_PSO_PARAMS: tuple[ParamSpec, ...] = (
         high=10.0,
     ),
     ParamSpec(
+        "informed_sampling",
+        bool,
+        False,
+        "RRT*: once a path exists, sample only where a shorter one can be (OMPL's informed "
+        "sampling, as in InformedRRTstar); off = the paper's plain RRT*.",
+    ),
+    ParamSpec(
+        "tree_pruning",
+        bool,
+        False,
+        "RRT*: prune tree vertices that cannot lead to a shorter path (with informed_sampling "
+        "this is OMPL's InformedRRTstar).",
+    ),
+    ParamSpec(
         "budget",
         float,
         0.0,
@@ -253,6 +267,8 @@ _INNER_SETTERS = {
     "range": "setRange",
     "goal_bias": "setGoalBias",
     "rewire_factor": "setRewireFactor",
+    "informed_sampling": "setInformedSampling",
+    "tree_pruning": "setTreePruning",
 }
 
 

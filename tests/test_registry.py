@@ -209,3 +209,15 @@ def test_entry_point_plugin_is_selectable_by_name(tmp_path):
 
     data = json.loads((tmp_path / "r.json").read_text())
     assert data["planner"] == "TinyStraight" and len(data["path"]) == 2
+
+
+def test_documented_parameter_tables_match_the_registry():
+    """docs/planners.md is generated from the registry; regenerate it when this fails
+    (python benchmarks/param_tables.py)."""
+    from conftest import REPO
+
+    text = (REPO / "docs" / "planners.md").read_text()
+    for name in ("RRTstarPSO", "PSO"):
+        for p in default_registry().get(name).params:
+            row = f"| `{p.name}` | {p.type.__name__} | {p.default} |"
+            assert row in text, f"{name}.{p.name} is not documented as {row}"
