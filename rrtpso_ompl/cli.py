@@ -68,6 +68,24 @@ def _build_parser() -> argparse.ArgumentParser:
         help="run OMPL's path simplifier on the result within the time limit",
     )
     p.add_argument(
+        "--trajectory",
+        metavar="OUT.csv",
+        help="write the wheel commands every robot.sample_time: "
+        "t,x,y,theta,v,omega,v_right,v_left,omega_right,omega_left",
+    )
+    p.add_argument(
+        "--plot-velocities",
+        metavar="OUT.png",
+        help="draw v and omega (paper Fig. 17) and the wheel speeds (Fig. 18)",
+    )
+    p.add_argument(
+        "--profile",
+        choices=("auto", "constant", "limits"),
+        default="auto",
+        help="velocity profile: the paper's constant robot.speed, or within the robot's limits "
+        "from rest to rest (auto: limits when any limit is given)",
+    )
+    p.add_argument(
         "-v",
         "--verbose",
         action="count",
@@ -140,18 +158,44 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         raise InputError(f"{src}: planner parameters: {exc}") from None
     _check_output(args.json, "--json")
     _check_output(args.plot, "--plot", image=True)
+    _check_output(args.trajectory, "--trajectory")
+    _check_output(args.plot_velocities, "--plot-velocities", image=True)
+    wants_motion = args.trajectory or args.plot_velocities
+    if wants_motion:
+        from .kinematics import REQUIRED_ROBOT_KEYS
+
+        flag = "--trajectory" if args.trajectory else "--plot-velocities"
+        for key in REQUIRED_ROBOT_KEYS:
+            if getattr(problem.robot, key) is None:
+                raise InputError(f"{src}: robot.{key}: required for {flag}")
 
     from .solve import solve
 
     result = solve(problem, name, args.time, args.seed, cli_params, simplify=args.simplify)
+    motion = None
+    if wants_motion and result.solved:
+        from .kinematics import drive
+        from .world import World
+
+        motion = drive(result.path, World.from_problem(problem), problem.robot, args.profile)
     if args.plot:
         from .plotting import plot_solution, save_figure
 
-        save_figure(plot_solution(problem, result), args.plot)
+        curve = motion.curve if motion else None
+        save_figure(plot_solution(problem, result, curve), args.plot)
+    if motion and args.plot_velocities:
+        from .plotting import plot_velocities, save_figure
+
+        save_figure(plot_velocities(motion.trajectory, problem.units), args.plot_velocities)
+    if motion and args.trajectory:
+        motion.trajectory.write_csv(args.trajectory)
     if args.json:
         from .results import write_json_atomic
 
-        write_json_atomic(result.to_dict(), args.json)
+        data = result.to_dict()
+        if motion:
+            data["kinematics"] = motion.summary()
+        write_json_atomic(data, args.json)
     length = f"{result.length:.3f}" if result.length is not None else "-"
     print(
         f"{problem.name}: {result.planner} {result.status} length={length} time={result.time:.3f}s",

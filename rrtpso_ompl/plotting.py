@@ -26,7 +26,7 @@ from matplotlib.patches import Polygon as PolygonPatch
 from .problem import Circle, Polygon, Problem
 from .results import SolveResult, publish_atomic
 
-__all__ = ["draw_world", "plot_solution", "save_figure"]
+__all__ = ["draw_world", "plot_solution", "plot_velocities", "save_figure"]
 
 OBSTACLE = "#5b6770"
 SAFETY = "#e0a030"
@@ -79,9 +79,10 @@ def draw_world(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> None
     ax.set_ylabel(f"y{unit}")
 
 
-def plot_solution(problem: Problem, result: SolveResult) -> Figure:
+def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> Figure:
     """The paper's Fig. 15: the world with the raw RRT* path and the final path (a), and the PSO's
-    best cost per iteration (b) when the planner ran a swarm."""
+    best cost per iteration (b) when the planner ran a swarm. ``curve`` (a
+    :class:`~rrtpso_ompl.kinematics.ReferenceCurve`) adds the smooth reference the robot drives."""
     stages: dict[str, Any] = result.stages or {}
     history = stages.get("pso_history") or []
     fig, axes = plt.subplots(
@@ -113,6 +114,16 @@ def plot_solution(problem: Problem, result: SolveResult) -> Figure:
             zorder=4,
             label=f"{result.planner} path ({result.length:.1f})",
         )
+    if curve is not None:
+        ax.plot(
+            curve.x,
+            curve.y,
+            "-",
+            color="tab:blue",
+            lw=1.0,
+            zorder=5,
+            label=f"reference curve ({curve.kind})",
+        )
     title = f"{problem.name}: {result.planner}, {result.status}"
     if result.length is not None:
         title += f", length {result.length:.2f}"
@@ -126,6 +137,34 @@ def plot_solution(problem: Problem, result: SolveResult) -> Figure:
         bx.set_ylabel("best cost")
         bx.set_title("PSO best cost per iteration")
         bx.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def plot_velocities(traj: Any, units: str = "") -> Figure:
+    """The paper's Figs. 17-18: v_ref and omega_ref, then the wheels' linear and angular speeds,
+    against time (``traj`` is a :class:`~rrtpso_ompl.kinematics.Trajectory`)."""
+    u = units or "units"
+    fig, axes = plt.subplots(2, 2, figsize=(12, 7), sharex=True)
+    panels = [
+        (axes[0, 0], [("v", "v_ref")], f"linear velocity [{u}/s]"),
+        (axes[0, 1], [("omega", "ω_ref")], "angular velocity [rad/s]"),
+        (axes[1, 0], [("v_right", "v_R"), ("v_left", "v_L")], f"wheel linear speed [{u}/s]"),
+        (
+            axes[1, 1],
+            [("omega_right", "ω_R"), ("omega_left", "ω_L")],
+            "wheel angular speed [rad/s]",
+        ),
+    ]
+    for ax, series, label in panels:
+        for name, legend in series:
+            ax.plot(traj.t, getattr(traj, name), label=legend, lw=1.3)
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+        ax.legend(loc="best", fontsize=8)
+    for ax in axes[1]:
+        ax.set_xlabel("t [s]")
+    fig.suptitle(f"Reference velocities ({traj.profile} profile, Ts = {traj.sample_time:g} s)")
     fig.tight_layout()
     return fig
 

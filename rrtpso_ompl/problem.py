@@ -131,6 +131,9 @@ class Robot:
     speed: float | None = None
     sample_time: float | None = None
     sensor_range: float | None = None
+    max_speed: float | None = None
+    max_wheel_speed: float | None = None
+    max_accel: float | None = None
 
 
 @dataclass(frozen=True)
@@ -252,7 +255,17 @@ _TOP_KEYS = (
     "moving_obstacles",
     "planner",
 )
-_ROBOT_KEYS = ("radius", "wheel_radius", "track_width", "speed", "sample_time", "sensor_range")
+_ROBOT_KEYS = (
+    "radius",
+    "wheel_radius",
+    "track_width",
+    "speed",
+    "sample_time",
+    "sensor_range",
+    "max_speed",
+    "max_wheel_speed",
+    "max_accel",
+)
 _PLANNER_KEYS = ("type", "time_limit", "seed", "params")
 _OBSTACLE_KEYS = {
     "circle": ("type", "center", "radius"),

@@ -186,11 +186,15 @@ def test_planners_lists_everything_with_params():
 
 
 @pytest.mark.parametrize("path", sorted(PROBLEMS.glob("*.yaml")), ids=lambda p: p.stem)
-def test_every_shipped_problem_solves(path, tmp_path):
-    out = tmp_path / "r.json"
-    proc = run("solve", str(path), "--time", "0.5", "--seed", "1", "--json", str(out))
+def test_every_shipped_problem_solves_and_drives(path, tmp_path):
+    out, csv_out = tmp_path / "r.json", tmp_path / "t.csv"
+    proc = run("solve", str(path), "--time", "0.5", "--seed", "1", "--json", str(out),
+               "--trajectory", str(csv_out))  # fmt: skip
     assert proc.returncode == 0, proc.stderr
-    assert json.loads(out.read_text())["solved"]
+    data = json.loads(out.read_text())
+    assert data["solved"]
+    assert data["kinematics"]["open_loop_max_error"] <= 0.02 * data["length"]
+    assert csv_out.read_text().startswith("t,x,y,theta,v,omega,v_right,v_left,")
 
 
 def test_output_files_get_normal_permissions(circle_file, tmp_path):

@@ -279,3 +279,11 @@ def test_junk_anywhere_only_raises_problem_error(key, junk):
         problem_from_dict(data, source="junk.yaml")
     except ProblemError as err:
         assert str(err).startswith("junk.yaml")
+
+
+def test_robot_limits_are_optional_positive_numbers():
+    doc = _with(robot={"radius": 28.5, "max_speed": 30, "max_wheel_speed": 25, "max_accel": 20})
+    robot = problem_from_dict(doc).robot
+    assert (robot.max_speed, robot.max_wheel_speed, robot.max_accel) == (30, 25, 20)
+    with pytest.raises(ProblemError, match=r"robot\.max_accel"):
+        problem_from_dict(_with(robot={"radius": 1, "max_accel": 0}))
