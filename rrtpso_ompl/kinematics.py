@@ -379,11 +379,7 @@ def time_parametrize(curve: ReferenceCurve, robot: Robot, profile: str = "auto")
     t_end = t_nodes[-1] + turn_dt[-1]
     n = max(1, math.ceil(t_end / ts - 1e-9))
     t = np.arange(n + 1) * ts
-    out = {k: np.zeros(n + 1) for k in ("x", "y", "theta", "s")}
-    for k, tk in enumerate(t):
-        out_k = _state_at(curve, v, dt, turn_dt, t_nodes, w_turn, min(tk, t_end))
-        for key, val in zip(("x", "y", "theta", "s"), out_k, strict=True):
-            out[key][k] = val
+    out = _states_at(curve, v, dt, turn_dt, np.asarray(t_nodes), w_turn, np.minimum(t, t_end))
     # The commands of row k are held until row k + 1 (what a controller does with them), so they
     # are the *mean* velocities over that step (eqs. 7-8 integrated over Ts): the heading then
     # matches the reference exactly at every sample, and means of limited speeds stay within the
@@ -399,28 +395,30 @@ def time_parametrize(curve: ReferenceCurve, robot: Robot, profile: str = "auto")
     )  # fmt: skip
 
 
-def _state_at(curve, v, dt, turn_dt, t_nodes, w_turn, tk):
-    """Pose and arc length at time ``tk`` (between samples: constant acceleration)."""
-    i = int(np.searchsorted(t_nodes, tk, side="right") - 1)
-    i = min(max(i, 0), len(curve.s) - 1)
+def _states_at(curve, v, dt, turn_dt, t_nodes, w_turn, tk) -> dict[str, np.ndarray]:
+    """Poses and arc lengths at the times ``tk`` (constant acceleration between curve samples;
+    a turn in place, if any, before leaving sample i)."""
+    last = len(curve.s) - 1
+    i = np.clip(np.searchsorted(t_nodes, tk, side="right") - 1, 0, last)
     local = tk - t_nodes[i]
-    # First the turn in place at sample i, if any.
-    if turn_dt[i] > 0 and local < turn_dt[i]:
-        theta = curve.theta[i] + math.copysign(w_turn * local, curve.turns[i])
-        return curve.x[i], curve.y[i], theta, curve.s[i]
-    local -= turn_dt[i]
+    turning = (turn_dt[i] > 0) & (local < turn_dt[i])
     th0 = curve.theta[i] + curve.turns[i]
-    if i >= len(curve.s) - 1 or dt[i] == 0.0:
-        return curve.x[i], curve.y[i], th0, curve.s[i]
-    # Constant acceleration from v[i] to v[i+1] over dt[i].
-    acc = (v[i + 1] - v[i]) / dt[i]
-    ds_local = v[i] * local + 0.5 * acc * local**2
-    seg = curve.s[i + 1] - curve.s[i]
-    f = 0.0 if seg == 0 else min(max(ds_local / seg, 0.0), 1.0)
-    x = curve.x[i] + f * (curve.x[i + 1] - curve.x[i])
-    y = curve.y[i] + f * (curve.y[i + 1] - curve.y[i])
-    theta = th0 + f * (curve.theta[i + 1] - th0)
-    return x, y, theta, curve.s[i] + f * seg
+    # Driving from sample i to i + 1 after the turn: constant acceleration from v[i] to v[i+1].
+    j = np.minimum(i + 1, last)
+    drive_t = np.maximum(local - turn_dt[i], 0.0)
+    dt_i = np.append(dt, 0.0)[i]
+    moving = ~turning & (i < last) & (dt_i > 0)
+    acc = np.where(moving, (v[j] - v[i]) / np.where(dt_i > 0, dt_i, 1.0), 0.0)
+    ds = np.where(moving, v[i] * drive_t + 0.5 * acc * drive_t**2, 0.0)
+    seg = curve.s[j] - curve.s[i]
+    f = np.clip(np.where(seg > 0, ds / np.where(seg > 0, seg, 1.0), 0.0), 0.0, 1.0)
+    turned = curve.theta[i] + np.sign(curve.turns[i]) * w_turn * local
+    return {
+        "x": curve.x[i] + f * (curve.x[j] - curve.x[i]),
+        "y": curve.y[i] + f * (curve.y[j] - curve.y[i]),
+        "theta": np.where(turning, turned, th0 + f * (curve.theta[j] - th0)),
+        "s": curve.s[i] + f * seg,
+    }
 
 
 # ----------------------------------------------------------------------------------------------
@@ -447,15 +445,14 @@ def integrate_wheels(
     """
     v_right = np.asarray(v_right, dtype=float)
     v_left = np.asarray(v_left, dtype=float)
-    poses = np.empty((len(v_right), 3))
-    poses[0] = pose0
-    for k in range(1, len(v_right)):
-        x, y, th = poses[k - 1]
-        vr, vl = v_right[k - 1], v_left[k - 1]
-        th = th + (vr - vl) / track_width * sample_time
-        v = 0.5 * (vr + vl)
-        poses[k] = (x + v * math.cos(th) * sample_time, y + v * math.sin(th) * sample_time, th)
-    return poses
+    x0, y0, th0 = pose0
+    # Eq. 3 accumulates the heading; eqs. 1-2 then move along the *new* heading of each step.
+    dtheta = (v_right[:-1] - v_left[:-1]) / track_width * sample_time
+    theta = th0 + np.concatenate([[0.0], np.cumsum(dtheta)])
+    step = 0.5 * (v_right[:-1] + v_left[:-1]) * sample_time
+    x = x0 + np.concatenate([[0.0], np.cumsum(step * np.cos(theta[1:]))])
+    y = y0 + np.concatenate([[0.0], np.cumsum(step * np.sin(theta[1:]))])
+    return np.column_stack([x, y, theta])
 
 
 @dataclass(frozen=True)
