@@ -21,6 +21,7 @@ import numpy as np
 from ompl import base as ob
 from ompl import util as ou
 
+from .problem import touch_tolerance
 from .registry import ParamSpec
 
 __all__ = ["PythonPlanner", "SpaceInformationCollisionModel", "collision_model_for"]
@@ -41,8 +42,9 @@ class SpaceInformationCollisionModel:
         self.si = si
         bounds = si.getStateSpace().getBounds()
         self.bounds = ((bounds.low[0], bounds.low[1]), (bounds.high[0], bounds.high[1]))
-        extent = max(bounds.high[0] - bounds.low[0], bounds.high[1] - bounds.low[1], 1.0)
-        self.tol = 1e-9 * extent
+        self.tol = touch_tolerance(
+            max(bounds.high[0] - bounds.low[0], bounds.high[1] - bounds.low[1])
+        )
         self.robot_radius = 0.0
         self._a = si.allocState()
         self._b = si.allocState()

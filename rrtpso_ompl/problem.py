@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import difflib
 import math
+import numbers
+import reprlib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -31,8 +33,10 @@ __all__ = [
     "Problem",
     "ProblemError",
     "Robot",
+    "clearance_threshold",
     "load_problem",
     "problem_from_dict",
+    "touch_tolerance",
 ]
 
 Point = tuple[float, float]
@@ -172,6 +176,12 @@ def load_problem(path: str | Path) -> Problem:
     path : str or Path
         A YAML file in the format of ``docs/problem-format.md``.
 
+    Returns
+    -------
+    Problem
+        The validated problem; its ``name`` defaults to the file's stem and its ``source`` is
+        ``str(path)``.
+
     Raises
     ------
     ProblemError
@@ -188,12 +198,13 @@ def load_problem(path: str | Path) -> Problem:
     except (OSError, UnicodeDecodeError) as exc:
         raise ProblemError(source, "", f"cannot read the file: {exc}") from None
     try:
-        data = yaml.safe_load(text)
+        data = _load_yaml(text)
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise ProblemError(source, "", f"malformed YAML{where}: {problem}") from None
+        raise ProblemError(source, "", f"malformed YAML{_yaml_message(exc)}") from None
+    except RecursionError:
+        raise ProblemError(
+            source, "", "malformed YAML: lists or mappings nested too deeply"
+        ) from None
     return problem_from_dict(data, source=source, name=path.stem)
 
 
@@ -205,11 +216,24 @@ def problem_from_dict(data: Any, source: str = "<dict>", name: str | None = None
     data : Any
         The parsed document; anything that is not a valid problem raises :class:`ProblemError`.
     source : str
-        Named in error messages (the file path).
+        Named in error messages (the file path) and stored as ``Problem.source``.
     name : str, optional
-        Default for the ``name`` key (the file's stem).
+        Default for the ``name`` key (the file's stem); ``"problem"`` when neither is given.
+
+    Returns
+    -------
+    Problem
+        The validated problem: rectangles become counter-clockwise 4-gons, polygons are stored
+        counter-clockwise, ``planner.params`` is read-only.
+
+    Raises
+    ------
+    ProblemError
+        For anything that is not a valid problem (the same checks as :func:`load_problem`).
     """
     v = _Validator(source)
+    if data is None:
+        raise v.error("", "the file is empty; a problem needs at least bounds, start, goal, robot")
     doc = v.mapping(data, "", _TOP_KEYS, required=("bounds", "start", "goal", "robot"))
     bounds = v.bounds(doc["bounds"], "bounds")
     robot = v.robot(doc["robot"], "robot")
@@ -221,17 +245,17 @@ def problem_from_dict(data: Any, source: str = "<dict>", name: str | None = None
         for i, o in enumerate(v.sequence(doc, "moving_obstacles"))
     )
     problem = Problem(
-        name=v.string(doc.get("name", name or "problem"), "name"),
-        description=v.string(doc.get("description", ""), "description", empty=True),
-        units=v.string(doc.get("units", ""), "units", empty=True),
+        name=v.string(_get(doc, "name", name or "problem"), "name"),
+        description=v.string(_get(doc, "description", ""), "description", empty=True),
+        units=v.string(_get(doc, "units", ""), "units", empty=True),
         bounds=bounds,
         start=v.point(doc["start"], "start"),
         goal=v.point(doc["goal"], "goal"),
-        goal_tolerance=v.number(doc.get("goal_tolerance", 0.0), "goal_tolerance", low=0.0),
+        goal_tolerance=v.number(_get(doc, "goal_tolerance", 0.0), "goal_tolerance", low=0.0),
         robot=robot,
         obstacles=obstacles,
         moving_obstacles=moving,
-        planner=v.planner(doc.get("planner", {}), "planner"),
+        planner=v.planner(_get(doc, "planner", {}), "planner"),
         source=source,
     )
     for key in ("start", "goal"):
@@ -273,9 +297,13 @@ _OBSTACLE_KEYS = {
     "polygon": ("type", "points"),
 }
 _MOVING_KEYS = ("radius", "start", "speed", "heading_deg")
+#: OMPL's ``RNG.setSeed`` takes an unsigned 64-bit integer; a larger seed would fail mid-run.
+_MAX_SEED = 2**64 - 1
 
 
 class _Validator:
+    """The checks, bound to the source they report (each method takes the key path it checks)."""
+
     def __init__(self, source: str) -> None:
         self.source = source
 
@@ -284,49 +312,56 @@ class _Validator:
 
     # -- containers ------------------------------------------------------------------------------
     def mapping(
-        self, value: Any, key: str, allowed: tuple[str, ...], required: tuple[str, ...] = ()
+        self,
+        value: Any,
+        key: str,
+        allowed: tuple[str, ...],
+        required: tuple[str, ...] = (),
+        what: str = "",
     ) -> Mapping[str, Any]:
         if not isinstance(value, Mapping):
-            what = "the file" if not key else "this key"
+            subject = "the file" if not key else "this key"
             raise self.error(
-                key, f"{what} must be a mapping of keys to values, got {_describe(value)}"
+                key, f"{subject} must be a mapping of keys to values, got {_describe(value)}"
             )
         for k in value:
             if not isinstance(k, str) or k not in allowed:
-                hint = difflib.get_close_matches(str(k), allowed, n=1)
-                did = f" (did you mean '{hint[0]}'?)" if hint else ""
                 raise self.error(
-                    _join(key, str(k)), f"unknown key{did}; allowed keys: {', '.join(allowed)}"
+                    _join(key, _key_label(k)),
+                    f"unknown key{what}{_did_you_mean(_key_label(k), allowed)}; "
+                    f"allowed keys: {', '.join(allowed)}",
                 )
         for k in required:
-            if k not in value or value[k] is None:
+            # ``radius:`` with nothing after it is null in YAML: as good as absent.
+            if value.get(k) is None:
                 raise self.error(_join(key, k), "required key is missing")
         return value
 
-    def sequence(self, doc: Mapping[str, Any], key: str) -> list[Any]:
-        value = doc.get(key)
-        if value is None:
-            return []
-        if not isinstance(value, list):
+    def sequence(self, doc: Mapping[str, Any], key: str) -> list[Any] | tuple[Any, ...]:
+        value = _get(doc, key, [])
+        if not isinstance(value, list | tuple):
             raise self.error(key, f"must be a list, got {_describe(value)}")
         return value
 
     # -- scalars -----------------------------------------------------------------------------------
     def number(self, value: Any, key: str, low: float | None = None, strict: bool = False) -> float:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise self.error(key, f"must be a number, got {_describe(value)}")
-        x = float(value)
+        # bool is an int subclass, but `radius: yes` is a mistake, not the number 1.
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            raise self.error(key, f"must be a number, got {_describe(value)}{_number_hint(value)}")
+        try:
+            x = float(value)
+        except OverflowError:
+            raise self.error(key, "is too large for a floating-point number") from None
         if not math.isfinite(x):
-            raise self.error(key, f"must be a finite number, got {value}")
+            raise self.error(key, f"must be a finite number, got {x}")
         if low is not None and (x <= low if strict else x < low):
-            raise self.error(key, f"must be {'>' if strict else '>='} {low:g}, got {value}")
+            raise self.error(key, f"must be {'>' if strict else '>='} {low:g}, got {x:g}")
         return x
 
     def string(self, value: Any, key: str, empty: bool = False) -> str:
         if not isinstance(value, str) or (not empty and not value.strip()):
-            raise self.error(
-                key, f"must be a {'' if empty else 'non-empty '}string, got {_describe(value)}"
-            )
+            kind = "string" if empty else "non-empty string"
+            raise self.error(key, f"must be a {kind}, got {_describe(value)}")
         return value
 
     def point(self, value: Any, key: str) -> Point:
@@ -341,10 +376,14 @@ class _Validator:
         lo, hi = self.point(value[0], f"{key}[0]"), self.point(value[1], f"{key}[1]")
         if not (lo[0] < hi[0] and lo[1] < hi[1]):
             raise self.error(key, f"needs xmin < xmax and ymin < ymax, got {lo} and {hi}")
+        # The touching tolerance is relative to the workspace size, which must itself be finite.
+        if not math.isfinite(max(hi[0] - lo[0], hi[1] - lo[1])):
+            raise self.error(key, "the workspace is too large for floating-point arithmetic")
         return lo, hi
 
     def robot(self, value: Any, key: str) -> Robot:
         doc = self.mapping(value, key, _ROBOT_KEYS, required=("radius",))
+        # Radius 0 is a point robot, which is a legitimate (classic) planning problem.
         radius = self.number(doc["radius"], f"{key}.radius", low=0.0)
         optional = {
             k: self.number(doc[k], f"{key}.{k}", low=0.0, strict=True)
@@ -354,38 +393,45 @@ class _Validator:
         return Robot(radius=radius, **optional)
 
     def planner(self, value: Any, key: str) -> PlannerConfig:
-        if value is None:
-            return PlannerConfig()
         doc = self.mapping(value, key, _PLANNER_KEYS)
-        ptype = self.string(doc["type"], f"{key}.type") if doc.get("type") is not None else None
+        ptype = doc.get("type")
+        if ptype is not None:
+            # Whether the name is registered is the CLI's business: plugins may add planners.
+            ptype = self.string(ptype, f"{key}.type")
         limit = doc.get("time_limit")
         if limit is not None:
             limit = self.number(limit, f"{key}.time_limit", low=0.0, strict=True)
         seed = doc.get("seed")
-        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
-            raise self.error(
-                f"{key}.seed", f"must be a non-negative integer, got {_describe(seed)}"
-            )
-        params = doc.get("params") or {}
+        if seed is not None:
+            if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+                raise self.error(
+                    f"{key}.seed", f"must be a non-negative integer, got {_describe(seed)}"
+                )
+            if seed > _MAX_SEED:
+                raise self.error(f"{key}.seed", "must be at most 2**64 - 1 (OMPL's seed range)")
+            seed = int(seed)
+        params = _get(doc, "params", {})
         if not isinstance(params, Mapping) or not all(isinstance(k, str) for k in params):
-            raise self.error(f"{key}.params", "must be a mapping of parameter names to values")
+            raise self.error(
+                f"{key}.params",
+                f"must be a mapping of parameter names to values, got {_describe(params)}",
+            )
         return PlannerConfig(ptype, limit, seed, MappingProxyType(dict(params)))
 
     def obstacle(self, value: Any, key: str) -> Obstacle:
         if not isinstance(value, Mapping):
             raise self.error(key, f"must be a mapping with a 'type', got {_describe(value)}")
+        known = ", ".join(_OBSTACLE_KEYS)
         kind = value.get("type")
         if kind is None:
-            raise self.error(
-                f"{key}.type", "required key is missing (circle, rectangle or polygon)"
-            )
+            raise self.error(f"{key}.type", f"required key is missing (one of {known})")
         if not isinstance(kind, str) or kind not in _OBSTACLE_KEYS:
+            did = _did_you_mean(str(kind), tuple(_OBSTACLE_KEYS)) if isinstance(kind, str) else ""
             raise self.error(
-                f"{key}.type",
-                f"unknown obstacle type {_describe(kind)}; known "
-                f"types: {', '.join(_OBSTACLE_KEYS)}",
+                f"{key}.type", f"unknown obstacle type {_describe(kind)}{did}; known types: {known}"
             )
-        doc = self.mapping(value, key, _OBSTACLE_KEYS[kind], required=_OBSTACLE_KEYS[kind])
+        allowed = _OBSTACLE_KEYS[kind]
+        doc = self.mapping(value, key, allowed, required=allowed, what=f" for a {kind}")
         if kind == "circle":
             center = self.point(doc["center"], f"{key}.center")
             radius = self.number(doc["radius"], f"{key}.radius", low=0.0, strict=True)
@@ -402,25 +448,34 @@ class _Validator:
     def polygon(self, value: Any, key: str) -> Polygon:
         if not isinstance(value, list | tuple):
             raise self.error(key, f"must be a list of points, got {_describe(value)}")
-        pts = [self.point(p, f"{key}[{i}]") for i, p in enumerate(value)]
-        if len(pts) > 1 and pts[0] == pts[-1]:
-            pts = pts[:-1]  # a closed ring written out: drop the repeated first vertex
-        if len(pts) < 3:
-            raise self.error(key, f"a polygon needs at least 3 distinct vertices, got {len(pts)}")
-        ring = shapely.Polygon(pts)
-        if _signed_area(pts) == 0.0 and all(_cross3(pts[0], pts[1], p) == 0.0 for p in pts[2:]):
+        ring: list[Point] = []
+        for i, p in enumerate(value):
+            q = self.point(p, f"{key}[{i}]")
+            # A vertex written twice in a row only adds a zero-length edge: drop the repeat.
+            if not ring or q != ring[-1]:
+                ring.append(q)
+        if len(ring) > 1 and ring[0] == ring[-1]:
+            ring.pop()  # a closed ring written out in full
+        if len(ring) < 3:
+            raise self.error(key, f"a polygon needs at least 3 distinct vertices, got {len(ring)}")
+        if all(_cross3(ring[0], ring[1], p) == 0.0 for p in ring[2:]):
+            # Checked before shapely, which would call this a self-intersection.
             raise self.error(key, "degenerate polygon: all vertices are collinear (zero area)")
-        if not ring.is_valid:
-            reason = shapely.is_valid_reason(ring)
+        shape = shapely.Polygon(ring)
+        if not math.isfinite(shape.area):
+            raise self.error(key, "the coordinates are too large for floating-point arithmetic")
+        if not shape.is_valid:
+            reason = shapely.is_valid_reason(shape)
             raise self.error(key, f"not a simple polygon (edges cross or touch): {reason}")
-        if ring.area <= 0.0:
+        if shape.area <= 0.0:
             raise self.error(key, "degenerate polygon: zero area")
-        if not ring.exterior.is_ccw:
-            pts = pts[::-1]
-        return Polygon(tuple(pts))
+        if not shape.exterior.is_ccw:
+            ring.reverse()
+        return Polygon(tuple(ring))
 
     def moving(self, value: Any, key: str) -> MovingObstacle:
         doc = self.mapping(value, key, _MOVING_KEYS, required=_MOVING_KEYS)
+        # No bounds check: a moving obstacle may well enter the workspace from outside.
         return MovingObstacle(
             radius=self.number(doc["radius"], f"{key}.radius", low=0.0, strict=True),
             start=self.point(doc["start"], f"{key}.start"),
@@ -439,47 +494,198 @@ class _Validator:
                 f"({x:g}, {y:g}) lies outside the bounds "
                 f"[{xmin:g}, {xmax:g}] x [{ymin:g}, {ymax:g}]",
             )
-        from .world import clearance_threshold  # world imports this module's types
-
         r = problem.robot.radius
-        need = clearance_threshold(r, 1e-9 * max(xmax - xmin, ymax - ymin, 1.0))
+        need = clearance_threshold(r, touch_tolerance(max(xmax - xmin, ymax - ymin)))
         for i, obs in enumerate(problem.obstacles):
             d = _clearance(obs, x, y)
-            if d < need:
+            if d >= need:
+                continue
+            if r == 0.0:
                 raise self.error(
-                    key,
-                    f"the robot disc (radius {r:g}) at ({x:g}, {y:g}) overlaps obstacles[{i}] "
-                    f"({obs.kind}): clearance {max(d, 0.0):.4g} < {r:g}",
+                    key, f"the point ({x:g}, {y:g}) lies in or on obstacles[{i}] ({obs.kind})"
                 )
+            raise self.error(
+                key,
+                f"the robot disc (radius {r:g}) at ({x:g}, {y:g}) overlaps obstacles[{i}] "
+                f"({obs.kind}): clearance {d:.4g} < {r:g}",
+            )
+
+
+# ----------------------------------------------------------------------------------------------
+# Small pure helpers.
+# ----------------------------------------------------------------------------------------------
+class _SafeLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` whose value errors carry the line and column of the value.
+
+    PyYAML's constructors raise plain ``ValueError``, ``KeyError`` and others for values such as
+    ``2020-13-45`` or ``!!int abc``. Converting them here, where the node (and so its position in
+    the file) is known, turns them into ordinary YAML errors with a location.
+    """
+
+    def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:
+        try:
+            return super().construct_object(node, deep=deep)
+        except (yaml.YAMLError, RecursionError):
+            raise
+        except Exception as exc:
+            raise yaml.constructor.ConstructorError(
+                None,
+                None,
+                f"cannot read the value {_REPR.repr(node.value)}: {exc}",
+                node.start_mark,
+            ) from None
+
+
+def _load_yaml(text: str) -> Any:
+    """``yaml.safe_load`` that also refuses duplicate keys.
+
+    PyYAML silently keeps the last of two equal keys, so a second ``radius:`` would quietly win;
+    the YAML spec requires keys to be unique. The check runs on the composed node graph, before
+    construction, where merge keys (``<<``) are still distinguishable from written keys.
+    """
+    loader = _SafeLoader(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        _refuse_duplicate_keys(node)
+        return loader.construct_document(node)
+    finally:
+        loader.dispose()
+
+
+def _refuse_duplicate_keys(root: yaml.Node) -> None:
+    # Iterative, and each node once: aliases may share or even contain their own nodes.
+    seen_nodes: set[int] = set()
+    stack = [root]
+    while stack:
+        node = stack.pop()
+        if id(node) in seen_nodes:
+            continue
+        seen_nodes.add(id(node))
+        if isinstance(node, yaml.MappingNode):
+            first: dict[tuple[str, str], yaml.Node] = {}
+            for key, value in node.value:
+                if isinstance(key, yaml.ScalarNode) and key.tag != "tag:yaml.org,2002:merge":
+                    other = first.setdefault((key.tag, key.value), key)
+                    if other is not key:
+                        raise yaml.constructor.ConstructorError(
+                            None,
+                            None,
+                            f"duplicate key {_REPR.repr(key.value)} "
+                            f"(first written at line {other.start_mark.line + 1})",
+                            key.start_mark,
+                        )
+                stack.extend((key, value))
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend(node.value)
+
+
+def _yaml_message(exc: yaml.YAMLError) -> str:
+    """`` at line L, column C: what`` (1-based, as editors count) from a PyYAML error."""
+    mark = getattr(exc, "problem_mark", None)
+    where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+    lines = str(exc).strip().splitlines()
+    what = getattr(exc, "problem", None) or (lines[0] if lines else type(exc).__name__)
+    return f"{where}: {what}"
+
+
+def touch_tolerance(size: float) -> float:
+    """Round-off allowance for "touching is allowed" comparisons in a workspace of ``size``.
+
+    ``1e-9`` of the workspace's larger side (at least ``1e-9``): far below any physical clearance,
+    well above float round-off in the distance formulas.
+    """
+    return 1e-9 * max(size, 1.0)
+
+
+def clearance_threshold(robot_radius: float, tol: float) -> float:
+    """The smallest distance to an obstacle that still counts as free.
+
+    ``robot_radius - tol``: touching at exactly the radius is allowed, up to round-off. For a point
+    robot (radius 0) that would let a segment *enter* an obstacle (its distance is then 0, like a
+    touch), so the threshold never drops below ``+tol``: still within the round-off tolerance of
+    the radius, and every penetration is caught. The loader (free start and goal) and
+    :class:`~rrtpso_ompl.world.World` share this rule, so a start accepted here is never refused
+    by a planner.
+    """
+    return max(robot_radius - tol, tol)
 
 
 def _clearance(obstacle: Obstacle, x: float, y: float) -> float:
-    """Distance from (x, y) to an obstacle (0 inside); circles analytically."""
+    """Distance from (x, y) to an obstacle, 0 inside; exact for circles (no polygon stand-in)."""
     if isinstance(obstacle, Circle):
         cx, cy = obstacle.center
         return max(0.0, math.hypot(x - cx, y - cy) - obstacle.radius)
     return float(shapely.Polygon(obstacle.points).distance(shapely.Point(x, y)))
 
 
-def _signed_area(pts: list[Point]) -> float:
-    return 0.5 * sum(
-        x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1], strict=True)
-    )
-
-
 def _cross3(o: Point, a: Point, b: Point) -> float:
+    """z of (a - o) x (b - o): zero when the three points are collinear."""
     return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+
+def _get(doc: Mapping[str, Any], key: str, default: Any) -> Any:
+    """An optional key; written with no value (null) it means the same as absent."""
+    value = doc.get(key)
+    return default if value is None else value
 
 
 def _join(prefix: str, key: str) -> str:
     return f"{prefix}.{key}" if prefix else key
 
 
+def _did_you_mean(word: str, choices: tuple[str, ...]) -> str:
+    """`` (did you mean 'x'?)`` for a misspelt or shortened key, else empty."""
+    close = difflib.get_close_matches(word, choices, n=1)
+    if not close and len(word) >= 3:
+        # difflib misses abbreviations such as `time` for `time_limit`.
+        close = [c for c in choices if c.startswith(word)][:1]
+    return f" (did you mean '{close[0]}'?)" if close else ""
+
+
+def _key_label(key: Any) -> str:
+    """A mapping key as the user wrote it, for messages (YAML spells None as null)."""
+    if key is None:
+        return "null"
+    if isinstance(key, bool):
+        return "true" if key else "false"
+    return str(key) or "''"
+
+
+def _number_hint(value: Any) -> str:
+    """Explain why a number-like string is not a number (empty when it does not look like one)."""
+    if not isinstance(value, str):
+        return ""
+    try:
+        x = float(value)
+    except ValueError:
+        return ""
+    if not math.isfinite(x):
+        return ""
+    if "e" in value.lower():
+        # PyYAML follows YAML 1.1, where a float needs a point: 1e3 and 1.0e3 are text.
+        fixed = repr(x)
+        mantissa, e, exponent = fixed.partition("e")
+        if e and "." not in mantissa:
+            fixed = f"{mantissa}.0e{exponent}"
+        return f" (YAML reads {value} as text, not a number: write {fixed})"
+    return " (a number in quotes is text: remove the quotes)"
+
+
+#: Short, bounded reprs: a value may be a huge or self-referencing structure (YAML anchors).
+_REPR = reprlib.Repr()
+_REPR.maxlevel = 3
+_REPR.maxstring = _REPR.maxother = _REPR.maxlong = 40
+_REPR.maxlist = _REPR.maxtuple = _REPR.maxdict = _REPR.maxset = _REPR.maxfrozenset = 4
+
+
 def _describe(value: Any) -> str:
     """A short description of a wrong value for error messages."""
     if value is None:
         return "nothing (null)"
-    text = repr(value)
-    if len(text) > 40:
-        text = text[:37] + "..."
+    try:
+        text = _REPR.repr(value)
+    except ValueError:  # an int with more digits than Python will convert to text
+        text = "(too long to show)"
     return f"{type(value).__name__} {text}"

@@ -31,20 +31,9 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
-from .problem import Circle, Polygon, Problem
+from .problem import Circle, Polygon, Problem, clearance_threshold, touch_tolerance
 
-__all__ = ["World", "clearance_threshold"]
-
-
-def clearance_threshold(robot_radius: float, tol: float) -> float:
-    """The smallest distance to an obstacle that still counts as free.
-
-    ``robot_radius - tol``: touching at exactly the radius is allowed, up to round-off. For a point
-    robot (radius 0) that would let a segment *enter* an obstacle (its distance is then 0, like a
-    touch), so the threshold never drops below ``+tol``: still within the round-off tolerance of
-    the radius, and every penetration is caught.
-    """
-    return max(robot_radius - tol, tol)
+__all__ = ["World", "clearance_threshold"]  # the rule lives in problem (the loader shares it)
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,9 +70,8 @@ class World:
         (xmin, ymin), (xmax, ymax) = bounds
         self.bounds = ((float(xmin), float(ymin)), (float(xmax), float(ymax)))
         self.robot_radius = float(robot_radius)
-        scale = max(xmax - xmin, ymax - ymin, 1.0)
         #: Absolute tolerance for "touching is allowed" comparisons (floating-point round-off).
-        self.tol = 1e-9 * scale
+        self.tol = touch_tolerance(max(xmax - xmin, ymax - ymin))
 
         circ = np.asarray(circles, dtype=float).reshape(-1, 3)
         self.circles = circ
@@ -374,9 +362,17 @@ class LocalViolation:
             )
             self.edges = _gather(near, edges, np.array([far, far, far, far]))
             self.edge_segments = np.flatnonzero(near.any(axis=1))
+            # A box with no polygon edge within R of it lies wholly inside or wholly outside the
+            # polygons; one point (its centre) tells which, and inside means full violation.
+            lone = np.flatnonzero(~near.any(axis=1))
+            mid = 0.5 * (seg_lo[lone] + seg_hi[lone])
+            self.buried_segments = lone[
+                shapely.intersects_xy(world._poly_union, mid[:, 0], mid[:, 1])
+            ]
         else:
             self.edges = np.zeros((n_seg, 0, 4))
             self.edge_segments = np.zeros(0, dtype=int)
+            self.buried_segments = np.zeros(0, dtype=int)
 
     def violation(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Same as :meth:`World.segment_violation` for ``a, b`` of shape ``(P, S, 2)``."""
@@ -403,6 +399,8 @@ class LocalViolation:
             start = a[:, idx]
             inside = shapely.intersects_xy(world._poly_union, start[..., 0], start[..., 1])
             v[:, idx] += np.maximum(0.0, r_need - np.where(inside, 0.0, d))
+        if len(self.buried_segments):
+            v[:, self.buried_segments] += r_need
         return v
 
 

@@ -2,24 +2,54 @@
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
 import pytest
 import yaml
 from conftest import PROBLEMS, SINGLE_CIRCLE
-from hypothesis import given, settings
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from rrtpso_ompl.problem import Circle, Polygon, ProblemError, load_problem, problem_from_dict
+from rrtpso_ompl.problem import (
+    Circle,
+    MovingObstacle,
+    Polygon,
+    ProblemError,
+    load_problem,
+    problem_from_dict,
+)
+from rrtpso_ompl.world import World
+
+SHIPPED = sorted(PROBLEMS.glob("*.yaml"))
 
 
-@pytest.mark.parametrize("path", sorted(PROBLEMS.glob("*.yaml")), ids=lambda p: p.stem)
+# ----------------------------------------------------------------------------------------------
+# The shipped problems
+# ----------------------------------------------------------------------------------------------
+def test_the_five_problems_are_shipped():
+    names = {p.stem for p in SHIPPED}
+    assert names >= {
+        "paper_static",
+        "single_circle",
+        "narrow_passage",
+        "cluttered_circles",
+        "polygon_map",
+    }
+
+
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda p: p.stem)
 def test_shipped_problems_load(path):
     problem = load_problem(path)
     assert problem.name == path.stem
-    assert problem.description and problem.robot.radius > 0
+    assert problem.description and problem.units == "cm" and problem.robot.radius > 0
     assert problem.planner.type == "RRTstarPSO"
+    assert (problem.planner.time_limit, problem.planner.seed) == (1.0, 1)
+    # Start and goal are free for the planners' own collision checker too.
+    world = World.from_problem(problem)
+    for x, y in (problem.start, problem.goal):
+        assert world.in_bounds(x, y) and world.point_free(x, y)
 
 
 def test_paper_static_has_the_papers_robot():
@@ -27,12 +57,26 @@ def test_paper_static_has_the_papers_robot():
     assert p.bounds == ((0, 0), (500, 500)) and p.start == (20, 20) and p.goal == (450, 450)
     r = p.robot
     assert (r.radius, r.wheel_radius, r.track_width, r.sample_time) == (28.5, 7.6, 38, 0.15)
+    assert (r.speed, r.sensor_range) == (20, 100)
     assert r.radius == pytest.approx(1.5 * r.track_width / 2)
     assert "reconstruction" in p.description.lower()
 
 
+def test_single_circle_is_the_documented_one():
+    p = load_problem(PROBLEMS / "single_circle.yaml")
+    assert p.obstacles == (Circle((250.0, 250.0), 80.0),)
+    assert p.robot.radius == 28.5 and "647.45" in p.description
+
+
+# ----------------------------------------------------------------------------------------------
+# Bad input: one ProblemError naming the file and the key
+# ----------------------------------------------------------------------------------------------
+_DELETE = object()
+
+
 def _with(**changes):
-    data = yaml.safe_load(yaml.safe_dump(SINGLE_CIRCLE))
+    """SINGLE_CIRCLE with changes at ``a__b__0``-style paths (``_DELETE`` removes the key)."""
+    data = copy.deepcopy(SINGLE_CIRCLE)
     for dotted, value in changes.items():
         keys = dotted.split("__")
         node = data
@@ -48,92 +92,243 @@ def _with(**changes):
     return data
 
 
-_DELETE = object()
+def _obstacle(**fields):
+    return _with(obstacles=[fields])
+
+
+def _moving(**changes):
+    mo = {"radius": 1, "start": [0, 0], "speed": 1, "heading_deg": 0, **changes}
+    return _with(moving_obstacles=[{k: v for k, v in mo.items() if v is not _DELETE}])
+
 
 # (id, document, the key the message must name, a fragment of the message)
 BAD = [
+    # the document and its top-level keys
     ("not-a-mapping", [1, 2], "", "mapping"),
     ("missing-bounds", _with(bounds=_DELETE), "bounds", "missing"),
-    ("missing-robot-radius", _with(robot={}), "robot.radius", "missing"),
+    ("missing-start", _with(start=_DELETE), "start", "missing"),
+    ("missing-goal", _with(goal=_DELETE), "goal", "missing"),
+    ("missing-robot", _with(robot=_DELETE), "robot", "missing"),
+    ("null-robot", _with(robot=None), "robot", "missing"),
     ("unknown-top-key", _with(obstacle=[]), "obstacle", "did you mean 'obstacles'"),
+    ("non-string-top-key", {**SINGLE_CIRCLE, 3: 4}, "3", "unknown key"),
+    ("name-empty", _with(name=""), "name", "non-empty"),
+    ("name-number", _with(name=7), "name", "string"),
+    ("description-list", _with(description=["a"]), "description", "string"),
+    ("units-number", _with(units=1), "units", "string"),
+    # numbers and points
+    ("bounds-inverted", _with(bounds=[[500, 0], [0, 500]]), "bounds", "xmin < xmax"),
+    ("bounds-flat", _with(bounds=[[0, 0], [500, 0]]), "bounds", "ymin < ymax"),
+    ("bounds-shape", _with(bounds=[0, 0, 500, 500]), "bounds", "[[xmin"),
+    ("bounds-string", _with(bounds="0 0 500 500"), "bounds", "[[xmin"),
+    ("bounds-nested", _with(bounds=[[[0], 0], [500, 500]]), "bounds[0][0]", "number"),
+    ("bounds-huge", _with(bounds=[[-1e308, 0], [1e308, 500]]), "bounds", "too large"),
+    ("point-shape", _with(start=[1, 2, 3]), "start", "[x, y]"),
+    ("point-scalar", _with(goal=450), "goal", "[x, y]"),
+    ("point-string-coordinate", _with(start=[20, "20"]), "start[1]", "number"),
+    ("point-null-coordinate", _with(start=[None, 20]), "start[0]", "number"),
+    ("point-bool-coordinate", _with(start=[True, 20]), "start[0]", "number"),
+    ("point-inf", _with(goal=[float("inf"), 20]), "goal[0]", "finite"),
+    ("point-huge-int", _with(goal=[10**400, 20]), "goal[0]", "too large"),
+    ("exponent-as-text", _with(goal=["4.5e2", 450]), "goal[0]", "write 450.0"),
+    # start and goal in the workspace
+    ("start-outside", _with(start=[-5, 20]), "start", "outside the bounds"),
+    ("goal-outside", _with(goal=[450, 501]), "goal", "outside the bounds"),
+    ("start-in-obstacle", _with(start=[250, 250]), "start", "overlaps obstacles[0]"),
+    ("goal-disc-overlaps", _with(goal=[250, 350]), "goal", "overlaps obstacles[0] (circle)"),
+    (
+        "start-in-rectangle",
+        _with(obstacles=[{"type": "rectangle", "min": [0, 0], "max": [10, 10]}]),
+        "start",
+        "overlaps obstacles[0] (rectangle)",
+    ),
+    (
+        "point-robot-on-boundary",
+        _with(
+            robot={"radius": 0}, obstacles=[{"type": "rectangle", "min": [20, 0], "max": [30, 30]}]
+        ),
+        "start",
+        "lies in or on obstacles[0]",
+    ),
+    ("negative-tolerance", _with(goal_tolerance=-1), "goal_tolerance", ">= 0"),
+    ("string-tolerance", _with(goal_tolerance="0"), "goal_tolerance", "remove the quotes"),
+    # the robot
+    ("robot-not-mapping", _with(robot=28.5), "robot", "mapping"),
+    ("missing-robot-radius", _with(robot={}), "robot.radius", "missing"),
     ("unknown-robot-key", _with(robot={"radius": 1, "radus": 2}), "robot.radus", "unknown"),
+    ("robot-key-typo-hint", _with(robot={"radius": 1, "sped": 2}), "robot.sped", "'speed'"),
     ("negative-radius", _with(robot={"radius": -1}), "robot.radius", ">= 0"),
     ("string-radius", _with(robot={"radius": "big"}), "robot.radius", "number"),
     ("bool-radius", _with(robot={"radius": True}), "robot.radius", "number"),
     ("nan-radius", _with(robot={"radius": float("nan")}), "robot.radius", "finite"),
+    ("list-radius", _with(robot={"radius": [28.5]}), "robot.radius", "number"),
     ("zero-speed", _with(robot={"radius": 1, "speed": 0}), "robot.speed", "> 0"),
-    ("bounds-inverted", _with(bounds=[[500, 0], [0, 500]]), "bounds", "xmin < xmax"),
-    ("bounds-shape", _with(bounds=[0, 0, 500, 500]), "bounds", "[[xmin"),
-    ("point-shape", _with(start=[1, 2, 3]), "start", "[x, y]"),
-    ("start-outside", _with(start=[-5, 20]), "start", "outside the bounds"),
-    ("goal-outside", _with(goal=[450, 501]), "goal", "outside the bounds"),
-    ("start-in-obstacle", _with(start=[250, 250]), "start", "overlaps obstacles[0]"),
-    ("goal-disc-overlaps", _with(goal=[250, 350]), "goal", "overlaps obstacles[0]"),
-    ("negative-tolerance", _with(goal_tolerance=-1), "goal_tolerance", ">= 0"),
-    ("circle-negative", _with(obstacles__0__radius=-3), "obstacles[0].radius", "> 0"),
-    ("circle-zero", _with(obstacles__0__radius=0), "obstacles[0].radius", "> 0"),
     (
-        "circle-no-center",
-        _with(obstacles=[{"type": "circle", "radius": 3}]),
-        "obstacles[0].center",
-        "missing",
+        "negative-wheel",
+        _with(robot={"radius": 1, "wheel_radius": -7.6}),
+        "robot.wheel_radius",
+        "> 0",
     ),
     (
+        "inf-track",
+        _with(robot={"radius": 1, "track_width": float("inf")}),
+        "robot.track_width",
+        "finite",
+    ),
+    ("zero-sample-time", _with(robot={"radius": 1, "sample_time": 0}), "robot.sample_time", "> 0"),
+    (
+        "string-sensor",
+        _with(robot={"radius": 1, "sensor_range": "far"}),
+        "robot.sensor_range",
+        "number",
+    ),
+    # obstacles
+    ("obstacles-not-list", _with(obstacles={"type": "circle"}), "obstacles", "list"),
+    ("obstacle-not-mapping", _with(obstacles=[[1, 2]]), "obstacles[0]", "mapping"),
+    ("obstacle-no-type", _obstacle(center=[1, 1], radius=1), "obstacles[0].type", "missing"),
+    (
         "obstacle-unknown-type",
-        _with(obstacles=[{"type": "hexagon"}]),
+        _obstacle(type="hexagon"),
         "obstacles[0].type",
         "circle, rectangle, polygon",
     ),
+    ("obstacle-type-typo", _obstacle(type="circel"), "obstacles[0].type", "did you mean 'circle'"),
+    ("obstacle-type-number", _obstacle(type=3), "obstacles[0].type", "unknown obstacle type"),
+    ("circle-negative", _with(obstacles__0__radius=-3), "obstacles[0].radius", "> 0"),
+    ("circle-zero", _with(obstacles__0__radius=0), "obstacles[0].radius", "> 0"),
+    ("circle-no-center", _obstacle(type="circle", radius=3), "obstacles[0].center", "missing"),
     (
-        "obstacle-no-type",
-        _with(obstacles=[{"center": [1, 1], "radius": 1}]),
-        "obstacles[0].type",
-        "missing",
+        "circle-key-typo",
+        _obstacle(type="circle", centre=[1, 1], radius=1),
+        "obstacles[0].centre",
+        "did you mean 'center'",
     ),
-    ("obstacle-not-mapping", _with(obstacles=[[1, 2]]), "obstacles[0]", "mapping"),
-    ("obstacles-not-list", _with(obstacles={"type": "circle"}), "obstacles", "list"),
+    (
+        "circle-with-rectangle-key",
+        _obstacle(type="circle", center=[1, 1], radius=1, min=[0, 0]),
+        "obstacles[0].min",
+        "unknown key for a circle",
+    ),
+    (
+        "circle-bad-center",
+        _obstacle(type="circle", center=[1], radius=1),
+        "obstacles[0].center",
+        "[x, y]",
+    ),
     (
         "rectangle-inverted",
-        _with(obstacles=[{"type": "rectangle", "min": [10, 10], "max": [5, 20]}]),
+        _obstacle(type="rectangle", min=[10, 10], max=[5, 20]),
         "obstacles[0]",
         "min < max",
     ),
     (
+        "rectangle-flat",
+        _obstacle(type="rectangle", min=[10, 10], max=[20, 10]),
+        "obstacles[0]",
+        "min < max",
+    ),
+    ("rectangle-no-max", _obstacle(type="rectangle", min=[10, 10]), "obstacles[0].max", "missing"),
+    (
+        "rectangle-with-radius",
+        _obstacle(type="rectangle", min=[10, 10], max=[20, 20], radius=1),
+        "obstacles[0].radius",
+        "unknown key for a rectangle",
+    ),
+    ("polygon-no-points", _obstacle(type="polygon"), "obstacles[0].points", "missing"),
+    (
+        "polygon-points-mapping",
+        _obstacle(type="polygon", points={"a": 1}),
+        "obstacles[0].points",
+        "list",
+    ),
+    (
         "polygon-two-points",
-        _with(obstacles=[{"type": "polygon", "points": [[0, 0], [1, 1]]}]),
+        _obstacle(type="polygon", points=[[0, 0], [1, 1]]),
         "obstacles[0].points",
         "at least 3",
     ),
     (
+        "polygon-repeated-vertices",
+        _obstacle(type="polygon", points=[[0, 0], [1, 1], [1, 1], [0, 0]]),
+        "obstacles[0].points",
+        "at least 3 distinct",
+    ),
+    (
         "polygon-collinear",
-        _with(obstacles=[{"type": "polygon", "points": [[0, 0], [1, 1], [2, 2]]}]),
+        _obstacle(type="polygon", points=[[0, 0], [1, 1], [2, 2]]),
         "obstacles[0].points",
         "collinear",
     ),
     (
         "polygon-bowtie",
-        _with(obstacles=[{"type": "polygon", "points": [[0, 0], [10, 10], [0, 10], [10, 0]]}]),
+        _obstacle(type="polygon", points=[[0, 0], [10, 10], [0, 10], [10, 0]]),
         "obstacles[0].points",
         "not a simple polygon",
     ),
     (
-        "moving-missing-speed",
-        _with(moving_obstacles=[{"radius": 1, "start": [0, 0], "heading_deg": 0}]),
-        "moving_obstacles[0].speed",
-        "missing",
+        "polygon-spike",
+        _obstacle(
+            type="polygon", points=[[100, 100], [200, 100], [300, 100], [200, 100], [200, 200]]
+        ),
+        "obstacles[0].points",
+        "not a simple polygon",
     ),
     (
-        "moving-negative-speed",
-        _with(moving_obstacles=[{"radius": 1, "start": [0, 0], "speed": -1, "heading_deg": 0}]),
-        "moving_obstacles[0].speed",
-        ">= 0",
+        "polygon-bad-vertex",
+        _obstacle(type="polygon", points=[[0, 0], [1, 0], [1, "x"]]),
+        "obstacles[0].points[2][1]",
+        "number",
+    ),
+    (
+        "polygon-huge",
+        _obstacle(type="polygon", points=[[-1e308, -1e308], [1e308, -1e308], [1e308, 1e308]]),
+        "obstacles[0].points",
+        "too large",
+    ),
+    (
+        "second-obstacle-named",
+        _with(obstacles=[SINGLE_CIRCLE["obstacles"][0], {"type": "circle", "center": [1, 1]}]),
+        "obstacles[1].radius",
+        "missing",
+    ),
+    # moving obstacles
+    ("moving-not-list", _with(moving_obstacles={"radius": 1}), "moving_obstacles", "list"),
+    ("moving-missing-speed", _moving(speed=_DELETE), "moving_obstacles[0].speed", "missing"),
+    ("moving-negative-speed", _moving(speed=-1), "moving_obstacles[0].speed", ">= 0"),
+    ("moving-zero-radius", _moving(radius=0), "moving_obstacles[0].radius", "> 0"),
+    (
+        "moving-nan-heading",
+        _moving(heading_deg=float("nan")),
+        "moving_obstacles[0].heading_deg",
+        "finite",
+    ),
+    (
+        "moving-unknown-key",
+        _moving(heading=3),
+        "moving_obstacles[0].heading",
+        "did you mean 'heading_deg'",
+    ),
+    # planner defaults
+    ("planner-not-mapping", _with(planner="RRTstar"), "planner", "mapping"),
+    (
+        "planner-unknown-key",
+        _with(planner={"time": 1}),
+        "planner.time",
+        "did you mean 'time_limit'",
     ),
     ("time-limit-zero", _with(planner={"time_limit": 0}), "planner.time_limit", "> 0"),
     ("time-limit-negative", _with(planner={"time_limit": -2}), "planner.time_limit", "> 0"),
+    ("time-limit-inf", _with(planner={"time_limit": float("inf")}), "planner.time_limit", "finite"),
+    ("time-limit-string", _with(planner={"time_limit": "1s"}), "planner.time_limit", "number"),
     ("seed-negative", _with(planner={"seed": -1}), "planner.seed", "non-negative"),
     ("seed-float", _with(planner={"seed": 1.5}), "planner.seed", "integer"),
+    ("seed-bool", _with(planner={"seed": True}), "planner.seed", "integer"),
+    ("seed-too-large", _with(planner={"seed": 2**64}), "planner.seed", "at most"),
     ("planner-type-empty", _with(planner={"type": ""}), "planner.type", "non-empty"),
+    ("planner-type-list", _with(planner={"type": ["RRTstar"]}), "planner.type", "string"),
     ("params-not-mapping", _with(planner={"params": [1]}), "planner.params", "mapping"),
+    ("params-empty-list", _with(planner={"params": []}), "planner.params", "mapping"),
+    ("params-int-keys", _with(planner={"params": {1: 2}}), "planner.params", "mapping"),
 ]
 
 
@@ -145,55 +340,193 @@ def test_bad_input_names_file_and_key(tmp_path, doc, key, fragment):
         load_problem(path)
     err = info.value
     assert err.key == key
-    assert str(err).startswith(f"{path}: ")
+    assert str(err).startswith(f"{path}: {key}: " if key else f"{path}: ")
     assert fragment in err.message
+    assert "\n" not in str(err)  # one line on stderr
 
 
-@pytest.mark.parametrize(
-    "text,fragment",
-    [
-        ("bounds: [[0, 0], [1, 1]\nstart: [0, 0]\n", "malformed YAML at line"),
-        ("", "mapping"),
-        ("- just\n- a list\n", "mapping"),
-    ],
-    ids=["unclosed-bracket", "empty", "list"],
-)
+@pytest.mark.parametrize("doc,key,fragment", [b[1:] for b in BAD], ids=[b[0] for b in BAD])
+def test_dict_input_is_checked_the_same_way(doc, key, fragment):
+    with pytest.raises(ProblemError) as info:
+        problem_from_dict(doc, source="mem")
+    assert info.value.key == key and fragment in info.value.message
+    assert str(info.value).startswith("mem: ")
+
+
+MALFORMED = [
+    (
+        "unclosed-bracket",
+        "bounds: [[0, 0], [1, 1]\nstart: [0, 0]\n",
+        "malformed YAML at line 2, column 1",
+    ),
+    ("bad-indent", "robot:\n  radius: 1\n   speed: 2\n", "malformed YAML at line 3, column 9"),
+    ("tab", "robot:\n\tradius: 1\n", "malformed YAML at line 2, column 1"),
+    (
+        "bad-date",
+        "name: x\nunits: 2020-13-45\n",
+        "at line 2, column 8: cannot read the value '2020-13-45'",
+    ),
+    (
+        "bad-int-tag",
+        "goal_tolerance: !!int abc\n",
+        "at line 1, column 17: cannot read the value 'abc'",
+    ),
+    ("python-tag", "start: !!python/tuple [1, 2]\n", "malformed YAML at line 1, column 8"),
+    ("two-documents", "a: 1\n---\nb: 2\n", "malformed YAML at line 2, column 1"),
+    (
+        "duplicate-key",
+        "robot:\n  radius: 1\n  radius: 2\n",
+        "line 3, column 3: duplicate key 'radius' (first",
+    ),
+    ("too-deep", "start: " + "[" * 3000 + "]" * 3000 + "\n", "nested too deeply"),
+    ("control-character", "name: \x07\n", "malformed YAML"),
+    ("empty", "", "the file is empty"),
+    ("only-comment", "# nothing here\n", "the file is empty"),
+    ("list", "- just\n- a list\n", "the file must be a mapping"),
+    ("scalar", "42\n", "the file must be a mapping"),
+]
+
+
+@pytest.mark.parametrize("text,fragment", [m[1:] for m in MALFORMED], ids=[m[0] for m in MALFORMED])
 def test_malformed_files(tmp_path, text, fragment):
     path = tmp_path / "m.yaml"
     path.write_text(text)
-    with pytest.raises(ProblemError, match=fragment):
+    with pytest.raises(ProblemError) as info:
         load_problem(path)
+    assert str(info.value).startswith(f"{path}: ") and info.value.key == ""
+    assert fragment in str(info.value)
 
 
-def test_missing_and_binary_files(tmp_path):
+def test_missing_binary_and_directory_files(tmp_path):
     with pytest.raises(ProblemError, match="no such file"):
         load_problem(tmp_path / "absent.yaml")
     blob = tmp_path / "blob.yaml"
     blob.write_bytes(b"\xff\xfe\x00\x01")
-    with pytest.raises(ProblemError):
+    with pytest.raises(ProblemError, match="cannot read"):
         load_problem(blob)
+    with pytest.raises(ProblemError, match="cannot read"):
+        load_problem(tmp_path)
 
 
-def test_rectangles_and_polygons_are_stored_counter_clockwise():
-    doc = _with(
-        obstacles=[
-            {"type": "rectangle", "min": [10, 300], "max": [60, 350]},
-            {
-                "type": "polygon",
-                "points": [[400, 50], [400, 100], [450, 100], [450, 50], [400, 50]],
-            },
-        ]
+def test_billion_laughs_is_cheap(tmp_path):
+    """Aliases to aliases build a huge structure by reference; the message stays short."""
+    lines = ["a0: &a0 [1, 1, 1, 1, 1, 1, 1, 1, 1]"]
+    lines += [f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 9)}]" for i in range(1, 9)]
+    text = "\n".join(lines).replace("a0:", "start:", 1) + "\n"
+    path = tmp_path / "laughs.yaml"
+    path.write_text(text)
+    with pytest.raises(ProblemError) as info:
+        load_problem(path)
+    assert len(str(info.value)) < 400
+
+
+# ----------------------------------------------------------------------------------------------
+# What valid input becomes
+# ----------------------------------------------------------------------------------------------
+def _signed_area(pts):
+    return 0.5 * sum(
+        x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1], strict=True)
     )
-    rect, poly = problem_from_dict(doc).obstacles
-    assert isinstance(rect, Polygon) and rect.kind == "rectangle" and len(rect.points) == 4
-    assert poly.kind == "polygon" and len(poly.points) == 4  # closing vertex dropped
 
-    def area(pts):
-        return 0.5 * sum(
-            x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1], strict=True)
-        )
 
-    assert area(rect.points) == pytest.approx(2500) and area(poly.points) == pytest.approx(2500)
+def test_rectangles_become_counter_clockwise_4_gons():
+    doc = _with(obstacles=[{"type": "rectangle", "min": [10, 300], "max": [60, 350]}])
+    (rect,) = problem_from_dict(doc).obstacles
+    assert isinstance(rect, Polygon) and rect.kind == "rectangle"
+    assert rect.points == ((10, 300), (60, 300), (60, 350), (10, 350))
+    assert _signed_area(rect.points) == pytest.approx(2500)
+
+
+def test_clockwise_polygons_are_reversed_and_closing_vertex_dropped():
+    clockwise = [[400, 50], [400, 100], [450, 100], [450, 50], [400, 50]]
+    doc = _with(obstacles=[{"type": "polygon", "points": clockwise}])
+    (poly,) = problem_from_dict(doc).obstacles
+    assert poly.kind == "polygon"
+    assert poly.points == ((450, 50), (450, 100), (400, 100), (400, 50))
+    assert _signed_area(poly.points) == pytest.approx(2500)
+
+
+def test_counter_clockwise_polygons_are_kept_and_repeats_dropped():
+    ccw = [[300, 50], [380, 60], [380, 60], [340, 120]]
+    (poly,) = problem_from_dict(_with(obstacles=[{"type": "polygon", "points": ccw}])).obstacles
+    assert poly.points == ((300, 50), (380, 60), (340, 120))
+
+
+def test_non_convex_polygon_is_accepted():
+    ell = [[0, 0], [100, 0], [100, 20], [20, 20], [20, 100], [0, 100]]
+    doc = _with(start=[200, 20], obstacles=[{"type": "polygon", "points": ell}])
+    (poly,) = problem_from_dict(doc).obstacles
+    assert len(poly.points) == 6 and _signed_area(poly.points) == pytest.approx(3600)
+
+
+def test_optional_keys_default_and_null_means_absent():
+    doc = {k: SINGLE_CIRCLE[k] for k in ("bounds", "start", "goal", "robot")}
+    p = problem_from_dict(doc, name="stem")
+    assert p.name == "stem" and p.description == "" and p.units == ""
+    assert p.goal_tolerance == 0.0 and p.obstacles == () and p.moving_obstacles == ()
+    assert p.planner.type is None and p.planner.time_limit is None and p.planner.seed is None
+    assert dict(p.planner.params) == {}
+    nulls = dict.fromkeys(
+        ("description", "units", "goal_tolerance", "obstacles", "moving_obstacles", "planner")
+    )
+    q = problem_from_dict({**doc, **nulls}, name="stem")
+    assert q == p
+    r = problem_from_dict({**doc, "planner": dict.fromkeys(("type", "time_limit", "seed"))})
+    assert r.planner == p.planner
+
+
+def test_name_defaults_to_the_file_stem(tmp_path):
+    doc = _with(name=_DELETE)
+    path = tmp_path / "my_problem.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    assert load_problem(path).name == "my_problem"
+    assert problem_from_dict(doc).name == "problem"
+
+
+def test_planner_block_is_read():
+    doc = _with(planner={"type": "RRTstar", "time_limit": 2, "seed": 7, "params": {"range": 30}})
+    cfg = problem_from_dict(doc).planner
+    assert (cfg.type, cfg.time_limit, cfg.seed) == ("RRTstar", 2.0, 7)
+    assert cfg.params == {"range": 30}
+    with pytest.raises(TypeError):
+        cfg.params["range"] = 1  # read-only
+    # The loader does not judge planner names: plugins may register more.
+    assert (
+        problem_from_dict(_with(planner={"type": "NoSuchPlanner"})).planner.type == "NoSuchPlanner"
+    )
+
+
+def test_robot_drive_parameters_and_limits_are_optional_positive_numbers():
+    robot = {"radius": 28.5, "wheel_radius": 7.6, "track_width": 38, "speed": 20}
+    robot |= {"sample_time": 0.15, "sensor_range": 100}
+    robot |= {"max_speed": 30, "max_wheel_speed": 25, "max_accel": 20}
+    r = problem_from_dict(_with(robot=robot)).robot
+    assert (r.wheel_radius, r.track_width, r.speed, r.sample_time) == (7.6, 38, 20, 0.15)
+    assert (r.sensor_range, r.max_speed, r.max_wheel_speed, r.max_accel) == (100, 30, 25, 20)
+    with pytest.raises(ProblemError, match=r"robot\.max_accel"):
+        problem_from_dict(_with(robot={"radius": 1, "max_accel": 0}))
+
+
+def test_point_robot_start_equal_goal_and_moving_obstacles_outside_are_fine():
+    doc = _with(
+        robot={"radius": 0},
+        goal=[20, 20],
+        goal_tolerance=5,
+        moving_obstacles=[{"radius": 20, "start": [-100, 900], "speed": 0, "heading_deg": -45}],
+    )
+    p = problem_from_dict(doc)
+    assert p.robot.radius == 0 and p.start == p.goal and p.goal_tolerance == 5
+    assert p.moving_obstacles[0].start == (-100, 900)
+
+
+def test_numpy_numbers_are_numbers():
+    doc = _with(
+        start=[np.float64(20), np.int64(20)],
+        goal=np.array([450.0, 450.0]).tolist(),
+        planner={"seed": np.uint32(3)},
+    )
+    p = problem_from_dict(doc)
+    assert p.start == (20.0, 20.0) and p.planner.seed == 3 and type(p.planner.seed) is int
 
 
 def test_touching_start_is_allowed():
@@ -205,85 +538,177 @@ def test_touching_start_is_allowed():
         problem_from_dict(_with(start=[250 - r + 1e-3, 250]))
 
 
+def test_overlap_message_reports_the_clearance():
+    with pytest.raises(ProblemError) as info:
+        problem_from_dict(_with(start=[180, 180]), source="f.yaml")
+    d = math.hypot(70, 70) - 80
+    assert str(info.value) == (
+        f"f.yaml: start: the robot disc (radius 28.5) at (180, 180) overlaps obstacles[0] "
+        f"(circle): clearance {d:.4g} < 28.5"
+    )
+
+
+_OBSTACLES = [
+    {"type": "circle", "center": [250, 250], "radius": 80},
+    {"type": "rectangle", "min": [60, 300], "max": [160, 340]},
+    {"type": "polygon", "points": [[300, 50], [380, 60], [340, 120]]},
+    {"type": "polygon", "points": [[380, 300], [480, 300], [480, 320], [400, 320], [400, 400]]},
+]
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    x=st.floats(0, 500),
+    y=st.floats(0, 500),
+    radius=st.sampled_from([0.0, 5.0, 28.5]),
+)
+def test_free_start_agrees_with_the_planners_world(x, y, radius):
+    """A start the loader accepts is exactly one the planners' collision checker calls free."""
+    doc = _with(start=[x, y], goal=[0, 500], robot={"radius": radius}, obstacles=_OBSTACLES)
+    world = World.from_problem(
+        problem_from_dict(_with(robot={"radius": radius}, obstacles=_OBSTACLES))
+    )
+    try:
+        problem_from_dict(doc)
+        accepted = True
+    except ProblemError as err:
+        assert err.key == "start"
+        accepted = False
+    if accepted != world.point_free(x, y):
+        # Only a hair's breadth from touching may the two exact computations round differently.
+        clearance = float(world.point_clearance(np.array([[x, y]]))[0])
+        assert clearance == pytest.approx(world.threshold, abs=1e-9)
+
+
 def test_moving_obstacle_follows_eqs_14_15():
     doc = _with(
         moving_obstacles=[{"radius": 20, "start": [310, 250], "speed": 10, "heading_deg": 124}]
     )
     mo = problem_from_dict(doc).moving_obstacles[0]
+    assert mo == MovingObstacle(radius=20, start=(310, 250), speed=10, heading_deg=124)
     h = math.radians(124)
+    # x = x0 + v cos(h) t, y = y0 + v sin(h) t
     assert np.allclose(mo.position(2.0), [310 + 20 * math.cos(h), 250 + 20 * math.sin(h)])
+    assert np.allclose(mo.velocity, [10 * math.cos(h), 10 * math.sin(h)])
     # Eqs. 14-15 stepped at Ts = 0.15 s give the same point as the closed form.
     p = np.array([310.0, 250.0])
     for _ in range(20):
         p = p + 10 * np.array([math.cos(h), math.sin(h)]) * 0.15
     assert np.allclose(mo.position(20 * 0.15), p)
     assert mo.position(np.array([0.0, 1.0])).shape == (2, 2)
+    assert np.allclose(mo.position(0.0), [310, 250])
 
 
-def test_dict_and_file_agree(tmp_path):
-    path = tmp_path / "single_circle.yaml"
-    path.write_text(yaml.safe_dump(SINGLE_CIRCLE))
-    from_file = load_problem(path)
-    from_dict = problem_from_dict(SINGLE_CIRCLE, source=str(path), name="ignored")
-    assert from_file == from_dict
-    assert from_file.obstacles == (Circle((250.0, 250.0), 80.0),)
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda p: p.stem)
+def test_dict_and_file_agree(tmp_path, path):
+    data = yaml.safe_load(path.read_text())
+    assert load_problem(path) == problem_from_dict(data, source=str(path), name=path.stem)
+    # And a problem written back out loads to the same thing.
+    copy_path = tmp_path / path.name
+    copy_path.write_text(yaml.safe_dump(data))
+    from_copy = load_problem(copy_path)
+    assert from_copy == problem_from_dict(data, source=str(copy_path), name="ignored")
 
 
+# ----------------------------------------------------------------------------------------------
+# Junk anywhere: only ever a ProblemError
+# ----------------------------------------------------------------------------------------------
 JSONISH = st.recursive(
     st.none()
     | st.booleans()
-    | st.integers(-(10**6), 10**6)
+    | st.integers()
+    | st.integers(-(10**400), 10**400)
     | st.floats(allow_nan=True)
-    | st.text(max_size=5),
+    | st.text(max_size=5)
+    | st.sampled_from(["circle", "rectangle", "polygon", "1e3", "28.5", ""]),
     lambda children: (
-        st.lists(children, max_size=4) | st.dictionaries(st.text(max_size=6), children, max_size=4)
+        st.lists(children, max_size=4)
+        | st.dictionaries(
+            st.text(max_size=6) | st.sampled_from(["type", "center", "radius", "points"]),
+            children,
+            max_size=4,
+        )
     ),
     max_leaves=12,
 )
 KEYS = [
+    "",
     "bounds",
+    "bounds.0",
+    "bounds.1.0",
     "start",
+    "start.0",
     "goal",
+    "goal.1",
     "robot",
     "robot.radius",
     "robot.speed",
+    "robot.wheel_radius",
+    "robot.radus",
     "obstacles",
     "obstacles.0",
     "obstacles.0.center",
+    "obstacles.0.center.1",
     "obstacles.0.radius",
     "obstacles.0.type",
+    "obstacles.0.points",
     "planner",
+    "planner.type",
+    "planner.seed",
+    "planner.time_limit",
     "planner.params",
     "moving_obstacles",
     "goal_tolerance",
     "name",
+    "description",
+    "units",
+    "junk",
 ]
 
 
-@settings(max_examples=300, deadline=None)
-@given(key=st.sampled_from(KEYS), junk=JSONISH)
-def test_junk_anywhere_only_raises_problem_error(key, junk):
-    data = yaml.safe_load(yaml.safe_dump(SINGLE_CIRCLE))
-    parts = key.split(".")
+def _put(data, key, junk):
+    """Put ``junk`` at a dotted path (``""`` is the whole document).
+
+    Missing mappings on the way are created; a path that an earlier put has made impossible
+    (a list that became shorter, a mapping that became a number) is left alone.
+    """
+    if not key:
+        return junk
+    *parents, last = key.split(".")
     node = data
-    for p in parts[:-1]:
-        node = node[int(p)] if isinstance(node, list) else node.setdefault(p, {})
-        if not isinstance(node, dict | list):
-            return
-    last = parts[-1]
-    if isinstance(node, list):
-        node[int(last)] = junk
-    else:
-        node[last] = junk
+    try:
+        for p in parents:
+            node = node[int(p)] if isinstance(node, list) else node.setdefault(p, {})
+        node[int(last) if isinstance(node, list) else last] = junk
+    except (IndexError, TypeError, AttributeError, ValueError):
+        pass
+    return data
+
+
+@settings(max_examples=400, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(puts=st.lists(st.tuples(st.sampled_from(KEYS), JSONISH), min_size=1, max_size=3))
+def test_junk_anywhere_only_raises_problem_error(puts):
+    data = copy.deepcopy(SINGLE_CIRCLE)
+    for key, junk in puts:
+        data = _put(data, key, junk)
     try:
         problem_from_dict(data, source="junk.yaml")
     except ProblemError as err:
         assert str(err).startswith("junk.yaml")
 
 
-def test_robot_limits_are_optional_positive_numbers():
-    doc = _with(robot={"radius": 28.5, "max_speed": 30, "max_wheel_speed": 25, "max_accel": 20})
-    robot = problem_from_dict(doc).robot
-    assert (robot.max_speed, robot.max_wheel_speed, robot.max_accel) == (30, 25, 20)
-    with pytest.raises(ProblemError, match=r"robot\.max_accel"):
-        problem_from_dict(_with(robot={"radius": 1, "max_accel": 0}))
+@settings(max_examples=300, deadline=None)
+@given(
+    where=st.integers(0, 10_000),
+    junk=st.text(max_size=12)
+    | st.sampled_from(["[", "]", "{", ": ", "\n  - ", "&a ", "*a", "!!int ", "? ", "\t", "'"]),
+)
+def test_junk_text_only_raises_problem_error(tmp_path_factory, where, junk):
+    text = (PROBLEMS / "paper_static.yaml").read_text()
+    where %= len(text) + 1
+    path = tmp_path_factory.mktemp("junk") / "junk.yaml"
+    path.write_text(text[:where] + junk + text[where:], encoding="utf-8", errors="surrogatepass")
+    try:
+        load_problem(path)
+    except ProblemError as err:
+        assert str(err).startswith(f"{path}: ")

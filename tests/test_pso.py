@@ -1,4 +1,5 @@
-"""The particle swarm (paper eqs. 4-5): convergence, the update rule itself, bounds, seeding."""
+"""The particle swarm (paper eqs. 4-5): convergence, the update rule itself, bounds, seeding,
+termination and the validation of its options."""
 
 from __future__ import annotations
 
@@ -9,10 +10,47 @@ from rrtpso_ompl.pso import PSOOptions, minimize
 
 
 def sphere(x):
-    return np.sum((x - 1.5) ** 2, axis=1)
+    return np.sum(x**2, axis=1)
 
 
-def test_converges_on_a_shifted_sphere():
+SHIFT = np.array([1.5, -2.0, 0.25])
+WEIGHTS = np.array([1.0, 4.0, 0.5])
+
+
+def shifted_quadratic(x):
+    """An anisotropic quadratic with its minimum 3.0 at SHIFT."""
+    return np.sum(WEIGHTS * (x - SHIFT) ** 2, axis=1) + 3.0
+
+
+class ConstRNG:
+    """A stand-in generator: ``random`` returns a constant (so r1 = r2 = value) and ``uniform``
+    the middle of the box, so the update can be replayed by hand."""
+
+    def __init__(self, value: float = 0.5) -> None:
+        self.value = value
+
+    def random(self, shape):
+        return np.full(shape, self.value)
+
+    def uniform(self, low, high, size):
+        return np.broadcast_to(0.5 * (np.asarray(low) + np.asarray(high)), size).copy()
+
+
+def recording(cost):
+    """Wrap ``cost`` to record a copy of every swarm it is called with."""
+    seen: list[np.ndarray] = []
+
+    def wrapped(x):
+        seen.append(np.array(x, copy=True))
+        return cost(x)
+
+    return wrapped, seen
+
+
+# ----------------------------------------------------------------------------------------------
+# Convergence and bookkeeping
+# ----------------------------------------------------------------------------------------------
+def test_converges_on_the_sphere_in_5d():
     res = minimize(
         sphere,
         -5 * np.ones(5),
@@ -20,66 +58,147 @@ def test_converges_on_a_shifted_sphere():
         PSOOptions(iterations=300),
         np.random.default_rng(0),
     )
-    assert np.allclose(res.position, 1.5, atol=1e-3)
-    assert res.cost < 1e-5
+    assert np.allclose(res.position, 0.0, atol=1e-3)
+    assert res.cost < 1e-6
+    assert res.cost == pytest.approx(float(sphere(res.position[None])[0]))
     assert res.n_iterations == 300 and len(res.history) == 301
+    assert res.history[-1] == res.cost
     assert np.all(np.diff(res.history) <= 0)  # the global best never gets worse
     assert res.n_evaluations == 30 * 301
+    assert res.stopped_by == "iterations"
+    assert res.time >= 0
 
 
-def test_cost_gets_the_whole_swarm_and_positions_stay_in_the_box():
-    seen = []
-
-    def cost(x):
-        seen.append(x.copy())
-        return sphere(x) + 10 * x[:, 0]  # pushes x0 against its lower bound
-
-    lo, hi = np.array([-1.0, 0.0, 0.0]), np.array([1.0, 2.0, 3.0])
-    minimize(cost, lo, hi, PSOOptions(swarm_size=12, iterations=40), np.random.default_rng(1))
-    assert all(x.shape == (12, 3) for x in seen)
-    stacked = np.concatenate(seen)
-    assert np.all(stacked >= lo) and np.all(stacked <= hi)
-    assert stacked[:, 0].min() == -1.0  # reached the wall, was clipped to it
-
-
-def test_same_seed_same_result_and_different_seed_differs():
-    opts = PSOOptions(iterations=5)  # not converged yet, so different seeds must differ
-    lo, hi = -3 * np.ones(4), 3 * np.ones(4)
-    a = minimize(sphere, lo, hi, opts, np.random.default_rng(5))
-    b = minimize(sphere, lo, hi, opts, np.random.default_rng(5))
-    c = minimize(sphere, lo, hi, opts, np.random.default_rng(6))
-    assert np.array_equal(a.position, b.position) and np.array_equal(a.history, b.history)
-    assert not np.array_equal(a.position, c.position)
-
-
-def test_terminate_is_polled_every_iteration():
-    calls = {"n": 0}
-
-    def stop_after_three():
-        calls["n"] += 1
-        return calls["n"] > 3
-
+def test_converges_on_a_shifted_anisotropic_quadratic():
     res = minimize(
-        sphere,
+        shifted_quadratic,
+        -5 * np.ones(3),
+        5 * np.ones(3),
+        PSOOptions(swarm_size=20, iterations=200),
+        np.random.default_rng(1),
+    )
+    assert np.allclose(res.position, SHIFT, atol=1e-3)
+    assert res.cost == pytest.approx(3.0, abs=1e-6)
+    assert res.cost >= 3.0
+    assert np.all(np.diff(res.history) <= 0) and len(res.history) == res.n_iterations + 1
+
+
+def test_optimum_on_the_boundary_of_the_box():
+    """The unconstrained minimum (1.5, ...) lies outside [-1, 1]: the best is the corner."""
+    res = minimize(
+        lambda x: np.sum((x - 1.5) ** 2, axis=1),
         -np.ones(2),
         np.ones(2),
         PSOOptions(iterations=100),
-        np.random.default_rng(0),
-        terminate=stop_after_three,
+        np.random.default_rng(2),
     )
-    assert res.n_iterations == 3 and res.stopped_by == "terminate"
+    assert np.allclose(res.position, 1.0, atol=1e-9)
+
+
+def test_zero_iterations_returns_the_best_initial_particle():
+    init = np.array([[3.0, 3.0], [0.5, -0.5], [-2.0, 1.0]])
+    cost, seen = recording(sphere)
     res = minimize(
-        sphere,
+        cost,
+        -5 * np.ones(2),
+        5 * np.ones(2),
+        PSOOptions(swarm_size=3, iterations=0),
+        np.random.default_rng(0),
+        init=init,
+    )
+    assert len(seen) == 1 and np.array_equal(seen[0], init)
+    assert np.array_equal(res.position, init[1]) and res.cost == 0.5
+    assert res.n_iterations == 0 and len(res.history) == 1 and res.n_evaluations == 3
+
+
+def test_init_is_clipped_to_the_box():
+    cost, seen = recording(sphere)
+    init = np.array([[-9.0, 0.0], [0.0, 9.0]])
+    minimize(
+        cost,
+        -np.ones(2),
+        np.ones(2),
+        PSOOptions(swarm_size=2, iterations=0),
+        np.random.default_rng(0),
+        init=init,
+    )
+    assert np.array_equal(seen[0], [[-1.0, 0.0], [0.0, 1.0]])
+
+
+# ----------------------------------------------------------------------------------------------
+# Randomness
+# ----------------------------------------------------------------------------------------------
+def test_same_seed_same_result_and_different_seed_differs():
+    opts = PSOOptions(iterations=5)  # not converged yet, so different seeds must differ
+    lo, hi = -3 * np.ones(4), 3 * np.ones(4)
+    a = minimize(sphere, lo, hi, opts, np.random.default_rng(7))
+    b = minimize(sphere, lo, hi, opts, np.random.default_rng(7))
+    c = minimize(sphere, lo, hi, opts, np.random.default_rng(8))
+    assert np.array_equal(a.position, b.position) and np.array_equal(a.history, b.history)
+    assert a.cost == b.cost
+    assert not np.array_equal(a.position, c.position)
+    assert not np.array_equal(a.history, c.history)
+
+
+# ----------------------------------------------------------------------------------------------
+# Termination
+# ----------------------------------------------------------------------------------------------
+def test_terminate_true_at_once_runs_no_iteration():
+    cost, seen = recording(sphere)
+    res = minimize(
+        cost,
         -np.ones(2),
         np.ones(2),
         PSOOptions(iterations=100),
         np.random.default_rng(0),
         terminate=lambda: True,
     )
-    assert res.n_iterations == 0 and len(res.history) == 1
+    assert res.n_iterations == 0 and len(res.history) == 1 and res.stopped_by == "terminate"
+    assert len(seen) == 1  # only the initial swarm was evaluated
 
 
-def test_early_stop_on_tolerance():
+@pytest.mark.parametrize("n", [1, 3, 17])
+def test_terminate_is_polled_once_per_iteration(n):
+    calls = {"n": 0}
+
+    def stop_after_n():
+        calls["n"] += 1
+        return calls["n"] > n
+
+    cost, seen = recording(sphere)
+    res = minimize(
+        cost,
+        -np.ones(2),
+        np.ones(2),
+        PSOOptions(iterations=100),
+        np.random.default_rng(0),
+        terminate=stop_after_n,
+    )
+    assert res.n_iterations == n and res.stopped_by == "terminate"
+    assert calls["n"] == n + 1
+    assert len(seen) == n + 1 and len(res.history) == n + 1
+    assert res.n_evaluations == 30 * (n + 1)
+
+
+def test_terminate_never_true_runs_all_iterations():
+    calls = {"n": 0}
+
+    def never():
+        calls["n"] += 1
+        return False
+
+    res = minimize(
+        sphere,
+        -np.ones(2),
+        np.ones(2),
+        PSOOptions(iterations=12),
+        np.random.default_rng(0),
+        terminate=never,
+    )
+    assert res.n_iterations == 12 and calls["n"] == 12 and res.stopped_by == "iterations"
+
+
+def test_early_stop_on_a_flat_cost():
     res = minimize(
         lambda x: np.zeros(len(x)),
         -np.ones(2),
@@ -90,63 +209,200 @@ def test_early_stop_on_tolerance():
     assert res.stopped_by == "tolerance" and res.n_iterations == 10
 
 
-class HalfRNG:
-    """A stand-in generator whose r1 = r2 = 0.5, to check the update rule by hand."""
+def test_early_stop_waits_while_the_cost_still_improves():
+    """A cost that improves by a factor of 2 every call never triggers a 1e-3 tolerance."""
+    calls = {"n": 0}
 
-    def random(self, shape):
-        return np.full(shape, 0.5)
+    def halving(x):
+        calls["n"] += 1
+        return np.full(len(x), 2.0 ** -calls["n"])
+
+    res = minimize(
+        halving,
+        -np.ones(2),
+        np.ones(2),
+        PSOOptions(iterations=40, tolerance=1e-3, patience=5),
+        np.random.default_rng(0),
+    )
+    assert res.stopped_by == "iterations" and res.n_iterations == 40
 
 
-def test_one_iteration_is_eqs_4_and_5():
-    x0 = np.array([[0.0, 0.0], [2.0, 1.0], [-1.0, 3.0]])
-    v0 = np.array([[0.1, -0.2], [0.0, 0.3], [0.2, 0.2]])
-    opts = PSOOptions(swarm_size=3, iterations=1, w=0.6, c1=1.2, c2=1.8)
-    seen = []
+def test_early_stop_on_the_sphere_is_near_the_optimum():
+    res = minimize(
+        sphere,
+        -5 * np.ones(3),
+        5 * np.ones(3),
+        PSOOptions(iterations=5000, tolerance=1e-6, patience=20),
+        np.random.default_rng(3),
+    )
+    assert res.stopped_by == "tolerance" and res.n_iterations < 5000
+    # Stopped because the last `patience` iterations improved by at most the relative tolerance.
+    old, new = res.history[-21], res.history[-1]
+    assert old - new <= 1e-6 * abs(old)
+    assert res.cost < 1e-3
 
-    def cost(x):
-        seen.append(x.copy())
-        return np.sum(x**2, axis=1)
 
-    minimize(cost, -10 * np.ones(2), 10 * np.ones(2), opts, HalfRNG(), init=x0, init_velocity=v0)
-    pbest = x0  # after initialisation every particle's best is where it is
-    gbest = x0[0]  # cost 0: the best of the three
-    v1 = 0.6 * v0 + 1.2 * 0.5 * (pbest - x0) + 1.8 * 0.5 * (gbest - x0)  # eq. 4
-    assert np.allclose(seen[1], x0 + v1)  # eq. 5
+# ----------------------------------------------------------------------------------------------
+# Shapes and bounds
+# ----------------------------------------------------------------------------------------------
+def test_cost_gets_the_whole_swarm_and_positions_stay_in_the_box():
+    cost, seen = recording(lambda x: sphere(x - 1.0) + 10 * x[:, 0])  # pushes x0 to its wall
+    lo, hi = np.array([-1.0, 0.0, 0.0]), np.array([1.0, 2.0, 3.0])
+    res = minimize(cost, lo, hi, PSOOptions(swarm_size=12, iterations=40), np.random.default_rng(1))
+    assert len(seen) == 41
+    assert all(x.shape == (12, 3) for x in seen)
+    stacked = np.concatenate(seen)
+    assert np.all(stacked >= lo) and np.all(stacked <= hi)
+    assert stacked[:, 0].min() == -1.0  # reached the wall, was clipped to it exactly
+    assert np.all(res.position >= lo) and np.all(res.position <= hi)
 
 
 def test_velocity_clamp():
-    seen = []
-
-    def cost(x):
-        seen.append(x.copy())
-        return -x[:, 0]  # run to the right as fast as allowed
-
+    cost, seen = recording(lambda x: -x[:, 0])  # run to the right as fast as allowed
     minimize(
         cost,
         np.zeros(1),
         np.full(1, 100.0),
         PSOOptions(swarm_size=4, iterations=5, v_max=0.5),
         np.random.default_rng(0),
-        init=np.zeros((4, 1)),
+        init=np.array([[0.0], [10.0], [20.0], [30.0]]),  # the best pulls the others hard
     )
     steps = np.abs(np.diff(np.stack(seen), axis=0))
     assert steps.max() <= 0.5 + 1e-12
+    assert steps.max() == pytest.approx(0.5)  # and the clamp is actually reached
+
+
+# ----------------------------------------------------------------------------------------------
+# The update rule
+# ----------------------------------------------------------------------------------------------
+def test_one_iteration_is_eqs_4_and_5():
+    x0 = np.array([[0.0, 0.0], [2.0, 1.0], [-1.0, 3.0]])
+    v0 = np.array([[0.1, -0.2], [0.0, 0.3], [0.2, 0.2]])
+    opts = PSOOptions(swarm_size=3, iterations=1, w=0.6, c1=1.2, c2=1.8)
+    cost, seen = recording(sphere)
+    res = minimize(
+        cost, -10 * np.ones(2), 10 * np.ones(2), opts, ConstRNG(), init=x0, init_velocity=v0
+    )
+    pbest = x0  # after initialisation every particle's best is where it is
+    gbest = x0[0]  # cost 0: the best of the three
+    v1 = 0.6 * v0 + 1.2 * 0.5 * (pbest - x0) + 1.8 * 0.5 * (gbest - x0)  # eq. 4
+    assert len(seen) == 2
+    assert np.allclose(seen[1], x0 + v1, rtol=0, atol=1e-15)  # eq. 5
+    assert res.n_iterations == 1
+
+
+def test_uniform_initialisation_uses_the_rng():
+    cost, seen = recording(sphere)
+    lo, hi = np.array([-2.0, 4.0]), np.array([6.0, 8.0])
+    minimize(cost, lo, hi, PSOOptions(swarm_size=4, iterations=0), ConstRNG())
+    assert np.array_equal(seen[0], np.tile([2.0, 6.0], (4, 1)))
+
+
+def reference_pso(cost, lo, hi, opts: PSOOptions, x, v, r: float, iterations: int):
+    """Eqs. 4-5 with inertia damping, velocity clamp and walls, replayed by hand with constant
+    r1 = r2 = r. Returns the swarm at every evaluation."""
+    x, v = x.copy(), v.copy()
+    f = cost(x)
+    pbest_x, pbest_f = x.copy(), f.copy()
+    g = int(np.argmin(f))
+    gbest_x, gbest_f = x[g].copy(), f[g]
+    w = opts.w
+    swarms = [x.copy()]
+    for _ in range(iterations):
+        v = w * v + opts.c1 * r * (pbest_x - x) + opts.c2 * r * (gbest_x - x)
+        if opts.v_max is not None:
+            v = np.clip(v, -opts.v_max, opts.v_max)
+        x = x + v
+        for i in range(x.shape[0]):
+            for j in range(x.shape[1]):
+                if x[i, j] < lo[j] or x[i, j] > hi[j]:
+                    x[i, j] = min(max(x[i, j], lo[j]), hi[j])
+                    v[i, j] = 0.0
+        f = cost(x)
+        for i in range(len(f)):
+            if f[i] < pbest_f[i]:
+                pbest_x[i], pbest_f[i] = x[i].copy(), f[i]
+                if f[i] < gbest_f:
+                    gbest_x, gbest_f = x[i].copy(), f[i]
+        swarms.append(x.copy())
+        w *= opts.w_damping
+    return swarms
+
+
+def test_several_iterations_match_a_hand_written_reference():
+    """Damping, velocity clamp and the wall (position clipped, velocity zeroed) over 8 steps."""
+    rng = np.random.default_rng(4)
+    x0 = rng.uniform(-1, 1, (5, 2))
+    v0 = rng.uniform(-0.5, 0.5, (5, 2))
+    lo, hi = np.array([-1.0, -1.0]), np.array([1.0, 1.0])
+    opts = PSOOptions(swarm_size=5, iterations=8, w=0.9, c1=1.0, c2=2.5, w_damping=0.8, v_max=0.7)
+
+    def cost(x):
+        return np.sum((x - np.array([3.0, 0.2])) ** 2, axis=1)  # pulls everyone into the wall
+
+    wrapped, seen = recording(cost)
+    minimize(wrapped, lo, hi, opts, ConstRNG(0.37), init=x0, init_velocity=v0)
+    expected = reference_pso(cost, lo, hi, opts, x0, v0, 0.37, 8)
+    assert len(seen) == len(expected) == 9
+    for got, want in zip(seen, expected, strict=True):
+        assert np.allclose(got, want, rtol=0, atol=1e-12)
+    assert np.any(np.stack(seen)[:, :, 0] == 1.0)  # the wall was actually hit
+
+
+# ----------------------------------------------------------------------------------------------
+# Options
+# ----------------------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"swarm_size": 1},
+        {"swarm_size": 0},
+        {"iterations": -1},
+        {"w": -0.1},
+        {"w": 1.6},
+        {"c1": 2.0, "c2": 2.0},
+        {"c1": 3.0, "c2": 1.5},
+        {"c1": -0.1},
+        {"c2": -0.1},
+        {"w_damping": 0.0},
+        {"w_damping": 1.01},
+        {"v_max": 0.0},
+        {"v_max": -1.0},
+        {"tolerance": -1e-9},
+        {"patience": 0},
+    ],
+    ids=lambda k: ",".join(f"{key}={val}" for key, val in k.items()),
+)
+def test_invalid_options_are_rejected(kwargs):
+    with pytest.raises(ValueError):
+        PSOOptions(**kwargs)
 
 
 @pytest.mark.parametrize(
     "kwargs",
     [
-        {"swarm_size": 1},
-        {"iterations": -1},
-        {"w": 2.0},
-        {"c1": 2.0, "c2": 2.0},
-        {"c1": -0.1},
-        {"w_damping": 0.0},
-        {"v_max": 0.0},
-        {"patience": 0},
+        {"swarm_size": 2},
+        {"iterations": 0},
+        {"w": 0.0},
+        {"w": 1.5},
+        {"c1": 1.99, "c2": 2.0},
+        {"c1": 0.0, "c2": 0.0},
+        {"w_damping": 1.0},
+        {"w_damping": 1e-3},
+        {"v_max": 1e-6},
+        {"tolerance": 0.0, "patience": 1},
     ],
-    ids=lambda k: ",".join(k),
+    ids=lambda k: ",".join(f"{key}={val}" for key, val in k.items()),
 )
-def test_options_are_validated(kwargs):
-    with pytest.raises(ValueError):
-        PSOOptions(**kwargs)
+def test_valid_edge_options_are_accepted(kwargs):
+    opts = PSOOptions(**kwargs)
+    for key, val in kwargs.items():
+        assert getattr(opts, key) == val
+
+
+def test_options_are_keyword_only_and_frozen():
+    with pytest.raises(TypeError):
+        PSOOptions(30)  # type: ignore[misc]
+    opts = PSOOptions()
+    with pytest.raises(AttributeError):
+        opts.w = 0.5  # type: ignore[misc]

@@ -1,4 +1,5 @@
-"""Exact geometry: the closed forms against shapely, against dense sampling, and against each
+"""Exact geometry: the closed forms against independent references (shapely for polygons, an
+analytic point-segment distance written here for circles), against dense sampling, and against each
 other (the scalar checks OMPL calls and the vectorised checks the swarm calls)."""
 
 from __future__ import annotations
@@ -14,17 +15,65 @@ from hypothesis import strategies as st
 from rrtpso_ompl.world import World
 
 BOUNDS = ((0.0, 0.0), (100.0, 100.0))
+#: A fixed non-convex polygon (its re-entrant corner is at (50, 50)).
 L_SHAPE = np.array([[40, 40], [70, 40], [70, 50], [50, 50], [50, 75], [40, 75]], dtype=float)
+#: Comparisons of a distance with the free threshold skip this window around the threshold, where
+#: either answer is right (touching is allowed up to round-off).
+BOUNDARY_WINDOW = 5e-8
 
-coord = st.floats(-10, 110, allow_nan=False)
+coord = st.floats(-10, 110, allow_nan=False, allow_infinity=False)
 point = st.tuples(coord, coord)
 
 
+# ----------------------------------------------------------------------------------------------
+# Independent references
+# ----------------------------------------------------------------------------------------------
+def point_segment_distance(p, a, b) -> float:
+    """Distance from point p to the closed segment a-b (a == b allowed), written from scratch."""
+    px, py = p
+    ax, ay = a
+    bx, by = b
+    ux, uy = bx - ax, by - ay
+    den = ux * ux + uy * uy
+    if den == 0.0:
+        return math.hypot(px - ax, py - ay)
+    t = min(1.0, max(0.0, ((px - ax) * ux + (py - ay) * uy) / den))
+    return math.hypot(px - (ax + t * ux), py - (ay + t * uy))
+
+
+def reference_distance(world: World, a, b) -> float:
+    """Exact distance from segment a-b to the nearest obstacle: analytic for circles (clamped at
+    0 inside), shapely for polygons."""
+    d = math.inf
+    for cx, cy, r in world.circles:
+        d = min(d, max(0.0, point_segment_distance((cx, cy), a, b) - r))
+    geom = shapely.Point(a) if tuple(a) == tuple(b) else shapely.LineString([a, b])
+    for p in world.polygons:
+        d = min(d, geom.distance(shapely.Polygon(p)))
+    return d
+
+
+def reference_point_distances(world: World, pts: np.ndarray) -> np.ndarray:
+    """Exact distance from each point to the nearest obstacle (0 inside), vectorised."""
+    d = np.full(len(pts), np.inf)
+    for cx, cy, r in world.circles:
+        d = np.minimum(d, np.maximum(0.0, np.hypot(pts[:, 0] - cx, pts[:, 1] - cy) - r))
+    geoms = shapely.points(pts)
+    for p in world.polygons:
+        d = np.minimum(d, shapely.distance(geoms, shapely.Polygon(p)))
+    return d
+
+
+# ----------------------------------------------------------------------------------------------
+# Strategies
+# ----------------------------------------------------------------------------------------------
 @st.composite
-def convex_polygon(draw):
+def convex_polygons(draw):
+    """A random convex polygon: vertices on a circle at sorted random angles."""
     cx, cy = draw(st.floats(15, 85)), draw(st.floats(15, 85))
     n = draw(st.integers(3, 7))
     angles = sorted(draw(st.lists(st.floats(0, 2 * math.pi), min_size=n, max_size=n, unique=True)))
+    assume(min(np.diff([*angles, angles[0] + 2 * math.pi])) > 1e-2)
     r = draw(st.floats(2, 15))
     pts = np.array([[cx + r * math.cos(a), cy + r * math.sin(a)] for a in angles])
     poly = shapely.Polygon(pts)
@@ -33,124 +82,351 @@ def convex_polygon(draw):
 
 
 @st.composite
+def rectangles(draw):
+    x0, y0 = draw(st.floats(5, 80)), draw(st.floats(5, 80))
+    w, h = draw(st.floats(0.5, 20)), draw(st.floats(0.5, 20))
+    return np.array([[x0, y0], [x0 + w, y0], [x0 + w, y0 + h], [x0, y0 + h]])
+
+
+@st.composite
 def worlds(draw):
     circles = draw(
-        st.lists(st.tuples(st.floats(5, 95), st.floats(5, 95), st.floats(0.5, 15)), max_size=4)
+        st.lists(st.tuples(st.floats(5, 95), st.floats(5, 95), st.floats(0.5, 15)), max_size=3)
     )
-    polys = draw(st.lists(convex_polygon(), max_size=2))
+    polys = draw(st.lists(st.one_of(convex_polygons(), rectangles()), max_size=2))
     if draw(st.booleans()):
         polys.append(L_SHAPE)
-    radius = draw(st.floats(0, 8))
+    radius = draw(st.one_of(st.just(0.0), st.floats(0, 8)))
     return World(BOUNDS, circles, polys, radius)
 
 
-def reference_distance(world: World, a, b) -> float:
-    """Independent exact reference: shapely for polygons, analytic for circles."""
-    geom = shapely.LineString([a, b]) if a != b else shapely.Point(a)
-    d = math.inf
-    for cx, cy, r in world.circles:
-        d = min(d, max(0.0, geom.distance(shapely.Point(cx, cy)) - r))
-    for p in world.polygons:
-        d = min(d, geom.distance(shapely.Polygon(p)))
-    return d
+@st.composite
+def segments(draw, world: World):
+    """A segment of one of several kinds that stress the exact formulas."""
+    kinds = ["random", "degenerate"]
+    if world.polygons:
+        kinds += ["from_vertex", "through_vertex", "inside", "collinear", "vertex_to_vertex"]
+    if len(world.circles):
+        kinds += ["near_circle"]
+    kind = draw(st.sampled_from(kinds))
+    a = draw(point)
+    if kind == "random":
+        return a, draw(point)
+    if kind == "degenerate":
+        return a, a
+    if kind == "near_circle":
+        cx, cy, r = world.circles[draw(st.integers(0, len(world.circles) - 1))]
+        ang = draw(st.floats(0, 2 * math.pi))
+        off = draw(st.floats(-2, 2)) + r + world.robot_radius
+        m = (cx + off * math.cos(ang), cy + off * math.sin(ang))
+        t = (-math.sin(ang), math.cos(ang))
+        s0, s1 = draw(st.floats(-30, 30)), draw(st.floats(-30, 30))
+        return (m[0] + s0 * t[0], m[1] + s0 * t[1]), (m[0] + s1 * t[0], m[1] + s1 * t[1])
+    poly = world.polygons[draw(st.integers(0, len(world.polygons) - 1))]
+    n = len(poly)
+    i = draw(st.integers(0, n - 1))
+    v = tuple(float(c) for c in poly[i])
+    if kind == "from_vertex":
+        return v, a
+    if kind == "vertex_to_vertex":
+        return v, tuple(float(c) for c in poly[draw(st.integers(0, n - 1))])
+    if kind == "through_vertex":
+        # From a through the vertex and beyond it.
+        s = draw(st.floats(1.0, 3.0))
+        return a, (a[0] + s * (v[0] - a[0]), a[1] + s * (v[1] - a[1]))
+    if kind == "collinear":
+        q = poly[(i + 1) % n]
+        s, t = draw(st.floats(-1, 2)), draw(st.floats(-1, 2))
+        return (
+            (v[0] + s * (q[0] - v[0]), v[1] + s * (q[1] - v[1])),
+            (v[0] + t * (q[0] - v[0]), v[1] + t * (q[1] - v[1])),
+        )
+    # "inside": convex combinations of vertices of a convex piece of the polygon.
+    # The L's first four vertices are a convex quadrilateral inside it.
+    piece = poly[:4] if np.array_equal(poly, L_SHAPE) else poly
+    w1 = np.array(draw(st.lists(st.floats(0.05, 1), min_size=len(piece), max_size=len(piece))))
+    w2 = np.array(draw(st.lists(st.floats(0.05, 1), min_size=len(piece), max_size=len(piece))))
+    p1, p2 = (w1 / w1.sum()) @ piece, (w2 / w2.sum()) @ piece
+    return tuple(float(c) for c in p1), tuple(float(c) for c in p2)
 
 
-def sampled_distance(world: World, a, b, n: int = 2000) -> float:
-    t = np.linspace(0.0, 1.0, n)[:, None]
-    pts = (1 - t) * np.asarray(a) + t * np.asarray(b)
-    return float(world.point_clearance(pts).min())
+def far_from_threshold(world: World, d: float) -> bool:
+    return abs(d - world.threshold) > BOUNDARY_WINDOW
 
 
-@settings(max_examples=150, deadline=None)
-@given(world=worlds(), a=point, b=point)
-def test_segment_distance_is_exact(world, a, b):
+# ----------------------------------------------------------------------------------------------
+# Property tests
+# ----------------------------------------------------------------------------------------------
+@settings(max_examples=250, deadline=None)
+@given(data=st.data(), world=worlds())
+def test_segment_distance_equals_the_exact_reference(data, world):
+    a, b = data.draw(segments(world))
     d = float(world.segment_distance(np.array(a), np.array(b)))
     ref = reference_distance(world, a, b)
     if math.isinf(ref):
         assert math.isinf(d)
-        return
-    assert d == pytest.approx(ref, abs=1e-7)
-    # Dense sampling can only overestimate the minimum, by at most half a sample step.
-    sampled = sampled_distance(world, a, b)
-    step = math.dist(a, b) / 1999
-    assert d <= sampled + 1e-9
-    assert sampled <= d + step + 1e-9
+    else:
+        assert d == pytest.approx(ref, abs=1e-7)
+    # The same segment among others in a batch gives the same answer.
+    batch = world.segment_distance(np.array([a, b, a]), np.array([b, a, a]))
+    assert batch[0] == pytest.approx(d, abs=1e-12) and batch[1] == pytest.approx(d, abs=1e-7)
+    assert batch[2] == pytest.approx(reference_distance(world, a, a), abs=1e-7)
 
 
 @settings(max_examples=150, deadline=None)
-@given(world=worlds(), a=point, b=point)
-def test_scalar_and_vectorised_checks_agree(world, a, b):
+@given(data=st.data(), world=worlds())
+def test_segment_distance_against_dense_sampling(data, world):
+    a, b = data.draw(segments(world))
+    assume(world.n_obstacles > 0)
     d = float(world.segment_distance(np.array(a), np.array(b)))
-    assume(abs(d - world.robot_radius) > 1e-7)  # either answer is right on the boundary itself
-    expected = d >= world.robot_radius
+    n = 2000
+    t = np.linspace(0.0, 1.0, n)[:, None]
+    pts = (1 - t) * np.asarray(a) + t * np.asarray(b)
+    exact = reference_point_distances(world, pts)
+    sampled = float(exact.min())
+    length = math.dist(a, b)
+    # Sampling can only overestimate the minimum over the segment ...
+    assert sampled >= d - 1e-9
+    # ... and by at most the distance to the nearest sample (the distance is 1-Lipschitz).
+    assert sampled <= d + length / n + 1e-9
+    # point_clearance is the exact point distance too.
+    assert np.allclose(world.point_clearance(pts), exact, atol=1e-7, rtol=0)
+
+
+@settings(max_examples=250, deadline=None)
+@given(data=st.data(), world=worlds())
+def test_scalar_and_vectorised_motion_checks_agree(data, world):
+    a, b = data.draw(segments(world))
+    d = float(world.segment_distance(np.array(a), np.array(b)))
+    ref = reference_distance(world, a, b)
+    assume(far_from_threshold(world, d) and far_from_threshold(world, ref))
+    expected = d >= world.threshold
+    assert expected == (ref >= world.threshold)
     assert world.motion_free(*a, *b) == expected
+    assert world.motion_free(*b, *a) == expected  # direction does not matter
     assert bool(world.segments_free(np.array([a]), np.array([b]))[0]) == expected
-    assert (float(world.segment_violation(np.array(a), np.array(b))) == 0.0) == expected
-    dp = float(world.point_clearance(np.array([a]))[0])
-    assume(abs(dp - world.robot_radius) > 1e-7)
-    assert world.point_free(*a) == (dp >= world.robot_radius)
+    violation = float(world.segment_violation(np.array(a), np.array(b)))
+    assert violation >= 0.0
+    assert (violation == 0.0) == expected
 
 
-def test_tangent_segment_is_free_and_a_hair_closer_is_not():
+@settings(max_examples=250, deadline=None)
+@given(world=worlds(), p=point)
+def test_point_free_agrees_with_point_clearance(world, p):
+    dp = float(world.point_clearance(np.array([p]))[0])
+    ref = float(reference_point_distances(world, np.array([p]))[0])
+    if math.isinf(ref):
+        assert math.isinf(dp) and world.point_free(*p)
+        return
+    assert dp == pytest.approx(ref, abs=1e-7)
+    assume(far_from_threshold(world, dp))
+    expected = dp >= world.threshold
+    assert world.point_free(*p) == expected
+    assert world.motion_free(*p, *p) == expected  # a zero-length motion is its point
+    assert world.path_valid(np.array([p])) == (expected and world.in_bounds(*p))
+
+
+# ----------------------------------------------------------------------------------------------
+# Hand-made exact cases
+# ----------------------------------------------------------------------------------------------
+def test_tangent_to_a_circle_is_free_and_a_hair_closer_is_not():
     world = World(BOUNDS, [(50, 50, 10)], [], robot_radius=5)
-    assert world.motion_free(0, 65, 100, 65)  # distance exactly 15 = r + R: touching is allowed
-    assert not world.motion_free(0, 65 - 1e-6, 100, 65 - 1e-6)
+    # Distance exactly 15 = r + R: touching is allowed.
+    assert world.motion_free(0, 65, 100, 65)
     assert world.segments_free(np.array([[0, 65.0]]), np.array([[100, 65.0]]))[0]
+    assert float(world.segment_violation(np.array([0, 65.0]), np.array([100, 65.0]))) == 0.0
+    # 1e-6 closer (10x the round-off tolerance of this 100-wide world): a collision.
+    y = 65 - 1e-6
+    assert not world.motion_free(0, y, 100, y)
+    assert not world.segments_free(np.array([[0, y]]), np.array([[100, y]]))[0]
+    assert float(world.segment_violation(np.array([0, y]), np.array([100, y]))) > 0.0
+    # The same for a point, from every side.
+    for ang in np.linspace(0, 2 * np.pi, 8, endpoint=False):
+        on = 50 + 15 * np.array([math.cos(ang), math.sin(ang)])
+        inside = 50 + (15 - 1e-6) * np.array([math.cos(ang), math.sin(ang)])
+        assert world.point_free(*on) and not world.point_free(*inside)
 
 
-def test_circles_are_circles_not_polygons():
-    """Half-way between two vertices of a 32-gon the circle bulges 0.048 beyond the polygon
-    (radius 10): a segment cutting the circle there by 0.01 is missed by the polygon and caught
-    exactly, and one passing 1e-4 outside the circle is free."""
-    world = World(BOUNDS, [(50, 50, 10)], [], robot_radius=0)
-    angle = math.pi / 32  # half-way between vertices 0 and 1 of a 32-gon starting at angle 0
-    n = np.array([math.cos(angle), math.sin(angle)])
-    tangent = np.array([-n[1], n[0]])
-    polygon = shapely.Point(50, 50).buffer(10, quad_segs=8)  # 32 vertices on the circle
-
-    cut = np.array([50.0, 50.0]) + (10 - 0.01) * n
-    a, b = cut - 2 * tangent, cut + 2 * tangent
-    assert not polygon.intersects(shapely.LineString([a, b]))  # the approximation misses it
-    assert not world.motion_free(*a, *b)
-    assert not world.segments_free(a, b)
-
-    outside = np.array([50.0, 50.0]) + (10 + 1e-4) * n
-    assert world.motion_free(*(outside - 2 * tangent), *(outside + 2 * tangent))
+def test_touching_a_polygon_edge_at_the_radius_is_free():
+    square = np.array([[40, 40], [60, 40], [60, 60], [40, 60]], dtype=float)
+    world = World(BOUNDS, [], [square], robot_radius=4)
+    assert world.motion_free(0, 36, 100, 36)  # 4 below the bottom edge
+    assert world.segments_free(np.array([0, 36.0]), np.array([100, 36.0]))
+    assert not world.motion_free(0, 36 + 1e-6, 100, 36 + 1e-6)
+    assert not world.segments_free(np.array([0, 36 + 1e-6]), np.array([100, 36 + 1e-6]))
+    # Near a corner the safety zone is round: at 45 degrees it reaches 4 / sqrt(2) per axis.
+    c = 60 + 4 / math.sqrt(2)
+    assert world.point_free(c + 1e-6, c + 1e-6) and not world.point_free(c - 1e-6, c - 1e-6)
+    assert world.point_free(62.9, 62.9)  # inside the bounding box grown by R, but free
 
 
-def test_thin_corner_between_samples_is_caught():
+def test_point_robot_cannot_touch_or_enter():
+    """With radius 0 the threshold is +tol, so touching an obstacle counts as a collision."""
+    tri = np.array([[50, 50], [60, 40], [60, 60]], dtype=float)
+    world = World(BOUNDS, [(20, 20, 5)], [tri], robot_radius=0.0)
+    assert not world.motion_free(0, 50, 50, 50)  # ends on a vertex
+    assert not world.motion_free(50, 50, 70, 50)  # starts on a vertex and crosses
+    assert not world.motion_free(60, 0, 60, 100)  # runs along an edge
+    assert not world.motion_free(0, 20, 15, 20)  # ends on a circle
+    assert world.motion_free(0, 50 + 1e-3, 49.99, 50 + 1e-3)
+    assert float(world.segment_distance(np.array([0, 50.0]), np.array([50, 50.0]))) == 0.0
+
+
+def test_thin_spike_between_samples_is_caught():
+    """A needle 0.002 wide at its base, half-way between two sample columns, crossed near its
+    tip: every sample of a discretised check at resolution 1 is free (the whole robot disc of
+    radius 0.4 around it), the exact check is not."""
+    spike = np.array([[50.499, 10.0], [50.5, 80.0], [50.501, 10.0]])
+    world = World(BOUNDS, [], [spike], robot_radius=0.4)
+    a, b = (0.0, 79.0), (100.0, 79.0)
+    samples = np.stack([np.arange(0.0, 101.0), np.full(101, 79.0)], axis=1)
+    assert all(world.point_free(*s) for s in samples)  # every sample is free ...
+    assert world.segments_free(samples, samples).all()
+    assert not world.motion_free(*a, *b)  # ... the segment is not
+    assert not world.segments_free(np.array(a), np.array(b))
+    assert float(world.segment_distance(np.array(a), np.array(b))) == 0.0
+
+
+def test_clipping_a_corner_by_a_hair_is_caught():
     """A segment that clips a polygon corner by 1e-6: a discretised check at resolution 1 misses
     it, the exact check does not."""
     tri = np.array([[50, 50], [60, 40], [60, 60]], dtype=float)
     world = World(BOUNDS, [], [tri], robot_radius=0)
     a, b = (50 + 1e-6, 0.0), (50 + 1e-6, 100.0)
     samples = np.stack([np.full(100, a[0]), np.linspace(0.5, 99.5, 100)], axis=1)
-    assert all(world.point_free(*s) for s in samples)  # every sample is free...
-    assert not world.motion_free(*a, *b)  # ...the segment is not
+    assert all(world.point_free(*s) for s in samples)
+    assert not world.motion_free(*a, *b)
     assert not world.segments_free(np.array(a), np.array(b))
+    # With a radius the same holds for a segment clipping the grown corner by 1e-6.
+    world = World(BOUNDS, [], [tri], robot_radius=3.0)
+    x = 50 - 3 + 1e-6
+    assert not world.motion_free(x, 0, x, 100)
+    assert world.motion_free(x - 2e-6, 0, x - 2e-6, 100)
 
 
-def test_segment_inside_polygon_collides():
+def test_circles_are_circles_not_polygons():
+    """A 32-gon is no substitute for a circle of radius 10 (robot radius 2, grown radius 12).
+
+    * Inscribed 32-gon (vertices on the grown circle): half-way between two vertices the circle
+      bulges 0.058 beyond it; a segment cutting the circle there by 0.01 is missed by the polygon
+      and caught exactly.
+    * Circumscribed 32-gon (edges tangent to the grown circle): at a vertex it sticks out 0.058
+      beyond the circle; a segment 1e-4 outside the circle there collides with the polygon and
+      is free exactly.
+    """
+    r, big_r = 10.0, 2.0
+    grown = r + big_r
+    world = World(BOUNDS, [(50, 50, r)], [], robot_radius=big_r)
+    c = np.array([50.0, 50.0])
+    ang = np.arange(32) * 2 * math.pi / 32
+    inscribed = shapely.Polygon(c + grown * np.column_stack([np.cos(ang), np.sin(ang)]))
+    circumscribed = shapely.Polygon(
+        c + grown / math.cos(math.pi / 32) * np.column_stack([np.cos(ang), np.sin(ang)])
+    )
+
+    def chord(direction: float, dist: float):
+        n = np.array([math.cos(direction), math.sin(direction)])
+        t = np.array([-n[1], n[0]])
+        m = c + dist * n
+        return m - 2 * t, m + 2 * t
+
+    a, b = chord(math.pi / 32, grown - 0.01)  # between vertices 0 and 1
+    assert not inscribed.intersects(shapely.LineString([a, b]))
+    assert not world.motion_free(*a, *b)
+    assert not world.segments_free(a, b)
+
+    a, b = chord(2 * math.pi / 32, grown + 1e-4)  # at vertex 1
+    assert circumscribed.intersects(shapely.LineString([a, b]))
+    assert world.motion_free(*a, *b)
+    assert world.segments_free(a, b)
+    assert float(world.segment_distance(a, b)) == pytest.approx(big_r + 1e-4, abs=1e-9)
+
+
+def test_segment_inside_a_polygon_collides():
     world = World(BOUNDS, [], [np.array([[10, 10], [90, 10], [90, 90], [10, 90]], float)], 0.0)
     assert not world.motion_free(20, 20, 30, 30)
+    assert not world.point_free(50, 50)
     assert float(world.segment_distance(np.array([20, 20]), np.array([30, 30]))) == 0.0
+    assert float(world.point_clearance(np.array([[50, 50]]))[0]) == 0.0
 
 
+def test_inside_the_notch_of_the_l_shape_is_outside():
+    """The re-entrant corner of a non-convex polygon: the notch is free space."""
+    world = World(BOUNDS, [], [L_SHAPE], robot_radius=2.0)
+    assert world.point_free(60, 60)  # in the notch, 10 from both inner edges
+    assert world.motion_free(55, 70, 68, 55)
+    assert float(world.point_clearance(np.array([[52.0, 52.0]]))[0]) == pytest.approx(2.0)
+    assert world.point_free(52, 52)  # touches both inner edges at exactly the radius
+    assert not world.point_free(52 - 1e-6, 52)
+    # Beyond the convex vertex (70, 50) the nearest point is the vertex itself.
+    assert float(world.point_clearance(np.array([[72.0, 52.0]]))[0]) == pytest.approx(
+        2 * math.sqrt(2)
+    )
+    assert not world.motion_free(45, 60, 60, 45)  # starts inside the L's upright arm
+
+
+def test_segment_distance_broadcasts():
+    world = World(BOUNDS, [(50, 50, 10)], [L_SHAPE], robot_radius=1.0)
+    rng = np.random.default_rng(0)
+    a = rng.uniform(0, 100, (3, 4, 2))
+    b = rng.uniform(0, 100, 2)
+    d = world.segment_distance(a, b)
+    assert d.shape == (3, 4)
+    for idx in np.ndindex(3, 4):
+        assert d[idx] == pytest.approx(reference_distance(world, tuple(a[idx]), tuple(b)), abs=1e-9)
+    assert world.segment_violation(a, b).shape == (3, 4)
+    assert world.segments_free(a, b).shape == (3, 4)
+
+
+def test_no_obstacles():
+    world = World(BOUNDS, [], [], robot_radius=3.0)
+    assert np.isinf(world.segment_distance(np.array([0, 0.0]), np.array([100, 100.0])))
+    assert world.motion_free(0, 0, 100, 100) and world.point_free(50, 50)
+    assert float(world.segment_violation(np.array([0, 0.0]), np.array([1, 1.0]))) == 0.0
+    assert world.path_valid(np.array([[0, 0], [100, 100]]))
+
+
+# ----------------------------------------------------------------------------------------------
+# Paths and violation
+# ----------------------------------------------------------------------------------------------
 def test_path_valid():
     world = World(BOUNDS, [(50, 50, 10)], [], robot_radius=2)
     assert world.path_valid(np.array([[5, 5], [5, 95], [95, 95]]))
     assert not world.path_valid(np.array([[5, 5], [95, 95]]))  # through the circle
-    assert not world.path_valid(np.array([[5, 5], [5, 101]]))  # leaves the bounds
+    assert not world.path_valid(np.array([[5, 5], [5, 101]]))  # a waypoint leaves the bounds
+    assert not world.path_valid(np.array([[-0.5, 5], [5, 5]]))
+    assert world.path_valid(np.array([[0, 0], [0, 100 + 1e-8]]))  # on the bounds (with tol)
     assert not world.path_valid(np.array([[5, 5], [np.nan, 5]]))
-    assert world.path_valid(np.array([[5, 5]]))
+    assert not world.path_valid(np.array([[5, 5], [np.inf, 5]]))
+    assert world.path_valid(np.array([[5, 5]]))  # a single valid point
+    assert not world.path_valid(np.array([[50, 45]]))  # a single point in collision
+    assert not world.path_valid(np.array([[150, 5]]))  # a single point out of bounds
     assert not world.path_valid(np.empty((0, 2)))
+
+
+def test_violation_is_zero_exactly_when_free():
+    world = World(BOUNDS, [(30, 30, 8), (70, 70, 5)], [L_SHAPE], robot_radius=3.0)
+    rng = np.random.default_rng(11)
+    a = rng.uniform(0, 100, (4000, 2))
+    b = a + rng.normal(0, 15, (4000, 2))
+    v = world.segment_violation(a, b)
+    free = world.segments_free(a, b)
+    assert free.any() and (~free).any()  # both kinds occur
+    assert np.all(v[free] == 0.0) and np.all(v[~free] > 0.0)
 
 
 def test_violation_sums_over_circles():
     one = World(BOUNDS, [(50, 50, 10)], [], 1.0)
     two = World(BOUNDS, [(50, 50, 10), (50, 52, 10)], [], 1.0)
     a, b = np.array([0.0, 50.0]), np.array([100.0, 50.0])
-    assert float(two.segment_violation(a, b)) > float(one.segment_violation(a, b)) > 0
+    v1, v2 = float(one.segment_violation(a, b)), float(two.segment_violation(a, b))
+    assert v2 > v1 > 0
+    # Through both centres the distance to each is 0, so each contributes the full threshold.
+    assert v1 == pytest.approx(one.threshold)
+    assert v2 == pytest.approx(2 * two.threshold)
+    # Partial intrusion: the segment at y = 60.5 is 0.5 into the grown circle (radius 11).
+    a, b = np.array([0.0, 60.5]), np.array([100.0, 60.5])
+    assert float(one.segment_violation(a, b)) == pytest.approx(0.5 - one.tol)
 
 
 def test_local_model_matches_full_check():
@@ -163,3 +439,14 @@ def test_local_model_matches_full_check():
     a = rng.uniform(lo, hi, (200, 5, 2))
     b = rng.uniform(lo, hi, (200, 5, 2))
     assert np.allclose(model.violation(a, b), world.segment_violation(a, b))
+
+
+def test_local_model_box_wholly_inside_a_polygon():
+    big = np.array([[0, 0], [100, 0], [100, 100], [0, 100]], dtype=float)
+    world = World(((0, 0), (200, 200)), [], [big], robot_radius=1.0)
+    model = world.local_model(np.array([[40.0, 40.0]]), np.array([[60.0, 60.0]]))
+    a, b = np.array([[[45.0, 45.0]]]), np.array([[[55.0, 55.0]]])
+    assert float(world.segment_violation(a, b)[0, 0]) > 0
+    assert float(model.violation(a, b)[0, 0]) == pytest.approx(
+        float(world.segment_violation(a, b)[0, 0])
+    )
