@@ -94,6 +94,60 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=_cmd_solve)
 
+    m = sub.add_parser(
+        "simulate",
+        help="drive among moving obstacles with collision prediction and replanning",
+        description="Drive the robot from start to goal among the problem's moving obstacles: it "
+        "senses them within robot.sensor_range, predicts collisions and replans contour detours "
+        "(docs/dynamic.md). Exit status 0 when the goal is reached without a collision, else 1.",
+    )
+    m.add_argument("problem", help="problem file with moving_obstacles")
+    m.add_argument("--json", metavar="OUT", help="write the simulation as JSON")
+    m.add_argument("--gif", metavar="OUT.gif", help="write an animation")
+    m.add_argument("--plot", metavar="OUT.png", help="draw the driven path (paper Fig. 24)")
+    m.add_argument("--seed", type=int, help="random seed (default: the file's planner.seed)")
+    m.add_argument(
+        "--planner",
+        help="planner of the static path and the detours (default: the file's planner.type, "
+        "else RRTstarPSO)",
+    )
+    m.add_argument(
+        "--time",
+        type=float,
+        metavar="SECONDS",
+        help="budget of the initial static path (default: the file's planner.time_limit, else 1.0)",
+    )
+    m.add_argument(
+        "--replan-time",
+        type=float,
+        default=0.5,
+        metavar="SECONDS",
+        help="simulated time one replan takes, split between the two detours (default 0.5)",
+    )
+    m.add_argument(
+        "--strategy",
+        choices=("contour", "global", "none"),
+        default="contour",
+        help="contour: detours up and down around the collision zone (the paper); global: replan "
+        "the whole remaining path; none: never replan (default: contour)",
+    )
+    m.add_argument(
+        "--heading-changes",
+        type=float,
+        default=0.0,
+        metavar="RATE",
+        help="random heading changes per obstacle per second (default 0: constant velocity)",
+    )
+    m.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="planner parameter, repeatable",
+    )
+    m.add_argument("-v", "--verbose", action="count", default=0, help="show OMPL's messages")
+    m.set_defaults(func=_cmd_simulate)
+
     q = sub.add_parser(
         "planners",
         help="list the planners and their parameters",
@@ -202,6 +256,95 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         file=sys.stderr,
     )
     return EXIT_SOLVED if result.solved else EXIT_UNSOLVED
+
+
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    from .ompl_setup import set_ompl_log_level
+    from .problem import ProblemError, load_problem
+    from .registry import UnknownPlannerError, default_registry
+    from .solve import DEFAULT_PLANNER
+
+    set_ompl_log_level(args.verbose)
+    try:
+        problem = load_problem(args.problem)
+    except ProblemError as exc:
+        raise InputError(str(exc)) from None
+    src = args.problem
+    for key in ("speed", "sample_time", "sensor_range"):
+        if getattr(problem.robot, key) is None:
+            raise InputError(f"{src}: robot.{key}: required for simulate")
+    name = args.planner or problem.planner.type or DEFAULT_PLANNER
+    try:
+        entry = default_registry().get(name)
+    except UnknownPlannerError as exc:
+        origin = "--planner" if args.planner else "planner.type"
+        raise InputError(f"{src}: {origin}: {exc}") from None
+    for flag, value in (("--time", args.time), ("--replan-time", args.replan_time)):
+        if value is not None and not (value > 0 and math.isfinite(value)):
+            raise InputError(f"{src}: {flag}: must be a positive number of seconds, got {value}")
+    if not (args.heading_changes >= 0 and math.isfinite(args.heading_changes)):
+        raise InputError(f"{src}: --heading-changes: must be >= 0, got {args.heading_changes}")
+    cli_params = _parse_params(args.param, src)
+    for key, value in problem.planner.params.items():
+        _check_param(entry, key, value, f"{src}: planner.params.{key}")
+    for key, value in cli_params.items():
+        _check_param(entry, key, value, f"{src}: --param {key}")
+    params = {**problem.planner.params, **cli_params}
+    try:
+        entry.validate(params)
+    except ValueError as exc:
+        raise InputError(f"{src}: planner parameters: {exc}") from None
+    _check_output(args.json, "--json")
+    _check_output(args.plot, "--plot", image=True)
+    _check_output(args.gif, "--gif")
+    if args.gif and Path(args.gif).suffix.lower() != ".gif":
+        raise InputError(f"--gif: '{args.gif}' must end in .gif")
+
+    from .dynamic import DynamicOptions, simulate
+
+    options = DynamicOptions(
+        planner=entry.name,
+        strategy=args.strategy,
+        replan_time=args.replan_time,
+        initial_time=args.time,
+        heading_changes=args.heading_changes,
+        params=params,
+    )
+    seed = args.seed if args.seed is not None else problem.planner.seed
+    with _progress_bar("simulating", unit="s") as bar:
+
+        def progress(t: float, t_end: float) -> None:
+            bar.total = round(t_end, 1)
+            bar.n = round(t, 1)
+            bar.refresh()
+
+        sim = simulate(problem, options, seed=seed, progress=progress)
+    if args.plot:
+        from .plotting import plot_simulation, save_figure
+
+        save_figure(plot_simulation(problem, sim), args.plot)
+    if args.gif and sim.motion is not None:
+        from .plotting import animate_simulation
+
+        animate_simulation(problem, sim, args.gif)
+    if args.json:
+        from .results import write_json_atomic
+
+        write_json_atomic(sim.to_dict(), args.json)
+    verdict = "reached the goal" if sim.reached_goal else f"did not reach the goal ({sim.status})"
+    print(
+        f"{problem.name}: {verdict}, {sim.collisions} collisions, {len(sim.replans)} replans, "
+        f"time {sim.total_time:.1f}s, length {sim.path_length:.1f}",
+        file=sys.stderr,
+    )
+    return EXIT_SOLVED if sim.success else EXIT_UNSOLVED
+
+
+def _progress_bar(desc: str, **kwargs: Any) -> Any:
+    """A tqdm bar on stderr, silent when stderr is not a terminal (logs, CI, pipes)."""
+    from tqdm import tqdm
+
+    return tqdm(desc=desc, file=sys.stderr, disable=not sys.stderr.isatty(), leave=False, **kwargs)
 
 
 def _check_output(path: str | None, flag: str, image: bool = False) -> None:

@@ -26,12 +26,21 @@ from matplotlib.patches import Polygon as PolygonPatch
 from .problem import Circle, Polygon, Problem
 from .results import SolveResult, publish_atomic
 
-__all__ = ["draw_world", "plot_solution", "plot_velocities", "save_figure"]
+__all__ = [
+    "animate_simulation",
+    "draw_world",
+    "plot_simulation",
+    "plot_solution",
+    "plot_velocities",
+    "save_figure",
+]
 
 OBSTACLE = "#5b6770"
 SAFETY = "#e0a030"
 RRT_COLOUR = "#8c8c8c"
 PATH_COLOUR = "#d62728"
+MOVING = "#7b3294"
+DETOUR = "#1a9641"
 
 
 def draw_world(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> None:
@@ -179,6 +188,130 @@ def save_figure(fig: Figure, path: str | Path, dpi: int = 120) -> None:
     os.close(fd)
     try:
         fig.savefig(tmp, dpi=dpi)
+        publish_atomic(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    finally:
+        plt.close(fig)
+
+
+# ----------------------------------------------------------------------------------------------
+# Simulations with moving obstacles (paper Figs. 23-24)
+# ----------------------------------------------------------------------------------------------
+def plot_simulation(problem: Problem, sim: Any) -> Figure:
+    """The paper's Fig. 24 for a :class:`~rrtpso_ompl.dynamic.SimulationResult`: (a) the world,
+    the static path, the driven path with its detours and each moving obstacle's track from its
+    first position (grey) to its position at the end (black); (b) the centre distance to each
+    moving obstacle over time against the contact distance ``SR + SO``."""
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(13, 6), gridspec_kw={"width_ratios": [1.1, 1]})
+    draw_world(ax, problem)
+    static = np.asarray(sim.static_path, dtype=float).reshape(-1, 2)
+    if len(static):
+        ax.plot(*static.T, "--", color=RRT_COLOUR, lw=1.2, zorder=3, label="static path")
+    traj = sim.trajectory
+    t_end = float(traj[-1, 0]) if len(traj) else 0.0
+    if len(traj):
+        ax.plot(traj[:, 1], traj[:, 2], "-", color=PATH_COLOUR, lw=1.8, zorder=4,
+                label=f"driven path ({sim.path_length:.1f})")  # fmt: skip
+    for i, rep in enumerate(sim.replans):
+        label = "detours" if i == 0 else None
+        if rep.detour is not None:
+            ax.plot(*np.asarray(rep.detour).T, "-", color=DETOUR, lw=1.2, zorder=5, label=label)
+        ax.plot(*rep.cross_point, "x", color="k", ms=8, zorder=6,
+                label="predicted cross point" if i == 0 else None)  # fmt: skip
+        side = f" {rep.side}" if rep.side else ""
+        ax.annotate(f"{rep.kind}{side} @ {rep.t:.1f}s", rep.start, fontsize=7, zorder=6)
+    for k, tr in enumerate(sim.tracks):
+        ts = np.linspace(0.0, t_end, 200)
+        q = tr.position(ts)
+        ax.plot(q[:, 0], q[:, 1], ":", color=MOVING, lw=1.0, zorder=3)
+        ax.add_patch(CirclePatch(q[0], tr.radius, color="0.7", alpha=0.8, zorder=3))
+        ax.add_patch(CirclePatch(q[-1], tr.radius, color="k", alpha=0.8, zorder=3))
+        ax.annotate(f"M{k}", q[0], ha="center", va="center", fontsize=7, color="k", zorder=4)
+    verdict = "goal reached" if sim.reached_goal else "goal NOT reached"
+    ax.set_title(f"{problem.name}: {sim.strategy}, {verdict}, {sim.collisions} collisions")
+    ax.legend(loc="best", fontsize=7)
+    for k, tr in enumerate(sim.tracks):
+        if not len(traj):
+            break
+        d = np.hypot(*(traj[:, 1:3] - tr.position(traj[:, 0])).T)
+        line = bx.plot(traj[:, 0], d, lw=1.3, label=f"M{k}")[0]
+        bx.axhline(sim.contact_distance[k], color=line.get_color(), ls="--", lw=0.9)
+    for rep in sim.replans:
+        bx.axvline(rep.t, color="0.6", lw=0.8)
+    bx.set_xlabel("t [s]")
+    unit = f" [{problem.units}]" if problem.units else ""
+    bx.set_ylabel(f"centre distance{unit}")
+    bx.set_title("separation (dashed: contact SR + SO; grey: replans)")
+    bx.grid(alpha=0.3)
+    if sim.tracks:
+        bx.legend(loc="best", fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def animate_simulation(
+    problem: Problem, sim: Any, path: str | Path, *, max_frames: int = 150, fps: int = 10
+) -> None:
+    """Write a GIF of the simulation: static and moving obstacles, the robot and its sensor range,
+    the plan it is driving, the predicted cross points and the detours (atomically)."""
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    traj = sim.trajectory
+    if not len(traj):
+        raise ValueError("nothing to animate: the simulation has no trajectory")
+    frames = np.unique(np.linspace(0, len(traj) - 1, min(max_frames, len(traj))).astype(int))
+    fig, ax = plt.subplots(figsize=(6.5, 6.5))
+    draw_world(ax, problem, safety_zones=False)
+    r = problem.robot.radius
+    sensor = CirclePatch((0, 0), problem.robot.sensor_range or 0.0, fill=False, ls=":",
+                         ec="tab:blue", lw=0.8, zorder=3)  # fmt: skip
+    body = CirclePatch((0, 0), r, color=PATH_COLOUR, alpha=0.6, zorder=6)
+    ax.add_patch(sensor)
+    ax.add_patch(body)
+    (heading,) = ax.plot([], [], "-", color="k", lw=1.2, zorder=7)
+    (trace,) = ax.plot([], [], "-", color=PATH_COLOUR, lw=1.5, zorder=4)
+    (plan_line,) = ax.plot([], [], "--", color=RRT_COLOUR, lw=1.0, zorder=3)
+    (cross,) = ax.plot([], [], "x", color="k", ms=9, zorder=7)
+    obstacles = [CirclePatch((0, 0), tr.radius, color=MOVING, alpha=0.7, zorder=5)
+                 for tr in sim.tracks]  # fmt: skip
+    for patch in obstacles:
+        ax.add_patch(patch)
+    detour_lines = [ax.plot([], [], "-", color=DETOUR, lw=1.3, zorder=5)[0] for _ in sim.replans]
+    title = ax.set_title("")
+    switch_times = np.array([t for t, _ in sim.plans])
+
+    def update(i: int) -> list[Any]:
+        t, x, y, th = traj[i]
+        body.center = sensor.center = (x, y)
+        heading.set_data([x, x + r * np.cos(th)], [y, y + r * np.sin(th)])
+        trace.set_data(traj[: i + 1, 1], traj[: i + 1, 2])
+        plan = sim.plans[int(np.searchsorted(switch_times, t, side="right")) - 1][1]
+        ahead = plan.waypoints_after(t)
+        plan_line.set_data(ahead[:, 0], ahead[:, 1])
+        live = [rep for rep in sim.replans if rep.t <= t <= rep.t_cross]
+        if live:
+            cross.set_data([live[-1].cross_point[0]], [live[-1].cross_point[1]])
+        else:
+            cross.set_data([], [])
+        for line, rep in zip(detour_lines, sim.replans, strict=True):
+            if rep.detour is not None and rep.t <= t:
+                line.set_data(*np.asarray(rep.detour).T)
+        for patch, tr in zip(obstacles, sim.tracks, strict=True):
+            patch.center = tuple(tr.position(t))
+        title.set_text(
+            f"{problem.name}: t = {t:5.1f} s, replans {sum(rep.t <= t for rep in sim.replans)}"
+        )
+        return [body, sensor, heading, trace, plan_line, cross, title, *obstacles, *detour_lines]
+
+    anim = FuncAnimation(fig, update, frames=frames, blit=False)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".gif", dir=path.parent)
+    os.close(fd)
+    try:
+        anim.save(tmp, writer=PillowWriter(fps=fps), dpi=80)
         publish_atomic(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
