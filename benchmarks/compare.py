@@ -79,7 +79,9 @@ def run_one(
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("problems", nargs="*", help="problem files (default: problems/*.yaml)")
+    parser.add_argument(
+        "problems", nargs="*", help="problem files (default: problems/static/*.yaml)"
+    )
     parser.add_argument("--planners", default=DEFAULT_PLANNERS)
     parser.add_argument("--budgets", default="0.25,1,4", help="seconds, comma-separated")
     parser.add_argument("--seeds", type=int, default=5, help="runs per cell (seeds 1..N)")
@@ -92,7 +94,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", default=str(REPO / "docs" / "benchmark.md"))
     args = parser.parse_args(argv)
 
-    problems = [Path(p) for p in args.problems] or sorted((REPO / "problems").glob("*.yaml"))
+    problems = [Path(p) for p in args.problems] or sorted(
+        (REPO / "problems" / "static").glob("*.yaml")
+    )
     planners = [p.strip() for p in args.planners.split(",")]
     budgets = [float(b) for b in args.budgets.split(",")]
     simplify = not args.no_simplify

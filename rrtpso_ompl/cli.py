@@ -148,6 +148,9 @@ def _build_parser() -> argparse.ArgumentParser:
     m.add_argument("-v", "--verbose", action="count", default=0, help="show OMPL's messages")
     m.set_defaults(func=_cmd_simulate)
 
+    _add_batch_parser(sub)
+    _add_generate_parser(sub)
+
     q = sub.add_parser(
         "planners",
         help="list the planners and their parameters",
@@ -345,6 +348,179 @@ def _progress_bar(desc: str, **kwargs: Any) -> Any:
     from tqdm import tqdm
 
     return tqdm(desc=desc, file=sys.stderr, disable=not sys.stderr.isatty(), leave=False, **kwargs)
+
+
+def _add_batch_parser(sub: Any) -> None:
+    b = sub.add_parser(
+        "batch",
+        help="solve many problem files in parallel, streaming JSON lines",
+        description="Solve every problem file x planner x run in its own process and stream one "
+        "JSON row per run to --out as it finishes. A bad file becomes an error row and the batch "
+        "goes on; exit status 1 when any row failed, 130 when interrupted (the file stays valid: "
+        "continue it with --resume).",
+    )
+    b.add_argument("inputs", nargs="+", metavar="FILE|DIR|GLOB", help="problem files")
+    b.add_argument(
+        "--planner",
+        action="append",
+        metavar="NAME[,NAME...]",
+        help="planner(s), repeatable or comma-separated (default: RRTstarPSO)",
+    )
+    b.add_argument("--time", type=float, metavar="SECONDS", help="time limit per run (default: "
+                   "each file's planner.time_limit, else 1.0)")  # fmt: skip
+    b.add_argument("--runs", type=int, default=1, help="runs per problem and planner (default 1)")
+    b.add_argument("--seed", type=int, default=1, help="seed of run 0; run r uses seed + r")
+    b.add_argument("--jobs", type=int, default=1, help="parallel worker processes (default 1)")
+    b.add_argument("--out", required=True, metavar="OUT.jsonl", help="results, one JSON per line")
+    b.add_argument("--resume", action="store_true", help="keep the rows already in --out")
+    b.add_argument(
+        "--param", action="append", default=[], metavar="NAME=VALUE", help="planner parameter"
+    )
+    b.add_argument("--simplify", action="store_true", help="run OMPL's simplifier after each run")
+    b.add_argument("--no-path", action="store_true", help="leave the paths out of the rows")
+    _add_executor_options(b)
+    b.set_defaults(func=_cmd_batch)
+
+
+def _add_executor_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--executor",
+        choices=("local", "dask"),
+        default="local",
+        help="local process pool (default) or a Dask cluster (pip install 'rrtpso-ompl[dask]')",
+    )
+    p.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler, e.g. tcp://host:8786")
+
+
+def _planner_list(values: list[str] | None, default: str) -> list[str]:
+    names = [n.strip() for v in (values or [default]) for n in v.split(",") if n.strip()]
+    return list(dict.fromkeys(names))
+
+
+def _check_run_options(args: argparse.Namespace) -> None:
+    if args.time is not None and not (args.time > 0 and math.isfinite(args.time)):
+        raise InputError(f"--time: must be a positive number of seconds, got {args.time}")
+    for flag in ("runs", "jobs"):
+        if getattr(args, flag) < 1:
+            raise InputError(f"--{flag}: must be at least 1, got {getattr(args, flag)}")
+    if args.seed is not None and args.seed < 0:
+        raise InputError(f"--seed: must be >= 0, got {args.seed}")
+    if args.executor == "dask":
+        if not args.scheduler:
+            raise InputError("--executor dask: needs --scheduler ADDRESS")
+        try:
+            import distributed  # noqa: F401
+        except ImportError:
+            raise InputError(
+                "--executor dask: Dask is not installed: pip install 'rrtpso-ompl[dask]'"
+            ) from None
+
+
+def _check_planners(names: list[str], items: list[str], flag: str) -> dict[str, dict[str, str]]:
+    """Resolve planner names and check --param against each; returns params per planner."""
+    from .registry import UnknownPlannerError, default_registry
+
+    registry = default_registry()
+    params = _parse_params(items, flag)
+    out = {}
+    for name in names:
+        try:
+            entry = registry.get(name)
+        except UnknownPlannerError as exc:
+            raise InputError(f"{flag}: {exc}") from None
+        # A --param applies to the planners that have it.
+        mine = {k: v for k, v in params.items() if any(p.name == k for p in entry.params)}
+        for key, value in mine.items():
+            _check_param(entry, key, value, f"--param {key}")
+        out[name] = mine
+    for key in params:
+        if not any(key in p for p in out.values()):
+            raise InputError(f"--param {key}: none of the planners {', '.join(names)} has it")
+    return out
+
+
+def _cmd_batch(args: argparse.Namespace) -> int:
+    from .batch import make_tasks, run_batch
+
+    _check_run_options(args)
+    planners = _planner_list(args.planner, "RRTstarPSO")
+    params = _check_planners(planners, args.param, "--planner")
+    _check_output(args.out, "--out")
+    tasks = make_tasks(
+        args.inputs, planners, runs=args.runs, seed=args.seed, time_limit=args.time,
+        params=params, simplify=args.simplify,
+        keep_path=not args.no_path,
+    )  # fmt: skip
+    counts = {"solved": 0, "unsolved": 0, "error": 0}
+    with _progress_bar("batch", unit="run") as bar:
+
+        def started(n: int, skipped: int) -> None:
+            bar.total = n
+            bar.refresh()
+            if skipped:
+                print(f"rrtpso: resuming: {skipped} rows already done", file=sys.stderr)
+
+        def progress(row: dict[str, Any]) -> None:
+            kind = "error" if row.get("error") else ("solved" if row["solved"] else "unsolved")
+            counts[kind] += 1
+            bar.set_postfix(counts, refresh=False)
+            bar.update(1)
+
+        rows = run_batch(
+            tasks, args.out, jobs=args.jobs, resume=args.resume, executor=args.executor,
+            scheduler=args.scheduler, progress=progress, on_start=started,
+        )  # fmt: skip
+    failed = [r for r in rows if not r.get("solved")]
+    for r in rows:
+        if r.get("error"):
+            print(f"rrtpso: {r['error']}", file=sys.stderr)
+    print(
+        f"batch: {len(rows)} rows, {len(rows) - len(failed)} solved, "
+        f"{sum(bool(r.get('error')) for r in rows)} errors -> {args.out}",
+        file=sys.stderr,
+    )
+    return EXIT_UNSOLVED if failed else EXIT_SOLVED
+
+
+def _add_generate_parser(sub: Any) -> None:
+    g = sub.add_parser(
+        "generate",
+        help="write a seeded random problem (circles, polygons or a maze)",
+        description="Write a seeded random problem file whose start and goal are free and "
+        "connected (certified by a collision-checked grid path). The same seed and options give "
+        "the same file, byte for byte.",
+    )
+    g.add_argument("kind", choices=("circles", "polygons", "maze"))
+    g.add_argument("--seed", type=int, required=True, help="seed (>= 0)")
+    g.add_argument("--out", required=True, metavar="FILE.yaml", help="where to write the problem")
+    g.add_argument("--size", type=float, help="side of the square workspace (default 100)")
+    g.add_argument("--n", type=int, help="number of obstacles (circles 30, polygons 20)")
+    g.add_argument("--cells", type=int, help="maze cells per side (default 8)")
+    g.add_argument("--robot-radius", type=float, help="robot radius (0: a point robot)")
+    g.add_argument("--radius-range", type=float, nargs=2, metavar=("LO", "HI"),
+                   help="obstacle radii (circles) or circumradii (polygons)")  # fmt: skip
+    g.add_argument("--vertices", type=int, nargs=2, metavar=("LO", "HI"),
+                   help="polygon vertex counts (default 3 8)")  # fmt: skip
+    g.add_argument("--gap", type=float, help="least free distance between obstacles")
+    g.add_argument("--wall", type=float, help="maze wall thickness")
+    g.add_argument("--algorithm", choices=("dfs", "kruskal"), help="maze algorithm")
+    g.add_argument("--name", help="problem name (default: from kind and seed)")
+    g.set_defaults(func=_cmd_generate)
+
+
+def _cmd_generate(args: argparse.Namespace) -> int:
+    from .generate import generate_to_file
+
+    keys = ("size", "n", "cells", "robot_radius", "radius_range", "vertices", "gap", "wall",
+            "algorithm", "name")  # fmt: skip
+    options = {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
+    _check_output(args.out, "--out")
+    try:
+        path = generate_to_file(args.kind, args.seed, args.out, **options)
+    except ValueError as exc:
+        raise InputError(f"generate {args.kind}: {exc}") from None
+    print(f"wrote {path}", file=sys.stderr)
+    return EXIT_SOLVED
 
 
 def _check_output(path: str | None, flag: str, image: bool = False) -> None:

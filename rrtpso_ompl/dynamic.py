@@ -379,11 +379,11 @@ class ReplanningManager:
             sides = ("up", "down")
             share = budget / len(sides)
         else:
-            sides = (None,)
-            share = budget
+            sides, share, tangent = (None,), budget, None
         for side in sides:
-            cand = self._detour(t_now, plan, obs, p_s, th_s, t_s, t_exit, side, share, first,
-                                tangent if side else None)  # fmt: skip
+            cand = self._detour(
+                t_now, plan, obs, p_s, th_s, t_s, t_exit, side, share, first, tangent
+            )
             candidates.append(cand["record"])
             if cand["motion"] is not None and (best is None or cand["motion"].t_end < best[0]):
                 best = (cand["motion"].t_end, cand["motion"], cand)

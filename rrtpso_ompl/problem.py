@@ -63,6 +63,10 @@ class ProblemError(ValueError):
         where = f"{self.source}: {key}" if key else self.source
         super().__init__(f"{where}: {message}")
 
+    def __reduce__(self):
+        # Picklable, so that a worker process can send it back to its parent.
+        return (type(self), (self.source, self.key, self.message))
+
 
 @dataclass(frozen=True)
 class Circle:

@@ -289,8 +289,8 @@ def test_simulate_command_writes_the_contract(tmp_path):
     gif = tmp_path / "run.gif"
     png = tmp_path / "run.png"
     proc = subprocess.run(
-        [*rrtpso_exe(), "simulate", str(PROBLEMS / "paper_dynamic.yaml"), "--json", str(out),
-         "--gif", str(gif), "--plot", str(png), "--seed", "2", "--time", "0.5"],
+        [*rrtpso_exe(), "simulate", str(PROBLEMS / "dynamic" / "paper_dynamic.yaml"), "--json",
+         str(out), "--gif", str(gif), "--plot", str(png), "--seed", "2", "--time", "0.5"],
         capture_output=True, text=True, timeout=300,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr

@@ -86,7 +86,7 @@ def test_open_loop_model_follows_a_straight_command():
 def paper_run(tmp_path_factory):
     """The command line on the paper's workspace with limits: CSV, JSON and velocity plot."""
     tmp = tmp_path_factory.mktemp("kin")
-    doc = yaml.safe_load((PROBLEMS / "paper_static.yaml").read_text())
+    doc = yaml.safe_load((PROBLEMS / "static" / "paper_static.yaml").read_text())
     doc["robot"].update(max_speed=30, max_wheel_speed=25, max_accel=20)
     problem = tmp / "paper_limits.yaml"
     problem.write_text(yaml.safe_dump(doc))

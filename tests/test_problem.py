@@ -22,7 +22,7 @@ from rrtpso_ompl.problem import (
 )
 from rrtpso_ompl.world import World
 
-SHIPPED = sorted(PROBLEMS.glob("*.yaml"))
+SHIPPED = sorted(PROBLEMS.glob("*/*.yaml"))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -43,9 +43,7 @@ def test_the_five_problems_are_shipped():
 def test_shipped_problems_load(path):
     problem = load_problem(path)
     assert problem.name == path.stem
-    assert problem.description and problem.units == "cm" and problem.robot.radius > 0
-    assert problem.planner.type == "RRTstarPSO"
-    assert (problem.planner.time_limit, problem.planner.seed) == (1.0, 1)
+    assert problem.description and problem.robot.radius >= 0
     # Start and goal are free for the planners' own collision checker too.
     world = World.from_problem(problem)
     for x, y in (problem.start, problem.goal):
@@ -53,7 +51,7 @@ def test_shipped_problems_load(path):
 
 
 def test_paper_static_has_the_papers_robot():
-    p = load_problem(PROBLEMS / "paper_static.yaml")
+    p = load_problem(PROBLEMS / "static" / "paper_static.yaml")
     assert p.bounds == ((0, 0), (500, 500)) and p.start == (20, 20) and p.goal == (450, 450)
     r = p.robot
     assert (r.radius, r.wheel_radius, r.track_width, r.sample_time) == (28.5, 7.6, 38, 0.15)
@@ -63,7 +61,7 @@ def test_paper_static_has_the_papers_robot():
 
 
 def test_single_circle_is_the_documented_one():
-    p = load_problem(PROBLEMS / "single_circle.yaml")
+    p = load_problem(PROBLEMS / "static" / "single_circle.yaml")
     assert p.obstacles == (Circle((250.0, 250.0), 80.0),)
     assert p.robot.radius == 28.5 and "647.45" in p.description
 
@@ -704,7 +702,7 @@ def test_junk_anywhere_only_raises_problem_error(puts):
     | st.sampled_from(["[", "]", "{", ": ", "\n  - ", "&a ", "*a", "!!int ", "? ", "\t", "'"]),
 )
 def test_junk_text_only_raises_problem_error(tmp_path_factory, where, junk):
-    text = (PROBLEMS / "paper_static.yaml").read_text()
+    text = (PROBLEMS / "static" / "paper_static.yaml").read_text()
     where %= len(text) + 1
     path = tmp_path_factory.mktemp("junk") / "junk.yaml"
     path.write_text(text[:where] + junk + text[where:], encoding="utf-8", errors="surrogatepass")

@@ -1,0 +1,135 @@
+"""``rrtpso batch``: isolation of bad files, the JSON-lines schema, resuming, interruption, Dask."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import signal
+import subprocess
+import time
+
+import pytest
+from conftest import PROBLEMS, rrtpso_exe
+
+from rrtpso_ompl.batch import expand_inputs, make_tasks, read_rows, run_batch
+
+ROW_KEYS = {"file", "problem", "planner", "seed", "run", "status", "solved", "length", "time",
+            "path", "error"}  # fmt: skip
+
+
+def batch(*args: str, timeout: float = 240) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [*rrtpso_exe(), "batch", *args], capture_output=True, text=True, timeout=timeout
+    )
+
+
+@pytest.fixture
+def folder(tmp_path):
+    """Two good problems and a bad one."""
+    d = tmp_path / "problems"
+    d.mkdir()
+    shutil.copy(PROBLEMS / "static" / "single_circle.yaml", d / "a_circle.yaml")
+    shutil.copy(PROBLEMS / "static" / "narrow_passage.yaml", d / "b_passage.yaml")
+    (d / "c_bad.yaml").write_text("bounds: [[0, 0], [10, 10]]\nstart: [1, 1]\ngoal: [9, 9]\n")
+    return d
+
+
+def test_inputs_mix_files_globs_and_directories(folder, tmp_path):
+    items = [str(folder / "a_circle.yaml"), str(folder / "*.yaml"), str(folder), "nope.yaml",
+             str(tmp_path / "*.none")]  # fmt: skip
+    got = expand_inputs(items)
+    paths = [p for p, _ in got]
+    assert paths[:3] == [str(folder / f) for f in ("a_circle.yaml", "b_passage.yaml", "c_bad.yaml")]
+    assert len(paths) == len(set(paths)) == 5  # no repeats
+    errors = dict(got)
+    assert "no such file" in errors["nope.yaml"]
+    assert "no file matches" in errors[str(tmp_path / "*.none")]
+
+
+def test_a_bad_file_is_its_row_and_the_batch_goes_on(folder, tmp_path):
+    out = tmp_path / "out.jsonl"
+    proc = batch(str(folder), "--planner", "RRTstarPSO,RRTConnect", "--time", "0.2", "--jobs",
+                 "2", "--out", str(out))  # fmt: skip
+    assert proc.returncode == 1, proc.stderr  # one row failed
+    rows = [json.loads(line) for line in out.read_text().splitlines()]
+    assert len(rows) == 6  # 3 files x 2 planners
+    for row in rows:
+        assert set(row) >= ROW_KEYS
+    bad = [r for r in rows if r["file"].endswith("c_bad.yaml")]
+    assert len(bad) == 2 and all(r["status"] == "error" and not r["solved"] for r in bad)
+    assert all("robot" in r["error"] and "c_bad.yaml" in r["error"] for r in bad)
+    good = [r for r in rows if not r["file"].endswith("c_bad.yaml")]
+    assert all(r["solved"] and r["error"] is None and r["length"] > 0 for r in good)
+    assert "c_bad.yaml" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_unknown_planner_is_a_usage_error(folder, tmp_path):
+    out = tmp_path / "out.jsonl"
+    proc = batch(str(folder), "--planner", "RRTsta", "--out", str(out))
+    assert proc.returncode == 2 and "RRTsta" in proc.stderr and not out.exists()
+
+
+def test_resume_skips_done_rows_and_retries_a_torn_line(folder, tmp_path):
+    out = tmp_path / "out.jsonl"
+    good = str(folder / "a_circle.yaml")
+    tasks = make_tasks([good], ["RRTConnect"], runs=3, seed=5, time_limit=0.1)
+    rows = run_batch(tasks[:2], out)
+    assert [r["seed"] for r in rows] == [5, 6]
+    # Simulate an interrupted write at the end of the file.
+    with out.open("a") as fh:
+        fh.write('{"file": "' + good + '", "planner": "RRTC')
+    seen = []
+    rows = run_batch(tasks, out, resume=True, on_start=lambda n, skipped: seen.append((n, skipped)))
+    assert seen == [(1, 2)]
+    assert sorted(r["seed"] for r in rows) == [5, 6, 7]
+    assert sorted(r["seed"] for r in read_rows(out)) == [5, 6, 7]
+    assert all(json.loads(line) for line in out.read_text().splitlines())
+
+
+def test_same_seed_same_row_in_a_fresh_process(tmp_path):
+    # Iteration-bounded so that the result does not depend on the machine's speed.
+    params = {"PSO": {"iterations": 30, "restarts": False}}
+    problem = str(PROBLEMS / "static" / "single_circle.yaml")
+    tasks = make_tasks([problem], ["PSO"], seed=3, time_limit=5.0, params=params)
+    a = run_batch(tasks, tmp_path / "a.jsonl")[0]
+    b = run_batch(tasks, tmp_path / "b.jsonl", jobs=2)[0]
+    assert a["solved"] == b["solved"] and a["path"] == b["path"]
+
+
+def test_ctrl_c_leaves_a_valid_partial_file(folder, tmp_path):
+    out = tmp_path / "out.jsonl"
+    proc = subprocess.Popen(
+        [*rrtpso_exe(), "batch", str(folder / "a_circle.yaml"), "--planner", "RRTstar",
+         "--runs", "30", "--time", "0.3", "--out", str(out)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and (not out.exists() or not out.read_text().strip()):
+        time.sleep(0.2)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    lines = out.read_text().splitlines()
+    assert 1 <= len(lines) < 30
+    assert all(json.loads(line)["solved"] for line in lines)
+    # And the batch continues where it stopped.
+    again = batch(str(folder / "a_circle.yaml"), "--planner", "RRTstar", "--runs", "30", "--time",
+                  "0.05", "--out", str(out), "--resume", "--jobs", "2")  # fmt: skip
+    assert again.returncode in (0, 1), again.stderr
+    rows = read_rows(out)
+    assert sorted(r["seed"] for r in rows) == list(range(1, 31))
+
+
+def test_dask_local_cluster_runs_the_same_batch(folder, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    tasks = make_tasks([str(folder / "a_circle.yaml"), str(folder / "c_bad.yaml")], ["RRTConnect"],
+                       runs=2, time_limit=0.1)  # fmt: skip
+    cluster = distributed.LocalCluster(
+        n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
+    )
+    with cluster, distributed.Client(cluster) as client:
+        rows = run_batch(tasks, tmp_path / "d.jsonl", executor="dask", scheduler=client)
+    assert len(rows) == 4
+    assert sum(bool(r["error"]) for r in rows) == 2
+    assert all(r["solved"] for r in rows if not r["error"])
+    assert len(read_rows(tmp_path / "d.jsonl")) == 4
