@@ -150,6 +150,7 @@ def _build_parser() -> argparse.ArgumentParser:
 
     _add_batch_parser(sub)
     _add_generate_parser(sub)
+    _add_optimum_parser(sub)
 
     q = sub.add_parser(
         "planners",
@@ -521,6 +522,47 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         raise InputError(f"generate {args.kind}: {exc}") from None
     print(f"wrote {path}", file=sys.stderr)
     return EXIT_SOLVED
+
+
+def _add_optimum_parser(sub: Any) -> None:
+    o = sub.add_parser(
+        "optimum",
+        help="compute the exact shortest path (the reference for path-length ratios)",
+        description="Compute the exact shortest path for the problem's disc robot among its "
+        "circles and polygons: a tangent graph with arcs around the inflated obstacles, searched "
+        "with Dijkstra's algorithm (docs/benchmarking.md). Moving obstacles are ignored. Exit "
+        "status 0 when a path exists, 1 when none does.",
+    )
+    o.add_argument("problem", help="problem file (YAML)")
+    o.add_argument("--json", metavar="OUT", help='write {"length": ..., "path": [...], ...}')
+    o.add_argument("--plot", metavar="OUT.png", help="draw the world and the shortest path")
+    o.set_defaults(func=_cmd_optimum)
+
+
+def _cmd_optimum(args: argparse.Namespace) -> int:
+    from .optimum import shortest_path
+    from .problem import ProblemError, load_problem
+
+    try:
+        problem = load_problem(args.problem)
+    except ProblemError as exc:
+        raise InputError(str(exc)) from None
+    _check_output(args.json, "--json")
+    _check_output(args.plot, "--plot", image=True)
+    result = shortest_path(problem)
+    if args.plot:
+        from .plotting import plot_optimum, save_figure
+
+        save_figure(plot_optimum(problem, result), args.plot)
+    if args.json:
+        from .results import write_json_atomic
+
+        write_json_atomic(result.to_dict(), args.json)
+    if result.found:
+        print(f"{problem.name}: optimum length={result.length:.6f}", file=sys.stderr)
+        return EXIT_SOLVED
+    print(f"{problem.name}: no path exists", file=sys.stderr)
+    return EXIT_UNSOLVED
 
 
 def _check_output(path: str | None, flag: str, image: bool = False) -> None:

@@ -29,6 +29,7 @@ from .results import SolveResult, publish_atomic
 __all__ = [
     "animate_simulation",
     "draw_world",
+    "plot_optimum",
     "plot_simulation",
     "plot_solution",
     "plot_velocities",
@@ -146,6 +147,24 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
         bx.set_ylabel("best cost")
         bx.set_title("PSO best cost per iteration")
         bx.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def plot_optimum(problem: Problem, result: Any) -> Figure:
+    """The world with the exact shortest path (an :class:`~rrtpso_ompl.optimum.OptimumResult`):
+    its tangent segments and its arcs around the inflated obstacles."""
+    fig, ax = plt.subplots(figsize=(6.5, 6))
+    draw_world(ax, problem)
+    path = result.polyline(np.radians(0.5))
+    if len(path):
+        ax.plot(path[:, 0], path[:, 1], "-", color=PATH_COLOUR, lw=1.8, zorder=4,
+                label=f"shortest path ({result.length:.2f})")  # fmt: skip
+        bends = np.array([p.end for p in result.pieces[:-1]]).reshape(-1, 2)
+        ax.plot(bends[:, 0], bends[:, 1], "o", color=PATH_COLOUR, ms=3, zorder=5)
+        ax.legend(loc="best", fontsize=8)
+    found = f"length {result.length:.4f}" if result.found else "no path"
+    ax.set_title(f"{problem.name}: exact optimum, {found}")
     fig.tight_layout()
     return fig
 

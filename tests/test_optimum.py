@@ -1,0 +1,285 @@
+"""The exact optimum: closed forms, an independent brute force, bounds from above and below."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+
+import numpy as np
+import pytest
+import shapely
+from conftest import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
+from scipy.sparse import csr_array
+from scipy.sparse.csgraph import dijkstra
+
+from rrtpso_ompl.generate import generate, grid_path
+from rrtpso_ompl.optimum import shortest_path
+from rrtpso_ompl.path_optimizer import path_length
+from rrtpso_ompl.problem import Circle, Polygon, load_problem, problem_from_dict
+from rrtpso_ompl.solve import solve
+from rrtpso_ompl.world import World
+
+
+def _one_circle_length(s, g, c, rho) -> float:
+    """Tangent, arc, tangent around one disc that blocks the straight line (closed form)."""
+    s, g, c = (np.asarray(v, float) for v in (s, g, c))
+    d1, d2 = np.linalg.norm(s - c), np.linalg.norm(g - c)
+    cos_t = np.dot(s - c, g - c) / (d1 * d2)
+    theta = math.acos(np.clip(cos_t, -1, 1))
+    arc = theta - math.acos(rho / d1) - math.acos(rho / d2)
+    return math.sqrt(d1**2 - rho**2) + math.sqrt(d2**2 - rho**2) + rho * arc
+
+
+def _box(lo, hi):
+    return {"type": "rectangle", "min": list(lo), "max": list(hi)}
+
+
+def test_single_circle_is_tangent_arc_tangent():
+    problem = problem_from_dict(SINGLE_CIRCLE)
+    result = shortest_path(problem)
+    rho = 80 + 28.5
+    expected = _one_circle_length((20, 20), (450, 450), (250, 250), rho)
+    assert expected == pytest.approx(647.4596, abs=1e-4)
+    assert result.length == pytest.approx(expected, rel=1e-12)
+    assert [p.kind for p in result.pieces] == ["line", "arc", "line"]
+    arc = result.pieces[1]
+    assert arc.radius == pytest.approx(rho) and arc.center == pytest.approx((250, 250))
+    for line in (result.pieces[0], result.pieces[2]):
+        # Tangent: the line's distance from the centre equals the grown radius.
+        a, b = np.array(line.start), np.array(line.end)
+        u, w = b - a, np.array([250.0, 250.0]) - a
+        dist = abs(u[0] * w[1] - u[1] * w[0]) / np.linalg.norm(u)
+        assert dist == pytest.approx(rho, rel=1e-12)
+    assert sum(p.length for p in result.pieces) == pytest.approx(result.length, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("start", "goal"),
+    [((10, 40), (90, 55)), ((20, 80), (75, 15)), ((50, 5), (45, 95)), ((5, 50), (95, 50))],
+)
+def test_one_circle_off_the_diagonal(start, goal):
+    doc = {
+        "bounds": [[0, 0], [100, 100]],
+        "start": list(start),
+        "goal": list(goal),
+        "robot": {"radius": 3},
+        "obstacles": [{"type": "circle", "center": [50, 50], "radius": 15}],
+    }
+    result = shortest_path(problem_from_dict(doc))
+    assert result.length == pytest.approx(_one_circle_length(start, goal, (50, 50), 18), rel=1e-12)
+
+
+def test_straight_line_when_nothing_is_in_the_way():
+    doc = {"bounds": [[0, 0], [10, 10]], "start": [1, 1], "goal": [9, 4], "robot": {"radius": 0.5},
+           "obstacles": [{"type": "circle", "center": [5, 8], "radius": 1}]}  # fmt: skip
+    result = shortest_path(problem_from_dict(doc))
+    assert result.length == pytest.approx(math.hypot(8, 3), rel=1e-12)
+    assert result.polyline().tolist() == [[1, 1], [9, 4]]
+
+
+def test_point_robot_bends_at_the_square_corners():
+    doc = {"bounds": [[0, 0], [100, 100]], "start": [10, 50], "goal": [90, 50],
+           "robot": {"radius": 0}, "obstacles": [_box((40, 35), (60, 60))]}  # fmt: skip
+    result = shortest_path(problem_from_dict(doc))
+    # Over the top: (10,50) -> (40,60) -> (60,60) -> (90,50); the bottom is longer.
+    expected = 2 * math.hypot(30, 10) + 20
+    assert result.length == pytest.approx(expected, abs=1e-6)
+    bends = [p.end for p in result.pieces[:-1]]
+    assert any(np.allclose(b, (40, 60), atol=1e-6) for b in bends)
+    assert any(np.allclose(b, (60, 60), atol=1e-6) for b in bends)
+
+
+def test_disc_robot_rounds_the_square_corners():
+    """Robot radius R: tangent to the corner circles, a straight run along the offset top edge and
+    the two corner arcs (closed form for a symmetric set-up)."""
+    R = 4.0
+    doc = {"bounds": [[0, 0], [100, 100]], "start": [10, 50], "goal": [90, 50],
+           "robot": {"radius": R}, "obstacles": [_box((40, 35), (60, 60))]}  # fmt: skip
+    result = shortest_path(problem_from_dict(doc))
+    v = np.array([40.0, 60.0])
+    d = np.linalg.norm(v - (10, 50))
+    tangent = math.sqrt(d**2 - R**2)
+    # The tangent leaves the corner circle at angle phi; the arc runs from there to straight up.
+    direction = math.atan2(10, 30)  # start -> corner
+    phi = direction + math.asin(R / d)  # the tangent's heading
+    arc = R * phi  # the heading turns from phi to 0 along the arc
+    expected = 2 * (tangent + arc) + 20
+    assert result.length == pytest.approx(expected, rel=1e-12)
+    assert [p.kind for p in result.pieces] == ["line", "arc", "line", "arc", "line"]
+
+
+def test_no_path_into_a_closed_box(tmp_path):
+    walls = [_box((60, 60), (90, 62)), _box((60, 88), (90, 90)), _box((60, 60), (62, 90)),
+             _box((88, 60), (90, 90))]  # fmt: skip
+    doc = {"name": "boxed", "bounds": [[0, 0], [100, 100]], "start": [10, 10],
+           "goal": [75, 75], "robot": {"radius": 1}, "obstacles": walls}  # fmt: skip
+    result = shortest_path(problem_from_dict(doc))
+    assert result.length is None and not result.found and result.pieces == []
+    path = tmp_path / "boxed.yaml"
+    path.write_text(json.dumps(doc))
+    out = tmp_path / "opt.json"
+    proc = subprocess.run([*rrtpso_exe(), "optimum", str(path), "--json", str(out)],
+                          capture_output=True, text=True)  # fmt: skip
+    assert proc.returncode == 1
+    assert json.loads(out.read_text())["length"] is None
+    assert json.loads(out.read_text())["path"] == []
+
+
+def test_a_gap_narrower_than_the_robot_is_closed():
+    """Two boxes with a 5-wide gap: a robot of radius 2 passes, one of radius 3 must go round."""
+    doc = {"bounds": [[0, 0], [100, 100]], "start": [50, 10], "goal": [50, 90],
+           "obstacles": [_box((0, 45), (47.5, 55)), _box((52.5, 45), (100, 55))]}  # fmt: skip
+    small = shortest_path(problem_from_dict({**doc, "robot": {"radius": 2}}))
+    assert small.length == pytest.approx(80.0, rel=1e-12)
+    big = shortest_path(problem_from_dict({**doc, "robot": {"radius": 3}}))
+    assert big.length is None  # the boxes reach the bounds on both sides
+
+
+def test_start_equals_goal_and_goal_tolerance():
+    doc = {"bounds": [[0, 0], [10, 10]], "start": [2, 2], "goal": [2, 2], "robot": {"radius": 0.5}}
+    assert shortest_path(problem_from_dict(doc)).length == 0.0
+    doc = {**doc, "goal": [8, 2], "goal_tolerance": 1.5}
+    result = shortest_path(problem_from_dict(doc))
+    assert result.length == pytest.approx(6.0 - 1.5, rel=1e-12) and result.exact
+    # With the tolerance the path around a circle ends where its leg enters the goal disc.
+    doc = {"bounds": [[0, 0], [500, 500]], "start": [20, 20], "goal": [450, 450],
+           "goal_tolerance": 10, "robot": {"radius": 28.5},
+           "obstacles": [{"type": "circle", "center": [250, 250], "radius": 80}]}  # fmt: skip
+    result = shortest_path(problem_from_dict(doc))
+    full = _one_circle_length((20, 20), (450, 450), (250, 250), 108.5)
+    assert result.length == pytest.approx(full - 10, rel=1e-12)
+
+
+# ----------------------------------------------------------------------------------------------
+def _brute_force(problem, quad_segs: int = 16) -> float | None:
+    """An independent check: the visibility graph of the grown obstacles drawn as shapely
+    polygons (vertices on the true boundary, so slightly smaller than the grown obstacles: a
+    lower bound that tends to the optimum as ``quad_segs`` grows)."""
+    R = problem.robot.radius
+    shapes = []
+    for o in problem.obstacles:
+        if isinstance(o, Circle):
+            shapes.append(shapely.Point(o.center).buffer(o.radius + R, quad_segs=quad_segs))
+        elif isinstance(o, Polygon):
+            shapes.append(shapely.Polygon(o.points).buffer(R, quad_segs=quad_segs))
+    union = shapely.union_all(shapes)
+    (x0, y0), (x1, y1) = problem.bounds
+    verts = [problem.start[:2], problem.goal[:2]]
+    for poly in getattr(union, "geoms", [union]):
+        for ring in [poly.exterior, *poly.interiors]:
+            verts.extend(ring.coords[:-1])
+    v = np.array(verts, float)
+    v = v[(v[:, 0] >= x0) & (v[:, 0] <= x1) & (v[:, 1] >= y0) & (v[:, 1] <= y1)]
+    i, j = np.triu_indices(len(v), k=1)
+    lines = shapely.linestrings(np.stack([v[i], v[j]], axis=1))
+    ok = ~shapely.relate_pattern(union, lines, "T********")  # no interior in common
+    w = np.hypot(*(v[i] - v[j]).T)[ok]
+    graph = csr_array((w, (i[ok], j[ok])), shape=(len(v), len(v)))
+    d = dijkstra(graph, directed=False, indices=0)[1]
+    return float(d) if np.isfinite(d) else None
+
+
+def _cluttered(seed: int, robot_radius: float) -> dict:
+    """Overlapping random circles and convex polygons across the start-goal line."""
+    rng = np.random.default_rng(seed)
+    start, goal = np.array([5.0, 50.0]), np.array([95.0, 50.0])
+    obstacles = []
+    while len(obstacles) < 9:
+        c = rng.uniform((20, 25), (80, 75))
+        size = rng.uniform(5, 14)
+        if min(np.linalg.norm(c - start), np.linalg.norm(c - goal)) < size + robot_radius + 3:
+            continue
+        if rng.random() < 0.5:
+            obstacles.append({"type": "circle", "center": c.round(2).tolist(), "radius": size})
+        else:
+            angles = np.sort(rng.uniform(0, 2 * np.pi, rng.integers(3, 7)))
+            pts = c + size * np.column_stack([np.cos(angles), np.sin(angles)])
+            obstacles.append({"type": "polygon", "points": pts.round(2).tolist()})
+    return {"bounds": [[0, 0], [100, 100]], "start": start.tolist(), "goal": goal.tolist(),
+            "robot": {"radius": robot_radius}, "obstacles": obstacles}  # fmt: skip
+
+
+@pytest.mark.parametrize(("seed", "robot_radius"), [(1, 0.0), (2, 1.5), (3, 3.0), (4, 0.5)])
+def test_agrees_with_brute_force_and_is_below_a_certified_grid_path(seed, robot_radius):
+    problem = problem_from_dict(_cluttered(seed, robot_radius))
+    result = shortest_path(problem)
+    lower = _brute_force(problem)
+    assert result.found and lower is not None
+    assert result.length > math.dist(problem.start, problem.goal) + 0.1  # obstacles in the way
+    # The inscribed polygons make the brute force slightly shorter, never longer.
+    assert lower <= result.length * (1 + 1e-9)
+    assert result.length <= lower * (1 + 5e-4)
+    grid = grid_path(problem)
+    assert grid is not None and result.length <= path_length(grid) + 1e-9
+
+
+def test_generated_worlds_are_below_their_grid_paths():
+    for kind, seed in (("circles", 3), ("polygons", 4)):
+        problem = problem_from_dict(generate(kind, seed, robot_radius=1.0))
+        result = shortest_path(problem)
+        grid = grid_path(problem)
+        assert result.found and result.length <= path_length(grid) + 1e-9
+
+
+def test_pieces_touch_but_never_enter_the_grown_obstacles():
+    problem = load_problem(PROBLEMS / "static" / "polygon_map.yaml")
+    result = shortest_path(problem)
+    world = World.from_problem(problem)
+    ends = np.array([p.start for p in result.pieces] + [result.pieces[-1].end])
+    assert world.points_in_bounds(ends).all()
+    lines = [p for p in result.pieces if p.kind == "line"]
+    d = world.segment_distance(np.array([p.start for p in lines]), np.array([p.end for p in lines]))
+    assert d.min() >= world.robot_radius - world.tol
+    # Arcs, sampled densely: every point is at least R from every obstacle (up to round-off).
+    for arc in (p for p in result.pieces if p.kind == "arc"):
+        pts = arc.points(math.radians(0.1))
+        assert world.point_clearance(pts).min() >= world.robot_radius - 1e-9
+    assert d.min() == pytest.approx(world.robot_radius, abs=1e-9)  # it does touch: optimal
+
+
+@pytest.mark.parametrize("planner", ["RRTstarPSO", "RRTstar", "RRTConnect"])
+@pytest.mark.parametrize("name", ["single_circle", "polygon_map"])
+def test_planners_never_beat_the_optimum(planner, name):
+    problem = load_problem(PROBLEMS / "static" / f"{name}.yaml")
+    optimum = shortest_path(problem).length
+    result = solve(problem, planner, time_limit=0.3, seed=5)
+    assert result.solved
+    assert result.length >= optimum - 1e-9
+    assert result.length <= 1.5 * optimum  # and they are in the right neighbourhood
+
+
+def test_library_optima_are_below_their_grid_paths():
+    for name in ("paper_static", "narrow_passage", "bug_trap", "maze", "yarpiz_pso", "wall_gap"):
+        problem = load_problem(PROBLEMS / "static" / f"{name}.yaml")
+        result = shortest_path(problem)
+        grid = grid_path(problem)
+        assert result.found and grid is not None
+        assert result.length <= path_length(grid) + 1e-9, name
+        assert result.length >= math.dist(problem.start, problem.goal) - 1e-9
+
+
+def test_cli_writes_the_contract(tmp_path):
+    out = tmp_path / "opt.json"
+    png = tmp_path / "opt.png"
+    problem = PROBLEMS / "static" / "single_circle.yaml"
+    proc = subprocess.run([*rrtpso_exe(), "optimum", str(problem), "--json", str(out),
+                           "--plot", str(png)], capture_output=True, text=True)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(out.read_text())
+    assert list(data)[:2] == ["length", "path"]
+    assert data["length"] == pytest.approx(647.4596, abs=1e-4)
+    path = np.array(data["path"])
+    assert np.allclose(path[0], (20, 20)) and np.allclose(path[-1], (450, 450))
+    assert png.stat().st_size > 1000
+
+
+def test_cli_bad_file_exit_2(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("bounds: [[0, 0], [10, 10]]\nstart: [1, 1]\n")
+    out = tmp_path / "opt.json"
+    proc = subprocess.run([*rrtpso_exe(), "optimum", str(bad), "--json", str(out)],
+                          capture_output=True, text=True)  # fmt: skip
+    assert proc.returncode == 2
+    assert str(bad) in proc.stderr and "goal" in proc.stderr and "Traceback" not in proc.stderr
+    assert not out.exists()
