@@ -134,12 +134,9 @@ def summarise(rows: list[dict], optimum: float | None) -> list[dict]:
         rs = [r for r in rows if r["strategy"] == strategy and "error" not in r]
         if not rs:
             continue
-        ref = optimum
-        overhead = [
-            100 * (r["path_length"] / (ref or r["static_length"]) - 1)
-            for r in rs
-            if r["reached_goal"]
-        ]
+        reached = [r for r in rs if r["reached_goal"]]
+        overhead = [100 * (r["path_length"] / optimum - 1) for r in reached] if optimum else []
+        over_static = [100 * (r["path_length"] / r["static_length"] - 1) for r in reached]
         plan_t = [t for r in rs for t in r["planning_times"]]
         out.append(
             {
@@ -151,6 +148,8 @@ def summarise(rows: list[dict], optimum: float | None) -> list[dict]:
                 "collision_runs": sum(r["collisions"] > 0 for r in rs),
                 "median_overhead": statistics.median(overhead) if overhead else None,
                 "p90_overhead": _quantile(overhead, 0.9),
+                "median_over_static": statistics.median(over_static) if over_static else None,
+                "p90_over_static": _quantile(over_static, 0.9),
                 "mean_replans": statistics.fmean(r["replans"] for r in rs),
                 "mean_detours": statistics.fmean(r["detours"] for r in rs),
                 "fallbacks": sum(sum(r["fallbacks"].values()) for r in rs),
@@ -190,14 +189,11 @@ def report(rows: list[dict], summary: list[dict], args, optimum: float | None, w
         f"same static path. Replanning budget {args.replan_time} s of simulated time per replan "
         "(split between the two contour detours).",
         "",
-        "Overhead is the driven length over the static shortest path "
-        + (
-            f"({optimum:.1f} cm, exact, `rrtpso optimum`)"
-            if optimum
-            else "(the static planned path)"
-        )
-        + ", over the runs that reached the goal. Planning time is measured wall-clock per detour "
-        "replan (both sides for contour).",
+        "Overhead is the driven length over the static world's exact shortest path "
+        f"({_fmt(optimum, '.2f')} cm, `rrtpso optimum`) and, in brackets, over the scenario's "
+        "static planned path (what the robot would have driven without moving obstacles), over "
+        "the runs that reached the goal. Planning time is measured wall-clock per detour replan "
+        "(both sides for contour).",
         "",
         "| strategy | planner | runs | success | reached | runs with a collision "
         "| median overhead % | p90 overhead % | replans/run | detours/run | fallbacks "
@@ -207,7 +203,9 @@ def report(rows: list[dict], summary: list[dict], args, optimum: float | None, w
     for s in summary:
         lines.append(
             f"| {s['strategy']} | {s['planner']} | {s['runs']} | {s['success']} | {s['reached']} | "
-            f"{s['collision_runs']} | {_fmt(s['median_overhead'])} | {_fmt(s['p90_overhead'])} | "
+            f"{s['collision_runs']} | {_fmt(s['median_overhead'])} "
+            f"({_fmt(s['median_over_static'])}) | {_fmt(s['p90_overhead'])} "
+            f"({_fmt(s['p90_over_static'])}) | "
             f"{s['mean_replans']:.2f} | {s['mean_detours']:.2f} | {s['fallbacks']} | "
             f"{s['unavoidable']} | "
             f"{_fmt(s['median_plan_time'], '.3f')} | {_fmt(s['max_plan_time'], '.3f')} | "
@@ -239,9 +237,11 @@ def main(argv: list[str] | None = None) -> int:
 
     from tqdm import tqdm
 
-    # Overhead against each scenario's static path: the exact optimum (`rrtpso optimum`) belongs
-    # to issue 5 and has not landed yet.
-    optimum = None
+    from rrtpso_ompl.optimum import shortest_path
+    from rrtpso_ompl.problem import load_problem
+
+    # Every scenario shares the static world, so one exact optimum is the reference for all.
+    optimum = shortest_path(load_problem(BASE)).length
     rows: list[dict] = []
     t0 = time.perf_counter()
     ctx = mp.get_context("spawn")

@@ -4,7 +4,11 @@ Stages, one module each: :mod:`~rrtpso_ompl.problem` (files) -> :mod:`~rrtpso_om
 (exact geometry) -> :mod:`~rrtpso_ompl.ompl_setup` (OMPL objects) -> planners
 (:mod:`~rrtpso_ompl.rrtstar_pso`, :mod:`~rrtpso_ompl.pso_planner`, OMPL's own) ->
 :mod:`~rrtpso_ompl.path_optimizer` and :mod:`~rrtpso_ompl.pso` (post-optimiser) ->
-:mod:`~rrtpso_ompl.results` / :mod:`~rrtpso_ompl.plotting`.
+:mod:`~rrtpso_ompl.results` / :mod:`~rrtpso_ompl.plotting`. Around them:
+:mod:`~rrtpso_ompl.kinematics` (wheel speeds), :mod:`~rrtpso_ompl.dynamic` (moving obstacles),
+:mod:`~rrtpso_ompl.optimum` (the exact shortest path), :mod:`~rrtpso_ompl.batch` and
+:mod:`~rrtpso_ompl.bench` (many runs, OMPL benchmark logs via :mod:`~rrtpso_ompl.ompl_log`),
+:mod:`~rrtpso_ompl.generate` (random worlds).
 
 The planner classes import OMPL; import them from their modules (``from rrtpso_ompl.rrtstar_pso
 import RRTstarPSO``) or through :func:`rrtpso_ompl.registry.default_registry`.

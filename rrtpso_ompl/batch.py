@@ -50,12 +50,13 @@ class Task:
     params: Mapping[str, Any] = field(default_factory=dict)
     simplify: bool = False
     keep_path: bool = True
+    progress: bool = False
     error: str | None = None
 
     @property
-    def key(self) -> tuple[str, str, int]:
+    def key(self) -> tuple[str, str, int, float | None]:
         """Identifies the row in a results file (for resuming)."""
-        return (self.file, self.planner, self.seed)
+        return (self.file, self.planner, self.seed, self.time_limit)
 
 
 def expand_inputs(items: Sequence[str]) -> list[tuple[str, str | None]]:
@@ -105,12 +106,14 @@ def make_tasks(
     seed: int = 1,
     time_limit: float | None = None,
     params: Mapping[str, Mapping[str, Any]] | None = None,
-    simplify: bool = False,
+    simplify: bool | Callable[[str], bool] = False,
     keep_path: bool = True,
+    progress: bool = False,
 ) -> list[Task]:
     """The tasks of a batch: every file x planner x run, run ``r`` seeded with ``seed + r``.
 
-    ``params`` maps a planner name to its parameters.
+    ``params`` maps a planner name to its parameters; ``simplify`` may be a function of the
+    planner name.
     """
     tasks = []
     for path, error in expand_inputs(items):
@@ -124,8 +127,9 @@ def make_tasks(
                         run=r,
                         time_limit=time_limit,
                         params=dict((params or {}).get(planner, {})),
-                        simplify=simplify,
+                        simplify=simplify(planner) if callable(simplify) else simplify,
                         keep_path=keep_path,
+                        progress=progress,
                         error=error,
                     )
                 )
@@ -140,14 +144,21 @@ def run_task(task: Task) -> dict[str, Any]:
 
     The row has the keys of ``rrtpso solve --json`` (``problem, planner, status, solved, length,
     time, seed, path`` and the per-stage figures) plus ``file``, ``run``, ``wall`` (s) and
-    ``error`` (None, or the message for a bad file or planner).
+    ``error`` (None, or the message for a bad file or planner), and ``budget``, the time limit
+    the task asked for (None: the file's).
     """
     from .ompl_setup import set_ompl_log_level
     from .problem import ProblemError, load_problem
     from .solve import solve
 
     set_ompl_log_level(0)
-    base = {"file": task.file, "planner": task.planner, "seed": task.seed, "run": task.run}
+    base = {
+        "file": task.file,
+        "planner": task.planner,
+        "seed": task.seed,
+        "run": task.run,
+        "budget": task.time_limit,
+    }
     t0 = time.perf_counter()
     if task.error:
         return _error_row(base, f"{task.file}: {task.error}")
@@ -160,6 +171,7 @@ def run_task(task: Task) -> dict[str, Any]:
             task.seed,
             dict(task.params),
             simplify=task.simplify,
+            progress=task.progress,
         )
     except ProblemError as exc:
         return _error_row(base, str(exc))
@@ -168,6 +180,7 @@ def run_task(task: Task) -> dict[str, Any]:
     row = {**base, **result.to_dict()}
     row["file"] = task.file
     row["run"] = task.run
+    row["budget"] = task.time_limit
     if not task.keep_path:
         row.pop("path", None)
     row["wall"] = time.perf_counter() - t0
@@ -215,8 +228,8 @@ def read_rows(path: str | Path) -> list[dict[str, Any]]:
     return rows
 
 
-def _row_key(row: Mapping[str, Any]) -> tuple[str, str, int]:
-    return (row.get("file"), row.get("planner"), row.get("seed"))
+def _row_key(row: Mapping[str, Any]) -> tuple[str, str, int, float | None]:
+    return (row.get("file"), row.get("planner"), row.get("seed"), row.get("budget"))
 
 
 def _json_line(row: Mapping[str, Any]) -> str:
@@ -291,6 +304,7 @@ def run_batch(
     scheduler: Any = None,
     progress: Callable[[dict[str, Any]], None] | None = None,
     on_start: Callable[[int, int], None] | None = None,
+    optimum: bool = True,
 ) -> list[dict[str, Any]]:
     """Run ``tasks`` and stream their rows to ``out`` (JSON lines) as they finish.
 
@@ -309,6 +323,9 @@ def run_batch(
         Called with each finished row.
     on_start : callable, optional
         Called as ``on_start(n_to_run, n_skipped)`` before the first task starts.
+    optimum : bool
+        Add ``optimum`` (the exact shortest length, :mod:`rrtpso_ompl.optimum`, computed once per
+        file in this process) and ``ratio`` (``length / optimum``) to every row.
 
     Returns
     -------
@@ -339,14 +356,41 @@ def run_batch(
         results = _dask_results(todo, scheduler)
     else:
         raise ValueError(f"unknown executor {executor!r} (local or dask)")
+    optima = _Optima() if optimum else None
     with out.open("a", buffering=1) as fh:
         for row in results:
+            if optima is not None:
+                optima.annotate(row)
             fh.write(_json_line(row))  # one whole line per write: never a torn row mid-file
             fh.flush()
             rows.append(row)
             if progress is not None:
                 progress(row)
     return rows
+
+
+class _Optima:
+    """The exact optimum of each problem file, computed when its first row arrives."""
+
+    def __init__(self) -> None:
+        self._cache: dict[str, float | None] = {}
+
+    def length(self, file: str) -> float | None:
+        if file not in self._cache:
+            from .optimum import shortest_path
+            from .problem import ProblemError, load_problem
+
+            try:
+                self._cache[file] = shortest_path(load_problem(file)).length
+            except (ProblemError, OSError):
+                self._cache[file] = None  # the row already says why
+        return self._cache[file]
+
+    def annotate(self, row: dict[str, Any]) -> None:
+        opt = None if row.get("error") else self.length(row["file"])
+        row["optimum"] = opt
+        length = row.get("length")
+        row["ratio"] = length / opt if length is not None and opt else None
 
 
 def task_dict(task: Task) -> dict[str, Any]:

@@ -151,6 +151,7 @@ def _build_parser() -> argparse.ArgumentParser:
     _add_batch_parser(sub)
     _add_generate_parser(sub)
     _add_optimum_parser(sub)
+    _add_bench_parser(sub)
 
     q = sub.add_parser(
         "planners",
@@ -351,6 +352,34 @@ def _progress_bar(desc: str, **kwargs: Any) -> Any:
     return tqdm(desc=desc, file=sys.stderr, disable=not sys.stderr.isatty(), leave=False, **kwargs)
 
 
+class _RunProgress:
+    """The progress bar of a batch or a bench: solved / unsolved / error counts per finished row."""
+
+    def __init__(self, desc: str, noun: str) -> None:
+        self.noun = noun
+        self.counts = {"solved": 0, "unsolved": 0, "error": 0}
+        self._bar = _progress_bar(desc, unit="run")
+
+    def __enter__(self) -> _RunProgress:
+        self._bar.__enter__()
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self._bar.__exit__(*exc)
+
+    def started(self, n: int, skipped: int) -> None:
+        self._bar.total = n
+        self._bar.refresh()
+        if skipped:
+            print(f"rrtpso: resuming: {skipped} {self.noun} already done", file=sys.stderr)
+
+    def row(self, row: dict[str, Any]) -> None:
+        kind = "error" if row.get("error") else ("solved" if row["solved"] else "unsolved")
+        self.counts[kind] += 1
+        self._bar.set_postfix(self.counts, refresh=False)
+        self._bar.update(1)
+
+
 def _add_batch_parser(sub: Any) -> None:
     b = sub.add_parser(
         "batch",
@@ -370,17 +399,22 @@ def _add_batch_parser(sub: Any) -> None:
     b.add_argument("--time", type=float, metavar="SECONDS", help="time limit per run (default: "
                    "each file's planner.time_limit, else 1.0)")  # fmt: skip
     b.add_argument("--runs", type=int, default=1, help="runs per problem and planner (default 1)")
-    b.add_argument("--seed", type=int, default=1, help="seed of run 0; run r uses seed + r")
-    b.add_argument("--jobs", type=int, default=1, help="parallel worker processes (default 1)")
     b.add_argument("--out", required=True, metavar="OUT.jsonl", help="results, one JSON per line")
-    b.add_argument("--resume", action="store_true", help="keep the rows already in --out")
-    b.add_argument(
-        "--param", action="append", default=[], metavar="NAME=VALUE", help="planner parameter"
-    )
+    _add_run_options(b, "the rows already in --out")
     b.add_argument("--simplify", action="store_true", help="run OMPL's simplifier after each run")
     b.add_argument("--no-path", action="store_true", help="leave the paths out of the rows")
-    _add_executor_options(b)
     b.set_defaults(func=_cmd_batch)
+
+
+def _add_run_options(p: argparse.ArgumentParser, kept: str) -> None:
+    """The options ``batch`` and ``bench`` share: seeds, parallelism, resuming, executors."""
+    p.add_argument("--seed", type=int, default=1, help="seed of run 0; run r uses seed + r")
+    p.add_argument("--jobs", type=int, default=1, help="parallel worker processes (default 1)")
+    p.add_argument("--resume", action="store_true", help=f"keep {kept}")
+    p.add_argument(
+        "--param", action="append", default=[], metavar="NAME=VALUE", help="planner parameter"
+    )
+    _add_executor_options(p)
 
 
 def _add_executor_options(p: argparse.ArgumentParser) -> None:
@@ -452,24 +486,10 @@ def _cmd_batch(args: argparse.Namespace) -> int:
         params=params, simplify=args.simplify,
         keep_path=not args.no_path,
     )  # fmt: skip
-    counts = {"solved": 0, "unsolved": 0, "error": 0}
-    with _progress_bar("batch", unit="run") as bar:
-
-        def started(n: int, skipped: int) -> None:
-            bar.total = n
-            bar.refresh()
-            if skipped:
-                print(f"rrtpso: resuming: {skipped} rows already done", file=sys.stderr)
-
-        def progress(row: dict[str, Any]) -> None:
-            kind = "error" if row.get("error") else ("solved" if row["solved"] else "unsolved")
-            counts[kind] += 1
-            bar.set_postfix(counts, refresh=False)
-            bar.update(1)
-
+    with _RunProgress("batch", "rows") as bar:
         rows = run_batch(
             tasks, args.out, jobs=args.jobs, resume=args.resume, executor=args.executor,
-            scheduler=args.scheduler, progress=progress, on_start=started,
+            scheduler=args.scheduler, progress=bar.row, on_start=bar.started,
         )  # fmt: skip
     failed = [r for r in rows if not r.get("solved")]
     for r in rows:
@@ -522,6 +542,66 @@ def _cmd_generate(args: argparse.Namespace) -> int:
         raise InputError(f"generate {args.kind}: {exc}") from None
     print(f"wrote {path}", file=sys.stderr)
     return EXIT_SOLVED
+
+
+def _add_bench_parser(sub: Any) -> None:
+    b = sub.add_parser(
+        "bench",
+        help="benchmark planners: OMPL benchmark logs, a Planner Arena database and a report",
+        description="Run every problem x time budget x planner x run in its own process with the "
+        "same collision checker, then write to --out: runs.jsonl, one OMPL benchmark log per "
+        "problem and budget (*.log), benchmark.db (built by OMPL's converter; open it in Planner "
+        "Arena), report.md, report.csv, ratio.png and success.png (docs/benchmarking.md). Exit "
+        "status 1 when a problem file was bad, 130 when interrupted (continue with --resume).",
+    )
+    b.add_argument("inputs", nargs="+", metavar="FILE|DIR|GLOB", help="problem files")
+    b.add_argument("--planners", required=True, metavar="A,B,...", help="planners to compare")
+    b.add_argument("--runs", type=int, default=10, help="runs per problem, budget and planner")
+    b.add_argument("--time", default="1", metavar="S[,S2,...]",
+                   help="time budget(s) in seconds, comma-separated (default 1)")  # fmt: skip
+    b.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    _add_run_options(b, "the runs already in DIR/runs.jsonl")
+    b.set_defaults(func=_cmd_bench)
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from .bench import run_bench
+
+    try:
+        times = [float(t) for t in args.time.split(",") if t.strip()]
+    except ValueError:
+        raise InputError(f"--time: expected seconds like 0.25,1,4, got '{args.time}'") from None
+    if not times or not all(t > 0 and math.isfinite(t) for t in times):
+        raise InputError(f"--time: every budget must be a positive number of seconds: {args.time}")
+    args.time = None
+    _check_run_options(args)
+    planners = _planner_list([args.planners], "")
+    if not planners:
+        raise InputError("--planners: name at least one planner")
+    params = _check_planners(planners, args.param, "--planners")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out: '{args.out}' exists and is not a folder")
+    _check_output(str(out / "report.md"), "--out")
+    with _RunProgress("bench", "runs") as bar:
+        result = run_bench(
+            args.inputs, planners, out, runs=args.runs, times=times, seed=args.seed,
+            params=params, jobs=args.jobs, executor=args.executor, scheduler=args.scheduler,
+            resume=args.resume, progress=bar.row, on_start=bar.started,
+        )  # fmt: skip
+    from .plotting import plot_bench, save_figure
+
+    if result.summary:
+        save_figure(plot_bench(result.summary, "ratio"), out / "ratio.png")
+        save_figure(plot_bench(result.summary, "success"), out / "success.png")
+    for e in result.errors:
+        print(f"rrtpso: {e}", file=sys.stderr)
+    print(
+        f"bench: {len(result.rows)} runs, {len(result.logs)} experiments -> {out}/ "
+        f"(benchmark.db, report.md)",
+        file=sys.stderr,
+    )
+    return EXIT_UNSOLVED if result.errors else EXIT_SOLVED
 
 
 def _add_optimum_parser(sub: Any) -> None:

@@ -34,8 +34,6 @@ from __future__ import annotations
 
 import math
 import numbers
-import os
-import tempfile
 import textwrap
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -56,7 +54,7 @@ from .problem import (
     ProblemError,
     problem_from_dict,
 )
-from .results import publish_atomic
+from .results import write_text_atomic
 from .world import World
 
 __all__ = [
@@ -395,16 +393,7 @@ def write_problem(
     if yaml.safe_load(text) != _plain(rounded):
         raise AssertionError("internal error: the formatted YAML does not read back as written")
 
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        publish_atomic(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    return write_text_atomic(text, path)
 
 
 def default_decimals(size: float) -> int:

@@ -287,14 +287,13 @@ class _TangentGraph:
         self.node_angle[0::2], self.node_angle[1::2] = ai, aj
         seg_u = np.arange(0, 2 * n_seg, 2)
         seg_w = np.hypot(*(q - p).T)
-        arc_u, arc_v, arc_a, arc_s = self._arcs()
+        arc_u, arc_v, arc_s = self._arcs()
         arc_w = self.circles[self.node_circle[arc_u], 2] * arc_s
 
         u = np.concatenate([seg_u, arc_u])
         v = np.concatenate([seg_u + 1, arc_v])
         w = np.concatenate([seg_w, arc_w])
         kind = np.concatenate([np.zeros(n_seg, int), np.ones(len(arc_u), int)])
-        del arc_a
         # Parallel edges (two arcs joining the same pair of nodes) must not be summed: keep the
         # shortest. scipy's graphs also drop explicit zeros, so zero lengths get a tiny weight.
         lo, hi = np.minimum(u, v), np.maximum(u, v)
@@ -365,8 +364,9 @@ class _TangentGraph:
         return p[keep], q[keep], ci[keep], cj[keep], ai[keep], aj[keep]
 
     # ------------------------------------------------------------------------------------------
-    def _arcs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Free arcs between angular neighbours on every circle: (u, v, start angle, sweep)."""
+    def _arcs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Free arcs between angular neighbours on every circle: (u, v, sweep), counter-clockwise
+        from node u to node v."""
         circle, angle = self.node_circle, self.node_angle
         order = np.lexsort((angle, circle))
         c_sorted, a_sorted = circle[order], angle[order]
@@ -390,7 +390,7 @@ class _TangentGraph:
         for s in range(0, len(u), chunk):
             k = slice(s, s + chunk)
             free[k] = self._arcs_free(centers[k], rho[k], a0[k], sweep[k])
-        return u[free], v[free], a0[free], sweep[free]
+        return u[free], v[free], sweep[free]
 
     def _arcs_free(
         self, center: np.ndarray, rho: np.ndarray, a0: np.ndarray, sweep: np.ndarray

@@ -6,8 +6,6 @@ failed or interrupted plot never leaves half an image behind.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -24,11 +22,12 @@ from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Polygon as PolygonPatch
 
 from .problem import Circle, Polygon, Problem
-from .results import SolveResult, publish_atomic
+from .results import SolveResult, atomic_path
 
 __all__ = [
     "animate_simulation",
     "draw_world",
+    "plot_bench",
     "plot_optimum",
     "plot_simulation",
     "plot_solution",
@@ -169,6 +168,51 @@ def plot_optimum(problem: Problem, result: Any) -> Figure:
     return fig
 
 
+def plot_bench(summary: Any, what: str = "ratio") -> Figure:
+    """Benchmark summary (:class:`~rrtpso_ompl.bench.SummaryRow` list) against the time budget:
+    ``what="ratio"`` the median path length over the optimum (quartiles shaded), ``"success"``
+    the success rate; one panel per problem, one line per planner."""
+    problems = list(dict.fromkeys(s.problem for s in summary))
+    planners = list(dict.fromkeys(s.planner for s in summary))
+    cols = min(4, max(1, len(problems)))
+    rows = -(-len(problems) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(3.6 * cols, 3.0 * rows), squeeze=False)
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for ax, problem in zip(axes.flat, problems, strict=False):
+        for i, planner in enumerate(planners):
+            mine = sorted(
+                (s for s in summary if s.problem == problem and s.planner == planner),
+                key=lambda s: s.budget,
+            )
+            c = colours[i % len(colours)]
+            t = [s.budget for s in mine]
+            if what == "success":
+                ax.plot(t, [100 * s.success for s in mine], "o-", color=c, ms=3, label=planner)
+                continue
+            pts = [(s.budget, s.median_ratio, s.q1_ratio, s.q3_ratio) for s in mine
+                   if s.median_ratio is not None]  # fmt: skip
+            if pts:
+                b, m, lo, hi = map(np.asarray, zip(*pts, strict=True))
+                ax.plot(b, m, "o-", color=c, ms=3, label=planner)
+                ax.fill_between(b, lo.astype(float), hi.astype(float), color=c, alpha=0.15)
+        ax.set_xscale("log")
+        budgets = sorted({s.budget for s in summary})
+        ax.set_xticks(budgets, [f"{b:g}" for b in budgets])
+        ax.minorticks_off()
+        ax.set_title(problem, fontsize=9)
+        ax.grid(alpha=0.3, which="both")
+        ax.set_ylabel("success (%)" if what == "success" else "length / optimum", fontsize=8)
+        ax.set_xlabel("time budget (s)", fontsize=8)
+        if what == "success":
+            ax.set_ylim(-5, 105)
+    for ax in axes.flat[len(problems) :]:
+        ax.axis("off")
+    handles, labels = axes.flat[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(planners), fontsize=8)
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    return fig
+
+
 def plot_velocities(traj: Any, units: str = "") -> Figure:
     """The paper's Figs. 17-18: v_ref and omega_ref, then the wheels' linear and angular speeds,
     against time (``traj`` is a :class:`~rrtpso_ompl.kinematics.Trajectory`)."""
@@ -199,18 +243,9 @@ def plot_velocities(traj: Any, units: str = "") -> Figure:
 
 def save_figure(fig: Figure, path: str | Path, dpi: int = 120) -> None:
     """Save ``fig`` atomically (temporary file, then rename) and close it."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(
-        prefix=f".{path.stem}.", suffix=path.suffix or ".png", dir=path.parent
-    )
-    os.close(fd)
     try:
-        fig.savefig(tmp, dpi=dpi)
-        publish_atomic(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=dpi)
     finally:
         plt.close(fig)
 
@@ -325,15 +360,8 @@ def animate_simulation(
         return [body, sensor, heading, trace, plan_line, cross, title, *obstacles, *detour_lines]
 
     anim = FuncAnimation(fig, update, frames=frames, blit=False)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".gif", dir=path.parent)
-    os.close(fd)
     try:
-        anim.save(tmp, writer=PillowWriter(fps=fps), dpi=80)
-        publish_atomic(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+        with atomic_path(path, suffix=".gif") as tmp:
+            anim.save(tmp, writer=PillowWriter(fps=fps), dpi=80)
     finally:
         plt.close(fig)

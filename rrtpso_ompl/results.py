@@ -6,13 +6,21 @@ import json
 import math
 import os
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-__all__ = ["SolveResult", "publish_atomic", "write_json_atomic"]
+__all__ = [
+    "SolveResult",
+    "atomic_path",
+    "publish_atomic",
+    "write_json_atomic",
+    "write_text_atomic",
+]
 
 
 @dataclass(frozen=True)
@@ -103,19 +111,38 @@ def publish_atomic(tmp: str | Path, path: str | Path) -> None:
     os.replace(tmp, path)
 
 
-def write_json_atomic(data: Any, path: str | Path) -> None:
-    """Write JSON through a temporary file and a rename, so a reader never sees half a file."""
+@contextmanager
+def atomic_path(path: str | Path, suffix: str | None = None) -> Iterator[str]:
+    """A temporary file name next to ``path`` to write to; renamed to ``path`` when the block ends
+    without an exception, removed otherwise. A reader never sees half a file.
+
+    The temporary name ends in ``suffix`` (default: ``path``'s), for writers that choose the
+    format by it (matplotlib, Pillow).
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=suffix or path.suffix or ".tmp",
+                               dir=path.parent)  # fmt: skip
+    os.close(fd)
     try:
-        with os.fdopen(fd, "w") as fh:
-            json.dump(data, fh, indent=2, allow_nan=False, default=_json_default)
-            fh.write("\n")
+        yield tmp
         publish_atomic(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def write_text_atomic(text: str, path: str | Path) -> Path:
+    """Write ``text`` (UTF-8, ``\\n`` line ends) atomically (see :func:`atomic_path`)."""
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="\n") as fh:
+        fh.write(text)
+    return Path(path)
+
+
+def write_json_atomic(data: Any, path: str | Path) -> None:
+    """Write JSON through a temporary file and a rename, so a reader never sees half a file."""
+    text = json.dumps(data, indent=2, allow_nan=False, default=_json_default) + "\n"
+    write_text_atomic(text, path)
 
 
 def _json_default(obj: Any) -> Any:

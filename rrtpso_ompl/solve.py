@@ -24,10 +24,15 @@ from .registry import PlannerRegistry, default_registry
 from .results import SolveResult
 from .world import World
 
-__all__ = ["DEFAULT_PLANNER", "DEFAULT_TIME_LIMIT", "solve"]
+__all__ = ["DEFAULT_PLANNER", "DEFAULT_TIME_LIMIT", "PROGRESS_PERIOD", "solve"]
 
 DEFAULT_PLANNER = "RRTstarPSO"
 DEFAULT_TIME_LIMIT = 1.0
+#: Seconds between progress samples (OMPL's ``Benchmark::Request::timeBetweenUpdates``).
+PROGRESS_PERIOD = 0.05
+
+#: The anytime planners whose termination condition is polled in the planning thread only.
+_SINGLE_THREADED_ANYTIME = (og.RRTstar, og.InformedRRTstar, og.SORRTstar, og.BITstar)
 
 _STATUS = {
     ob.PlannerStatus.EXACT_SOLUTION: "exact",
@@ -43,6 +48,7 @@ def solve(
     params: Mapping[str, Any] | None = None,
     *,
     simplify: bool = False,
+    progress: bool = False,
     registry: PlannerRegistry | None = None,
     world: World | None = None,
 ) -> SolveResult:
@@ -105,17 +111,25 @@ def solve(
     ctx.ss.setPlanner(instance)
     ctx.ss.setup()
 
+    sampler = _ProgressSampler(instance, time_limit) if progress else None
     t0 = time.perf_counter()
-    status = ctx.ss.solve(ob.timedPlannerTerminationCondition(time_limit))
+    if sampler is not None and sampler.polls:
+        sampler.t0 = t0
+        status = ctx.ss.solve(ob.PlannerTerminationCondition(sampler))
+    else:
+        status = ctx.ss.solve(ob.timedPlannerTerminationCondition(time_limit))
     elapsed = time.perf_counter() - t0
+    pdef = ctx.ss.getProblemDefinition()
     simplification_time = None
+    unsimplified: np.ndarray | None = None
+    if pdef.hasSolution():
+        unsimplified = path_to_array(pdef.getSolutionPath())
     if simplify and ctx.ss.haveExactSolutionPath():
         t1 = time.perf_counter()
         ctx.ss.simplifySolution()
         simplification_time = time.perf_counter() - t1
 
     code = status.getStatus()
-    pdef = ctx.ss.getProblemDefinition()
     path = np.empty((0, 2))
     if pdef.hasSolution():
         path = path_to_array(pdef.getSolutionPath())
@@ -136,6 +150,10 @@ def solve(
         }
     if simplification_time is not None:
         stages["simplification_time"] = simplification_time
+        stages["unsimplified_length"] = path_length(unsimplified)
+        stages["unsimplified_valid"] = bool(ctx.world.path_valid(unsimplified))
+    if sampler is not None:
+        stages["progress"] = sampler.rows(stats, elapsed, unsimplified, code)
     return SolveResult(
         problem=problem.name,
         planner=entry.name,
@@ -152,3 +170,53 @@ def solve(
         clearance=clearance,
         valid=bool(valid),
     )
+
+
+class _ProgressSampler:
+    """A termination condition that also samples the planner's best cost every
+    :data:`PROGRESS_PERIOD` seconds.
+
+    OMPL polls the condition from the planning thread, so reading ``bestCost`` here is safe; a
+    sampling thread could not run at all, since ``solve`` holds the GIL. Only planners with a
+    ``bestCost`` are given this Python condition (:attr:`polls`): PRM and PRM* evaluate their
+    condition in a second thread as well, which would wait for the GIL forever; the others run
+    with OMPL's own timed condition and get their one progress row at the end.
+    """
+
+    def __init__(self, planner: Any, time_limit: float) -> None:
+        self.time_limit = time_limit
+        self.t0 = time.perf_counter()
+        self._next = PROGRESS_PERIOD
+        self._best = getattr(planner, "bestCost", None)
+        #: Whether to poll this condition (only for single-threaded anytime planners).
+        self.polls = self._best is not None and isinstance(planner, _SINGLE_THREADED_ANYTIME)
+        self._rows: list[list[float]] = []
+
+    def __call__(self) -> bool:
+        t = time.perf_counter() - self.t0
+        if t >= self._next and self._best is not None:
+            self._next = (math.floor(t / PROGRESS_PERIOD) + 1) * PROGRESS_PERIOD
+            cost = self._best().value()
+            if math.isfinite(cost):
+                self._rows.append([t, cost])
+        return t >= self.time_limit
+
+    def rows(
+        self, stats: Any, elapsed: float, path: np.ndarray | None, code: Any
+    ) -> list[list[float]]:
+        """The best cost over time, ending with the returned path's length at ``elapsed``."""
+        rows = list(self._rows)
+        if stats is not None and hasattr(stats, "rrt_progress"):
+            # RRTstarPSO: its RRT* samples, then OMPL's simplifier, then the swarm's result.
+            rows = [list(r) for r in stats.rrt_progress]
+            if stats.simplified_length is not None:
+                rows.append([stats.rrt_time + stats.simplify_time, stats.simplified_length])
+        exact = code == ob.PlannerStatus.EXACT_SOLUTION
+        if exact and path is not None and len(path):
+            rows.append([elapsed, path_length(path)])
+        # Strictly increasing times: OMPL's database keys progress rows by (run, time).
+        out: list[list[float]] = []
+        for t, c in rows:
+            if not out or t > out[-1][0]:
+                out.append([float(t), float(c)])
+        return out

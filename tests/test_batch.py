@@ -12,9 +12,11 @@ import pytest
 from conftest import PROBLEMS, rrtpso_exe
 
 from rrtpso_ompl.batch import expand_inputs, make_tasks, read_rows, run_batch
+from rrtpso_ompl.optimum import shortest_path
+from rrtpso_ompl.problem import load_problem
 
 ROW_KEYS = {"file", "problem", "planner", "seed", "run", "status", "solved", "length", "time",
-            "path", "error"}  # fmt: skip
+            "path", "error", "budget", "optimum", "ratio"}  # fmt: skip
 
 
 def batch(*args: str, timeout: float = 240) -> subprocess.CompletedProcess:
@@ -60,6 +62,12 @@ def test_a_bad_file_is_its_row_and_the_batch_goes_on(folder, tmp_path):
     assert all("robot" in r["error"] and "c_bad.yaml" in r["error"] for r in bad)
     good = [r for r in rows if not r["file"].endswith("c_bad.yaml")]
     assert all(r["solved"] and r["error"] is None and r["length"] > 0 for r in good)
+    # Every row carries the exact optimum of its problem and its ratio to it.
+    for r in good:
+        optimum = shortest_path(load_problem(r["file"])).length
+        assert r["optimum"] == pytest.approx(optimum, rel=1e-12)
+        assert r["ratio"] == pytest.approx(r["length"] / optimum) and r["ratio"] >= 1 - 1e-9
+    assert all(r["optimum"] is None and r["ratio"] is None for r in bad)
     assert "c_bad.yaml" in proc.stderr and "Traceback" not in proc.stderr
 
 
@@ -100,7 +108,7 @@ def test_ctrl_c_leaves_a_valid_partial_file(folder, tmp_path):
     out = tmp_path / "out.jsonl"
     proc = subprocess.Popen(
         [*rrtpso_exe(), "batch", str(folder / "a_circle.yaml"), "--planner", "RRTstar",
-         "--runs", "30", "--time", "0.3", "--out", str(out)],
+         "--runs", "8", "--time", "0.2", "--out", str(out)],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
     deadline = time.monotonic() + 120
@@ -110,14 +118,15 @@ def test_ctrl_c_leaves_a_valid_partial_file(folder, tmp_path):
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err
     lines = out.read_text().splitlines()
-    assert 1 <= len(lines) < 30
+    assert 1 <= len(lines) < 8
     assert all(json.loads(line)["solved"] for line in lines)
-    # And the batch continues where it stopped.
-    again = batch(str(folder / "a_circle.yaml"), "--planner", "RRTstar", "--runs", "30", "--time",
-                  "0.05", "--out", str(out), "--resume", "--jobs", "2")  # fmt: skip
+    # And the batch continues where it stopped (the same tasks: the time limit is part of a task).
+    again = batch(str(folder / "a_circle.yaml"), "--planner", "RRTstar", "--runs", "8", "--time",
+                  "0.2", "--out", str(out), "--resume", "--jobs", "2")  # fmt: skip
     assert again.returncode in (0, 1), again.stderr
+    assert f"{len(lines)} rows already done" in again.stderr
     rows = read_rows(out)
-    assert sorted(r["seed"] for r in rows) == list(range(1, 31))
+    assert sorted(r["seed"] for r in rows) == list(range(1, 9))
 
 
 def test_dask_local_cluster_runs_the_same_batch(folder, tmp_path):

@@ -159,7 +159,9 @@ def test_replaying_the_wheels_reproduces_the_path(paper_run):
     import json
 
     kin = json.loads(out["json"].read_text())["kinematics"]
-    assert kin["open_loop_max_error"] == pytest.approx(open_loop, rel=1e-6)
+    # The CSV keeps 9 significant digits (about 1e-6 m at x = 450 m) and the replay integrates
+    # thousands of rounded samples, so the two figures agree to rounding, not to the last bit.
+    assert kin["open_loop_max_error"] == pytest.approx(open_loop, abs=1e-4)
     assert kin["tracking_max_error"] < open_loop
 
 

@@ -1,0 +1,417 @@
+"""Benchmarks in OMPL's format: every planner through the same harness, logs, database, report.
+
+``run_bench`` solves every problem x time budget x planner x run as a batch task
+(:mod:`rrtpso_ompl.batch`: one fresh process per run, seeded, with the same exact collision
+checker for every planner), then writes
+
+- ``runs.jsonl``: one row per run (the batch format, with the optimum and the ratio to it);
+- ``<problem>_<budget>s.log``: OMPL's benchmark log, one experiment per problem and budget
+  (:mod:`rrtpso_ompl.ompl_log`);
+- ``benchmark.db``: the SQLite database that Planner Arena opens, built from the logs by OMPL's
+  own converter;
+- ``report.csv`` and ``report.md``: per problem, budget and planner, the success rate, the median
+  path length over the exact optimum (:mod:`rrtpso_ompl.optimum`) and the median time;
+- ``ratio.png`` and ``success.png`` (drawn by the command line; this module draws nothing).
+
+How runs map to OMPL's properties, as Planner Arena expects them:
+
+- OMPL's stock planners are followed by OMPL's path simplifier, as in OMPL's ``Benchmark``:
+  ``time`` is the planner's, ``solution length`` its raw path, ``simplified solution length``
+  the simplified one, ``simplification time`` the simplifier's.
+- For RRTstarPSO the RRT* stage is the planner and the swarm the simplifier: ``simplification
+  time`` is the PSO's time, ``time`` the rest of the solve (the RRT* stage and OMPL's simplifier,
+  when on), so ``time + simplification time`` is the whole solve, within the budget;
+  ``solution length`` is the RRT* path and ``simplified solution length`` the PSO result. Other
+  planners of this package are not simplified.
+- Every planner gets progress rows ``time, best cost`` (see :func:`rrtpso_ompl.solve.solve`).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import re
+import socket
+import statistics
+from collections import defaultdict
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .batch import Task, make_tasks, run_batch
+from .ompl_log import Experiment, PlannerRuns, build_database, write_log
+
+__all__ = ["BenchResult", "SummaryRow", "bench_tasks", "run_bench", "summarise", "write_report"]
+
+#: Run properties of every planner, in log order.
+RUN_PROPERTIES: list[tuple[str, str]] = [
+    ("time", "REAL"),
+    ("solved", "BOOLEAN"),
+    ("status", "ENUM"),
+    ("correct solution", "BOOLEAN"),
+    ("solution length", "REAL"),
+    ("simplified solution length", "REAL"),
+    ("simplification time", "REAL"),
+    ("total time", "REAL"),
+    ("solution clearance", "REAL"),
+    ("length over optimum", "REAL"),
+    ("seed", "INTEGER"),
+]
+PROGRESS_PROPERTIES: list[tuple[str, str]] = [("time", "REAL"), ("best cost", "REAL")]
+
+
+def is_stock(planner: str) -> bool:
+    """Whether ``planner`` is one of OMPL's own (simplified after the run, as OMPL does)."""
+    from .registry import default_registry
+
+    return default_registry().get(planner).source.endswith(".ompl_geometric")
+
+
+def bench_tasks(
+    items: Sequence[str],
+    planners: Sequence[str],
+    runs: int,
+    times: Sequence[float],
+    seed: int = 1,
+    params: Mapping[str, Mapping[str, Any]] | None = None,
+) -> list[Task]:
+    """Every problem x budget x planner x run (run ``r`` seeded ``seed + r`` at every budget)."""
+    tasks = []
+    for budget in times:
+        tasks += make_tasks(items, planners, runs=runs, seed=seed, time_limit=budget,
+                            params=params, simplify=is_stock, keep_path=False,
+                            progress=True)  # fmt: skip
+    return tasks
+
+
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class SummaryRow:
+    """One line of the report: a planner on a problem at a budget.
+
+    Lengths are in problem units, times in seconds; ratios are over the exact optimum.
+    """
+
+    problem: str
+    budget: float
+    planner: str
+    runs: int
+    solved: int
+    success: float
+    optimum: float | None
+    median_length: float | None
+    median_ratio: float | None
+    q1_ratio: float | None
+    q3_ratio: float | None
+    best_ratio: float | None
+    median_raw_ratio: float | None
+    median_time: float | None
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+@dataclass
+class BenchResult:
+    """What :func:`run_bench` produced."""
+
+    rows: list[dict[str, Any]]
+    summary: list[SummaryRow]
+    out_dir: Path
+    logs: list[Path] = field(default_factory=list)
+    database: Path | None = None
+    errors: list[str] = field(default_factory=list)
+
+
+def run_bench(
+    items: Sequence[str],
+    planners: Sequence[str],
+    out_dir: str | Path,
+    *,
+    runs: int = 10,
+    times: Sequence[float] = (1.0,),
+    seed: int = 1,
+    params: Mapping[str, Mapping[str, Any]] | None = None,
+    jobs: int = 1,
+    executor: str = "local",
+    scheduler: Any = None,
+    resume: bool = False,
+    progress: Callable[[dict[str, Any]], None] | None = None,
+    on_start: Callable[[int, int], None] | None = None,
+) -> BenchResult:
+    """Run a benchmark and write its results to ``out_dir`` (see the module docstring).
+
+    Parameters
+    ----------
+    items : sequence of str
+        Problem files, directories or glob patterns.
+    planners : sequence of str
+        Registered planner names.
+    out_dir : path
+        Output folder (created).
+    runs : int
+        Runs per problem, budget and planner.
+    times : sequence of float
+        Time budgets, seconds; one experiment per problem and budget.
+    seed, params, jobs, executor, scheduler, resume, progress, on_start
+        As for :func:`rrtpso_ompl.batch.run_batch` and :func:`~rrtpso_ompl.batch.make_tasks`.
+
+    Returns
+    -------
+    BenchResult
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    tasks = bench_tasks(items, planners, runs, times, seed, params)
+    rows = run_batch(tasks, out / "runs.jsonl", jobs=jobs, resume=resume, executor=executor,
+                     scheduler=scheduler, progress=progress, on_start=on_start)  # fmt: skip
+    errors = sorted({r["error"] for r in rows if r.get("error")})
+    good = [r for r in rows if not r.get("error")]
+    experiments = to_experiments(good, planners, runs, seed)
+    for stale in out.glob("*.log"):  # from an earlier bench into the same folder
+        stale.unlink()
+    logs = [write_log(e, out / f"{e.name}.log") for e in experiments]
+    database = build_database(logs, out / "benchmark.db") if logs else None
+    summary = summarise(good, planners)
+    write_report(summary, out, errors=errors, command=None)
+    return BenchResult(rows, summary, out, logs, database, errors)
+
+
+# ----------------------------------------------------------------------------------------------
+# Rows -> OMPL experiments
+# ----------------------------------------------------------------------------------------------
+def run_properties(row: Mapping[str, Any]) -> dict[str, Any]:
+    """One batch row as OMPL run properties (see the module docstring for the mapping)."""
+    st = row.get("stages") or {}
+    solved = bool(row.get("solved"))
+    final = row.get("length") if solved else None
+    if "pso_length" in st:  # RRTstarPSO: the swarm is its simplifier
+        total = row.get("time")
+        simp_time = st.get("pso_time")
+        plan_time = None if total is None else total - (simp_time or 0.0)
+        raw = st.get("rrt_length")
+        simplified = final
+    elif "unsimplified_length" in st:  # a stock planner and OMPL's simplifier
+        plan_time = row.get("time")
+        raw = st.get("unsimplified_length")
+        simplified, simp_time = final, st.get("simplification_time")
+        total = (plan_time or 0.0) + (simp_time or 0.0)
+    else:
+        plan_time, raw, simplified, simp_time = row.get("time"), final, None, None
+        total = plan_time
+    optimum = row.get("optimum")
+    return {
+        "time": plan_time,
+        "solved": solved,
+        "status": row.get("ompl_status") or "Unknown status",
+        "correct solution": bool(row.get("valid")),
+        "solution length": raw if row.get("status") in ("exact", "approximate") else None,
+        "simplified solution length": simplified,
+        "simplification time": simp_time,
+        "total time": total,
+        "solution clearance": row.get("clearance") if solved else None,
+        "length over optimum": final / optimum if final is not None and optimum else None,
+        "seed": row.get("seed"),
+    }
+
+
+def _experiment_name(problem: str, budget: float) -> str:
+    word = re.sub(r"[^A-Za-z0-9_.-]+", "_", problem or "problem")
+    return f"{word}_{budget:g}s"
+
+
+def to_experiments(
+    rows: Iterable[Mapping[str, Any]],
+    planners: Sequence[str],
+    runs: int,
+    seed: int,
+) -> list[Experiment]:
+    """Group rows (not error rows) into one experiment per problem and budget."""
+    groups: dict[tuple[str, float], list[Mapping[str, Any]]] = defaultdict(list)
+    for r in rows:
+        groups[(r["file"], float(r.get("budget") or r.get("time_limit") or 0.0))].append(r)
+    names: dict[str, int] = {}
+    experiments = []
+    host = re.sub(r"\s+", "_", socket.gethostname()) or "localhost"
+    for (file, budget), group in sorted(groups.items(), key=lambda kv: (kv[0][1], kv[0][0])):
+        name = _experiment_name(group[0].get("problem") or Path(file).stem, budget)
+        names[name] = names.get(name, 0) + 1
+        if names[name] > 1:  # two files with the same problem name
+            name = f"{name}_{names[name]}"
+        blocks = []
+        for planner in planners:
+            mine = sorted((r for r in group if r["planner"] == planner), key=lambda r: r["seed"])
+            if not mine:
+                continue
+            # The configuration, not the run: the seed and the budget are run/experiment data.
+            settings = {
+                k: v
+                for k, v in (mine[0].get("params") or {}).items()
+                if v is not None and k not in ("seed", "budget")
+            }
+            blocks.append(
+                PlannerRuns(
+                    name=planner,
+                    settings=settings,
+                    run_properties=RUN_PROPERTIES,
+                    runs=[run_properties(r) for r in mine],
+                    progress_properties=PROGRESS_PROPERTIES,
+                    progress=[
+                        [tuple(p) for p in (r.get("stages") or {}).get("progress", [])]
+                        for r in mine
+                    ],
+                )
+            )
+        optimum = group[0].get("optimum")
+        props: dict[str, object] = {"time budget": float(budget)}
+        if optimum is not None:
+            props["optimum"] = float(optimum)
+        experiments.append(
+            Experiment(
+                name=name,
+                planners=blocks,
+                time_limit=float(budget),
+                run_count=runs,
+                seed=seed,
+                total_time=sum(r.get("wall") or 0.0 for r in group),
+                host=host,
+                setup=f"problem file: {file}\nplanners: {', '.join(planners)}\n"
+                "harness: rrtpso_ompl.bench (one process per run, exact collision checks)",
+                properties=props,
+            )
+        )
+    return experiments
+
+
+# ----------------------------------------------------------------------------------------------
+# Report
+# ----------------------------------------------------------------------------------------------
+def _median(xs: list[float]) -> float | None:
+    return statistics.median(xs) if xs else None
+
+
+def _quartiles(xs: list[float]) -> tuple[float | None, float | None]:
+    if len(xs) < 2:
+        return (xs[0], xs[0]) if xs else (None, None)
+    q = statistics.quantiles(xs, n=4, method="inclusive")
+    return q[0], q[2]
+
+
+def summarise(rows: Iterable[Mapping[str, Any]], planners: Sequence[str]) -> list[SummaryRow]:
+    """Per problem, budget and planner: success rate, length over optimum, time."""
+    groups: dict[tuple[str, float, str], list[Mapping[str, Any]]] = defaultdict(list)
+    for r in rows:
+        if r.get("error"):
+            continue
+        budget = float(r.get("budget") or r.get("time_limit") or 0.0)
+        groups[(r.get("problem") or r["file"], budget, r["planner"])].append(r)
+    order = {p: i for i, p in enumerate(planners)}
+    out = []
+    for (problem, budget, planner), group in sorted(
+        groups.items(), key=lambda kv: (kv[0][0], kv[0][1], order.get(kv[0][2], 99))
+    ):
+        props = [run_properties(r) for r in group]
+        ok = [r for r in group if r.get("solved")]
+        optimum = group[0].get("optimum")
+        ratios = sorted(p["length over optimum"] for p in props if p["length over optimum"])
+        raw = sorted(
+            p["solution length"] / optimum
+            for p in props
+            if optimum and p["solved"] and p["solution length"] is not None
+        )
+        q1, q3 = _quartiles(ratios)
+        out.append(
+            SummaryRow(
+                problem=problem,
+                budget=budget,
+                planner=planner,
+                runs=len(group),
+                solved=len(ok),
+                success=len(ok) / len(group),
+                optimum=optimum,
+                median_length=_median([r["length"] for r in ok]),
+                median_ratio=_median(ratios),
+                q1_ratio=q1,
+                q3_ratio=q3,
+                best_ratio=ratios[0] if ratios else None,
+                median_raw_ratio=_median(raw),
+                median_time=_median([p["total time"] for p in props if p["total time"]]),
+            )
+        )
+    return out
+
+
+def write_report(
+    summary: Sequence[SummaryRow],
+    out_dir: str | Path,
+    *,
+    errors: Sequence[str] = (),
+    command: str | None = None,
+) -> tuple[Path, Path]:
+    """Write ``report.csv`` (every column) and ``report.md`` (one table per budget)."""
+    out = Path(out_dir)
+    csv_path, md_path = out / "report.csv", out / "report.md"
+    fields = list(SummaryRow.__dataclass_fields__)
+    with csv_path.open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields)
+        w.writeheader()
+        for s in summary:
+            w.writerow({k: "" if v is None else v for k, v in s.to_dict().items()})
+    md_path.write_text(report_markdown(summary, errors=errors, command=command))
+    return csv_path, md_path
+
+
+def _fmt(x: float | None, spec: str = ".3f") -> str:
+    return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
+
+
+def report_markdown(
+    summary: Sequence[SummaryRow], *, errors: Sequence[str] = (), command: str | None = None
+) -> str:
+    """The report as markdown: per budget, a table of problems x planners."""
+    lines = ["# Benchmark report", ""]
+    if command:
+        lines += [f"Command: `{command}`", ""]
+    lines += [
+        "Cells: median path length over the exact optimum (first and third quartile) "
+        "[success rate], median time in seconds (planning plus simplification or PSO). "
+        "The optimum comes from `rrtpso optimum`.",
+        "",
+    ]
+    planners = list(dict.fromkeys(s.planner for s in summary))
+    for budget in sorted({s.budget for s in summary}):
+        cells = {(s.problem, s.planner): s for s in summary if s.budget == budget}
+        problems = list(dict.fromkeys(s.problem for s in summary if s.budget == budget))
+        lines += [f"## Budget {budget:g} s", ""]
+        lines.append("| problem | optimum | " + " | ".join(planners) + " |")
+        lines.append("|---|---:|" + "---:|" * len(planners))
+        for problem in problems:
+            opt = next((s.optimum for s in summary if s.problem == problem), None)
+            row = [problem, _fmt(opt, ".2f")]
+            for planner in planners:
+                s = cells.get((problem, planner))
+                if s is None:
+                    row.append("")
+                    continue
+                row.append(
+                    f"{_fmt(s.median_ratio, '.4f')} ({_fmt(s.q1_ratio, '.3f')}–"
+                    f"{_fmt(s.q3_ratio, '.3f')}) [{s.success:.0%}], {_fmt(s.median_time, '.2f')}"
+                )
+            lines.append("| " + " | ".join(row) + " |")
+        # The across-problem view a reader wants first: which planner, how far from optimal.
+        lines += ["", "| planner | median ratio over problems | success | median time |",
+                  "|---|---:|---:|---:|"]  # fmt: skip
+        for planner in planners:
+            mine = [s for s in summary if s.budget == budget and s.planner == planner]
+            meds = [s.median_ratio for s in mine if s.median_ratio is not None]
+            succ = sum(s.solved for s in mine) / max(1, sum(s.runs for s in mine))
+            times = [s.median_time for s in mine if s.median_time is not None]
+            lines.append(
+                f"| {planner} | {_fmt(_median(meds), '.4f')} | {succ:.0%} | "
+                f"{_fmt(_median(times), '.2f')} |"
+            )
+        lines.append("")
+    if errors:
+        lines += ["## Errors", ""] + [f"- {e}" for e in errors] + [""]
+    return "\n".join(lines)
