@@ -139,6 +139,7 @@ def run_bench(
     resume: bool = False,
     progress: Callable[[dict[str, Any]], None] | None = None,
     on_start: Callable[[int, int], None] | None = None,
+    command: str | None = None,
 ) -> BenchResult:
     """Run a benchmark and write its results to ``out_dir`` (see the module docstring).
 
@@ -156,6 +157,8 @@ def run_bench(
         Time budgets, seconds; one experiment per problem and budget.
     seed, params, jobs, executor, scheduler, resume, progress, on_start
         As for :func:`rrtpso_ompl.batch.run_batch` and :func:`~rrtpso_ompl.batch.make_tasks`.
+    command : str, optional
+        The command line that ran the benchmark, quoted at the top of ``report.md``.
 
     Returns
     -------
@@ -174,7 +177,7 @@ def run_bench(
     logs = [write_log(e, out / f"{e.name}.log") for e in experiments]
     database = build_database(logs, out / "benchmark.db") if logs else None
     summary = summarise(good, planners)
-    write_report(summary, out, errors=errors, command=None)
+    write_report(summary, out, errors=errors, command=command)
     return BenchResult(rows, summary, out, logs, database, errors)
 
 

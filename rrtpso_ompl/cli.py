@@ -11,6 +11,7 @@ import json
 import logging
 import math
 import os
+import shlex
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -168,6 +169,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     parser = _build_parser()
     args = parser.parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)
     logging.basicConfig(
         level=logging.INFO if getattr(args, "verbose", 0) else logging.WARNING,
         format="%(levelname)s: %(name)s: %(message)s",
@@ -588,6 +590,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
             args.inputs, planners, out, runs=args.runs, times=times, seed=args.seed,
             params=params, jobs=args.jobs, executor=args.executor, scheduler=args.scheduler,
             resume=args.resume, progress=bar.row, on_start=bar.started,
+            command="rrtpso " + shlex.join(args.argv),
         )  # fmt: skip
     from .plotting import plot_bench, save_figure
 

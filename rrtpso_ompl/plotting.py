@@ -168,10 +168,15 @@ def plot_optimum(problem: Problem, result: Any) -> Figure:
     return fig
 
 
+#: Lowest excess over the optimum that :func:`plot_bench` draws, in percent (log axis).
+EXCESS_FLOOR = 1e-3
+
+
 def plot_bench(summary: Any, what: str = "ratio") -> Figure:
     """Benchmark summary (:class:`~rrtpso_ompl.bench.SummaryRow` list) against the time budget:
-    ``what="ratio"`` the median path length over the optimum (quartiles shaded), ``"success"``
-    the success rate; one panel per problem, one line per planner."""
+    ``what="ratio"`` the median excess length over the optimum, ``100 (length / optimum - 1)``
+    in percent on a log axis (quartiles shaded), ``"success"`` the success rate; one panel per
+    problem, one line per planner."""
     problems = list(dict.fromkeys(s.problem for s in summary))
     planners = list(dict.fromkeys(s.planner for s in summary))
     cols = min(4, max(1, len(problems)))
@@ -192,19 +197,24 @@ def plot_bench(summary: Any, what: str = "ratio") -> Figure:
             pts = [(s.budget, s.median_ratio, s.q1_ratio, s.q3_ratio) for s in mine
                    if s.median_ratio is not None]  # fmt: skip
             if pts:
-                b, m, lo, hi = map(np.asarray, zip(*pts, strict=True))
+                # Excess in percent on a log axis: a planner 20 % off and one 0.01 % off are both
+                # readable in the same panel. The floor keeps exact optima on the axis.
+                b, m, lo, hi = (np.asarray(v, dtype=float) for v in zip(*pts, strict=True))
+                m, lo, hi = (np.maximum(100 * (v - 1), EXCESS_FLOOR) for v in (m, lo, hi))
                 ax.plot(b, m, "o-", color=c, ms=3, label=planner)
-                ax.fill_between(b, lo.astype(float), hi.astype(float), color=c, alpha=0.15)
+                ax.fill_between(b, lo, hi, color=c, alpha=0.15)
         ax.set_xscale("log")
         budgets = sorted({s.budget for s in summary})
         ax.set_xticks(budgets, [f"{b:g}" for b in budgets])
         ax.minorticks_off()
         ax.set_title(problem, fontsize=9)
-        ax.grid(alpha=0.3, which="both")
-        ax.set_ylabel("success (%)" if what == "success" else "length / optimum", fontsize=8)
+        ax.grid(alpha=0.3)
+        ax.set_ylabel("success (%)" if what == "success" else "over optimum (%)", fontsize=8)
         ax.set_xlabel("time budget (s)", fontsize=8)
         if what == "success":
             ax.set_ylim(-5, 105)
+        else:
+            ax.set_yscale("log")
     for ax in axes.flat[len(problems) :]:
         ax.axis("off")
     handles, labels = axes.flat[0].get_legend_handles_labels()

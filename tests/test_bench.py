@@ -63,6 +63,8 @@ def test_writes_every_output_and_reports_the_bad_file(bench_dir):
     report = (out / "report.md").read_text()
     assert "## Budget 0.1 s" in report and "## Budget 0.2 s" in report
     assert "| single_circle | 647.46 |" in report and "bad.yaml" in report
+    # The report names the command that made it, so it can be reproduced.
+    assert "Command: `rrtpso bench " in report and "--time 0.1,0.2" in report
 
 
 def test_database_has_one_experiment_per_budget_and_the_optimum(bench_dir):
