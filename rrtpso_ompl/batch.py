@@ -325,7 +325,7 @@ def run_batch(
         Called as ``on_start(n_to_run, n_skipped)`` before the first task starts.
     optimum : bool
         Add ``optimum`` (the exact shortest length, :mod:`rrtpso_ompl.optimum`, computed once per
-        file in this process) and ``ratio`` (``length / optimum``) to every row.
+        file in this process) and ``ratio`` (``length / optimum``, null unless solved) to every row.
 
     Returns
     -------
@@ -389,7 +389,9 @@ class _Optima:
     def annotate(self, row: dict[str, Any]) -> None:
         opt = None if row.get("error") else self.length(row["file"])
         row["optimum"] = opt
-        length = row.get("length")
+        # Only a solved path has a ratio: an approximate one stops short of the goal and can be
+        # shorter than the optimum.
+        length = row.get("length") if row.get("solved") else None
         row["ratio"] = length / opt if length is not None and opt else None
 
 

@@ -388,8 +388,8 @@ def _add_batch_parser(sub: Any) -> None:
         help="solve many problem files in parallel, streaming JSON lines",
         description="Solve every problem file x planner x run in its own process and stream one "
         "JSON row per run to --out as it finishes. A bad file becomes an error row and the batch "
-        "goes on; exit status 1 when any row failed, 130 when interrupted (the file stays valid: "
-        "continue it with --resume).",
+        "goes on; exit status 1 when any row is unsolved or an error, 130 when interrupted (the "
+        "file stays valid: continue it with --resume).",
     )
     b.add_argument("inputs", nargs="+", metavar="FILE|DIR|GLOB", help="problem files")
     b.add_argument(

@@ -142,3 +142,38 @@ def test_dask_local_cluster_runs_the_same_batch(folder, tmp_path):
     assert sum(bool(r["error"]) for r in rows) == 2
     assert all(r["solved"] for r in rows if not r["error"])
     assert len(read_rows(tmp_path / "d.jsonl")) == 4
+
+
+def test_only_a_solved_row_gets_a_ratio():
+    """An approximate path stops short of the goal, so it can be shorter than the optimum: it
+    gets the optimum but no ratio (seen on the maze at 0.2 s: ratio 0.39 before the fix)."""
+    from rrtpso_ompl.batch import _Optima
+
+    maze = str(PROBLEMS / "static" / "maze.yaml")
+    optima = _Optima()
+    approximate = {"file": maze, "error": None, "solved": False, "length": 79.2}
+    solved = {"file": maze, "error": None, "solved": True, "length": 210.0}
+    for row in (approximate, solved):
+        optima.annotate(row)
+    assert approximate["optimum"] == pytest.approx(204.30, abs=0.01)
+    assert approximate["ratio"] is None
+    assert solved["ratio"] == pytest.approx(210.0 / solved["optimum"])
+
+
+def test_an_unsolvable_file_is_an_unsolved_row_and_exit_1(tmp_path):
+    """A wall across the whole workspace: a valid file with no path. Its row says so honestly
+    (not solved, no error, no optimum) and the batch exits 1."""
+    wall = tmp_path / "wall.yaml"
+    wall.write_text(
+        "bounds: [[0, 0], [100, 100]]\nstart: [50, 10]\ngoal: [50, 90]\nrobot: {radius: 2}\n"
+        "obstacles:\n  - {type: rectangle, min: [0, 45], max: [100, 55]}\n"
+    )
+    out = tmp_path / "out.jsonl"
+    proc = batch(str(wall), str(PROBLEMS / "static" / "single_circle.yaml"),
+                 "--planner", "RRTConnect", "--time", "0.1", "--out", str(out))  # fmt: skip
+    assert proc.returncode == 1, proc.stderr
+    rows = {r["problem"]: r for r in read_rows(out)}
+    assert rows["single_circle"]["solved"]
+    walled = next(r for name, r in rows.items() if name != "single_circle")
+    assert not walled["solved"] and walled["error"] is None
+    assert walled["optimum"] is None and walled["ratio"] is None
