@@ -42,7 +42,16 @@ from typing import Any
 from .batch import Task, make_tasks, run_batch
 from .ompl_log import Experiment, PlannerRuns, build_database, write_log
 
-__all__ = ["BenchResult", "SummaryRow", "bench_tasks", "run_bench", "summarise", "write_report"]
+__all__ = [
+    "BenchResult",
+    "SummaryRow",
+    "bench_tasks",
+    "overview_markdown",
+    "read_report_csv",
+    "run_bench",
+    "summarise",
+    "write_report",
+]
 
 #: Run properties of every planner, in log order.
 RUN_PROPERTIES: list[tuple[str, str]] = [
@@ -345,6 +354,16 @@ def summarise(rows: Iterable[Mapping[str, Any]], planners: Sequence[str]) -> lis
     return out
 
 
+def read_report_csv(path: str | Path) -> list[SummaryRow]:
+    """The summary back from a ``report.csv`` written by :func:`write_report`."""
+    types = {"problem": str, "planner": str, "runs": int, "solved": int}
+    with Path(path).open(newline="") as fh:
+        return [
+            SummaryRow(**{k: None if v == "" else types.get(k, float)(v) for k, v in r.items()})
+            for r in csv.DictReader(fh)
+        ]
+
+
 def write_report(
     summary: Sequence[SummaryRow],
     out_dir: str | Path,
@@ -369,15 +388,95 @@ def _fmt(x: float | None, spec: str = ".3f") -> str:
     return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
 
 
+def _excess(ratio: float | None) -> str:
+    """A ratio over the optimum as the excess in percent: 1.0017 -> "+0.17 %"."""
+    return "–" if ratio is None else f"+{100 * (ratio - 1):.2f} %"
+
+
+def overview_markdown(summary: Sequence[SummaryRow]) -> str:
+    """The across-problem view a reader wants first: which planner, how far from optimal.
+
+    Three parts, each over all problems: per planner and budget, the median of the per-problem
+    median excess over the optimum with the success rate over all runs and the median time; the
+    same excess before simplification (``solution length`` in the log: RRTstarPSO's RRT* stage, a
+    stock planner's raw path); and the cells in which the first planner is not the shortest.
+    """
+    planners = list(dict.fromkeys(s.planner for s in summary))
+    budgets = sorted({s.budget for s in summary})
+
+    def cells(planner: str, budget: float) -> list[SummaryRow]:
+        return [s for s in summary if s.planner == planner and s.budget == budget]
+
+    head = "| planner | " + " | ".join(f"{b:g} s" for b in budgets) + " |"
+    rule = "|---|" + "---|" * len(budgets)
+    final, raw = [head, rule], [head, rule]
+    for planner in planners:
+        row, raw_row = [planner], [planner]
+        for budget in budgets:
+            mine = cells(planner, budget)
+            runs = sum(s.runs for s in mine)
+            ratio = _median([s.median_ratio for s in mine if s.median_ratio is not None])
+            time = _median([s.median_time for s in mine if s.median_time is not None])
+            success = sum(s.solved for s in mine) / runs if runs else 0.0
+            row.append(f"{_excess(ratio)}, {success:.0%}, {_fmt(time, '.2f')} s")
+            raw_row.append(
+                _excess(_median([s.median_raw_ratio for s in mine if s.median_raw_ratio]))
+            )
+        final.append("| " + " | ".join(row) + " |")
+        raw.append("| " + " | ".join(raw_row) + " |")
+    first = planners[0] if planners else ""
+    beaten, total = [], 0
+    for budget in budgets:
+        for problem in dict.fromkeys(s.problem for s in summary if s.budget == budget):
+            cell = {s.planner: s.median_ratio for s in summary
+                    if s.budget == budget and s.problem == problem and s.median_ratio}  # fmt: skip
+            if not cell:
+                continue
+            total += 1
+            best = min(cell, key=cell.__getitem__)
+            if first not in cell:
+                beaten.append(f"- {budget:g} s, {problem}: {best}; {first} solved no run")
+                continue
+            if best != first:
+                margin = 100 * (cell[first] - cell[best])
+                beaten.append(
+                    f"- {budget:g} s, {problem}: {best}, shorter by {margin:.3f} % of the optimum"
+                )
+    return "\n".join(
+        [
+            "## Overview",
+            "",
+            "Per planner and budget, over all problems: the median of each problem's median "
+            "excess length over the exact optimum, the success rate over all runs, and the median "
+            "of each problem's median time (planning plus simplification or PSO).",
+            "",
+            *final,
+            "",
+            "The same excess before simplification (`solution length` in the log: RRTstarPSO's "
+            "RRT* stage, a stock planner's raw path):",
+            "",
+            *raw,
+            "",
+            f"{first} has the shortest median path in {total - len(beaten)} of {total} problem x "
+            "budget cells. In the others, the shortest median path was:",
+            "",
+            *(beaten or ["- none"]),
+            "",
+        ]
+    )
+
+
 def report_markdown(
     summary: Sequence[SummaryRow], *, errors: Sequence[str] = (), command: str | None = None
 ) -> str:
-    """The report as markdown: per budget, a table of problems x planners."""
+    """The report as markdown: the :func:`overview_markdown`, then per budget a table of
+    problems x planners."""
     lines = ["# Benchmark report", ""]
     if command:
         lines += [f"Command: `{command}`", ""]
+    lines += [overview_markdown(summary), ""]
     lines += [
-        "Cells: median path length over the exact optimum (first and third quartile) "
+        "Cells below: median path length over the exact optimum (first and third quartile) "
         "[success rate], median time in seconds (planning plus simplification or PSO). "
         "The optimum comes from `rrtpso optimum`.",
         "",
@@ -402,18 +501,6 @@ def report_markdown(
                     f"{_fmt(s.q3_ratio, '.3f')}) [{s.success:.0%}], {_fmt(s.median_time, '.2f')}"
                 )
             lines.append("| " + " | ".join(row) + " |")
-        # The across-problem view a reader wants first: which planner, how far from optimal.
-        lines += ["", "| planner | median ratio over problems | success | median time |",
-                  "|---|---:|---:|---:|"]  # fmt: skip
-        for planner in planners:
-            mine = [s for s in summary if s.budget == budget and s.planner == planner]
-            meds = [s.median_ratio for s in mine if s.median_ratio is not None]
-            succ = sum(s.solved for s in mine) / max(1, sum(s.runs for s in mine))
-            times = [s.median_time for s in mine if s.median_time is not None]
-            lines.append(
-                f"| {planner} | {_fmt(_median(meds), '.4f')} | {succ:.0%} | "
-                f"{_fmt(_median(times), '.2f')} |"
-            )
         lines.append("")
     if errors:
         lines += ["## Errors", ""] + [f"- {e}" for e in errors] + [""]

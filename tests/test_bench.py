@@ -233,3 +233,21 @@ def test_solve_records_progress_for_every_kind_of_planner(planner):
         assert result.length <= result.stages["unsimplified_length"] + 1e-9
     else:
         assert costs[-1] == pytest.approx(result.length)
+
+
+def test_overview_counts_the_cells_the_first_planner_loses():
+    from rrtpso_ompl.bench import SummaryRow, overview_markdown
+
+    def row(problem, planner, ratio, solved=10):
+        return SummaryRow(problem, 1.0, planner, 10, solved, solved / 10, 100.0, None, ratio,
+                          None, None, ratio, ratio, 1.0)  # fmt: skip
+
+    text = overview_markdown([
+        row("a", "Ours", 1.001), row("a", "Theirs", 1.002),  # we win
+        row("b", "Ours", 1.003), row("b", "Theirs", 1.002),  # they win by 0.1 %
+        row("c", "Ours", None, solved=0), row("c", "Theirs", 1.5),  # we solve nothing
+    ])  # fmt: skip
+    assert "Ours has the shortest median path in 1 of 3 problem x budget cells" in text
+    assert "- 1 s, b: Theirs, shorter by 0.100 % of the optimum" in text
+    assert "- 1 s, c: Theirs; Ours solved no run" in text
+    assert "| Ours | +0.20 %, 67%, 1.00 s |" in text  # median of 1.001 and 1.003; 20 of 30 runs

@@ -1,0 +1,32 @@
+"""The measured figures in the docs are the benchmark's own output, not numbers typed by hand."""
+
+from __future__ import annotations
+
+from conftest import REPO as ROOT
+
+from rrtpso_ompl.bench import overview_markdown, read_report_csv
+
+DOCS = ROOT / "docs"
+
+
+def _overview() -> list[str]:
+    return overview_markdown(read_report_csv(DOCS / "bench" / "report.csv")).splitlines()
+
+
+def test_committed_report_opens_with_the_overview_of_its_csv():
+    assert "\n".join(_overview()) in (DOCS / "bench" / "report.md").read_text()
+
+
+def test_benchmarking_guide_quotes_the_overview_verbatim():
+    guide = {line.strip() for line in (DOCS / "benchmarking.md").read_text().splitlines()}
+    quoted = [line for line in _overview() if line.startswith(("|", "- "))]
+    assert len(quoted) > 20  # both tables and the list of cells
+    missing = [line for line in quoted if line not in guide]
+    assert not missing, f"docs/benchmarking.md differs from docs/bench/report.csv: {missing}"
+
+
+def test_readme_table_is_the_overview_table():
+    overview = _overview()
+    first = overview.index(next(line for line in overview if line.startswith("| planner")))
+    table = overview[first : overview.index("", first)]
+    assert "\n".join(table) in (ROOT / "README.md").read_text()
