@@ -30,3 +30,26 @@ def test_readme_table_is_the_overview_table():
     first = overview.index(next(line for line in overview if line.startswith("| planner")))
     table = overview[first : overview.index("", first)]
     assert "\n".join(table) in (ROOT / "README.md").read_text()
+
+
+def test_dynamic_guide_quotes_the_dynamic_benchmark():
+    """docs/dynamic.md's table repeats docs/dynamic-benchmark.md (written by
+    benchmarks/dynamic.py): success, collisions, overhead, replans and planning times."""
+    generated = {}
+    for line in (DOCS / "dynamic-benchmark.md").read_text().splitlines():
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        if cells[0] in ("contour", "global"):
+            generated[cells[0]] = cells
+    guide = (DOCS / "dynamic.md").read_text().splitlines()
+    assert set(generated) == {"contour", "global"}
+    for strategy, c in generated.items():
+        row = next(line for line in guide if line.startswith(f"| {strategy} ("))
+        median, p90 = (c[i].split(" ")[0] for i in (6, 7))
+        expected = [
+            f"| {c[3]} / {c[2]} |",  # success of runs
+            f"| {c[5]} |",  # runs with a collision
+            f"| {median} % / {p90} % |",
+            f"| {c[8]} |",  # replans per run
+            f"{float(c[12]):.2f} s median, {float(c[13]):.2f} s max",
+        ]
+        assert all(e in row for e in expected), (strategy, row, expected)
