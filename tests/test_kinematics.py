@@ -4,6 +4,7 @@ profile and its limits, the CSV the command line writes, and tracking."""
 from __future__ import annotations
 
 import csv
+import json
 import math
 import subprocess
 from dataclasses import replace
@@ -148,7 +149,7 @@ def test_limits_are_never_exceeded_and_clearance_is_kept(paper_run):
 
 def test_replaying_the_wheels_reproduces_the_path(paper_run):
     """Euler integration of the CSV's wheel speeds (corrected eqs. 1-3) stays within 2% of the
-    path length, and the tracking controller does better still."""
+    path length, and the tracking controller stays within 0.2% of it."""
     _, rows, out = paper_run
     c = columns(rows)
     x, y = c["x"], c["y"]
@@ -156,13 +157,14 @@ def test_replaying_the_wheels_reproduces_the_path(paper_run):
     length = np.hypot(np.diff(x), np.diff(y)).sum()
     open_loop = np.hypot(poses[:, 0] - x, poses[:, 1] - y).max()
     assert open_loop <= 0.02 * length
-    import json
-
     kin = json.loads(out["json"].read_text())["kinematics"]
-    # The CSV keeps 9 significant digits (about 1e-6 m at x = 450 m) and the replay integrates
+    # The CSV keeps 9 significant digits (about 1e-6 cm at x = 450 cm) and the replay integrates
     # thousands of rounded samples, so the two figures agree to rounding, not to the last bit.
     assert kin["open_loop_max_error"] == pytest.approx(open_loop, abs=1e-4)
-    assert kin["tracking_max_error"] < open_loop
+    # The closed loop stays at the discretisation floor of the same size as the open-loop drift
+    # (seeds 1-8: 0.44-0.61 cm against 0.57-0.76 cm open loop; not always below it); its real
+    # job, recovering from a disturbance, is tested below.
+    assert kin["tracking_max_error"] <= 0.002 * length
 
 
 def test_reference_curve_is_certified_and_tightens_or_falls_back():
