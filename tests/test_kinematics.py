@@ -161,9 +161,9 @@ def test_replaying_the_wheels_reproduces_the_path(paper_run):
     # The CSV keeps 9 significant digits (about 1e-6 cm at x = 450 cm) and the replay integrates
     # thousands of rounded samples, so the two figures agree to rounding, not to the last bit.
     assert kin["open_loop_max_error"] == pytest.approx(open_loop, abs=1e-4)
-    # The closed loop stays at the discretisation floor of the same size as the open-loop drift
-    # (seeds 1-8: 0.44-0.61 cm against 0.57-0.76 cm open loop; not always below it); its real
-    # job, recovering from a disturbance, is tested below.
+    # The closed loop stays at the discretisation floor, about the size of the open-loop drift
+    # and not always below it (docs/tracking.md, benchmarks/tracking.py); its real job,
+    # recovering from a disturbance, is tested below.
     assert kin["tracking_max_error"] <= 0.002 * length
 
 
