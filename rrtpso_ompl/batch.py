@@ -14,13 +14,14 @@ import glob
 import json
 import math
 import multiprocessing as mp
-import os
 import time
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
+
+from .results import write_text_atomic
 
 __all__ = [
     "Task",
@@ -343,10 +344,7 @@ def run_batch(
     if on_start is not None:
         on_start(len(todo), len(tasks) - len(todo))
     # Rewrite the kept rows first: this drops a torn last line and retried error rows.
-    tmp = out.with_name(f".{out.name}.tmp")
-    with tmp.open("w") as fh:
-        fh.writelines(_json_line(r) for r in kept)
-    os.replace(tmp, out)
+    write_text_atomic("".join(_json_line(r) for r in kept), out)
     rows = list(kept)
     if executor == "local":
         results = _local_results(todo, max(1, jobs))

@@ -41,6 +41,7 @@ from typing import Any
 
 from .batch import Task, make_tasks, run_batch
 from .ompl_log import Experiment, PlannerRuns, build_database, write_log
+from .results import atomic_path, write_text_atomic
 
 __all__ = [
     "BenchResult",
@@ -375,12 +376,12 @@ def write_report(
     out = Path(out_dir)
     csv_path, md_path = out / "report.csv", out / "report.md"
     fields = list(SummaryRow.__dataclass_fields__)
-    with csv_path.open("w", newline="") as fh:
+    with atomic_path(csv_path) as tmp, open(tmp, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=fields)
         w.writeheader()
         for s in summary:
             w.writerow({k: "" if v is None else v for k, v in s.to_dict().items()})
-    md_path.write_text(report_markdown(summary, errors=errors, command=command))
+    write_text_atomic(report_markdown(summary, errors=errors, command=command), md_path)
     return csv_path, md_path
 
 

@@ -65,14 +65,13 @@ import shutil
 import socket
 import subprocess
 import sys
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .results import publish_atomic, write_text_atomic
+from .results import atomic_path, write_text_atomic
 
 __all__ = [
     "PROPERTY_TYPES",
@@ -618,12 +617,8 @@ def build_database(
         if not p.is_file():
             raise FileNotFoundError(f"benchmark log not found: {p}")
     db = Path(db_path)
-    db.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{db.name}.", suffix=".tmp", dir=db.parent)
-    os.close(fd)
-    try:
-        fresh = not (append and db.exists())
-        if not fresh:
+    with atomic_path(db, suffix=".tmp") as tmp:
+        if append and db.exists():
             shutil.copy2(db, tmp)
         proc = subprocess.run(
             [sys.executable, "-c", _CONVERTER, tmp, *map(str, log_paths)],
@@ -636,11 +631,4 @@ def build_database(
                 f"OMPL's benchmark log converter failed (exit code {proc.returncode}) on "
                 f"{', '.join(map(str, log_paths))}:\n{_stderr_tail(proc.stderr)}"
             )
-        if fresh:
-            publish_atomic(tmp, db)
-        else:
-            os.replace(tmp, db)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
     return db
