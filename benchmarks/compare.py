@@ -1,6 +1,6 @@
 """Compare RRTstarPSO with OMPL's stock planners at equal time budgets.
 
-Every run goes through :func:`rrtpso_ompl.solve.solve` (same OMPL setup, same exact collision
+Every run goes through :func:`rrtpso_ompl.planners.solve.solve` (same OMPL setup, same exact collision
 checker) in a fresh process (OMPL's RNG can be seeded only once per process). Stock planners are
 followed by OMPL's path simplifier, as OMPL's Benchmark does, and their simplification time is
 reported separately (it is *not* charged to their budget); RRTstarPSO's simplifier and PSO run
@@ -45,9 +45,9 @@ def run_one(
     problem_path: str, planner: str, budget: float, seed: int, simplify: bool = True
 ) -> dict:
     """One run in a fresh worker process; returns a plain row. ``planner`` may be a spec."""
-    from rrtpso_ompl.ompl_setup import set_ompl_log_level
-    from rrtpso_ompl.problem import load_problem
-    from rrtpso_ompl.solve import solve
+    from rrtpso_ompl.model.problem import load_problem
+    from rrtpso_ompl.ompl_setup.context import set_ompl_log_level
+    from rrtpso_ompl.planners.solve import solve
 
     set_ompl_log_level(0)
     problem = load_problem(problem_path)
@@ -144,8 +144,8 @@ def main(argv: list[str] | None = None) -> int:
     command = "python benchmarks/compare.py " + shlex.join(
         argv if argv is not None else sys.argv[1:]
     )
-    from rrtpso_ompl.optimum import shortest_path
-    from rrtpso_ompl.problem import load_problem
+    from rrtpso_ompl.evaluation.optimum import shortest_path
+    from rrtpso_ompl.model.problem import load_problem
 
     # The reference of every cell: the exact shortest path (`rrtpso optimum`), once per problem.
     optima = {}

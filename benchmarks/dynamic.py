@@ -43,7 +43,7 @@ def make_scenario(seed: int, static_path, problem):
     """The moving obstacles of scenario ``seed`` (a list of MovingObstacle)."""
     import numpy as np
 
-    from rrtpso_ompl.problem import MovingObstacle
+    from rrtpso_ompl.model.problem import MovingObstacle
 
     rng = np.random.default_rng(seed)
     path = np.asarray(static_path)
@@ -76,10 +76,10 @@ def run_scenario(seed: int, replan_time: float, initial_time: float) -> list[dic
     """All strategies on scenario ``seed``, in one fresh process; one row per strategy."""
     import dataclasses
 
-    from rrtpso_ompl.dynamic import DynamicOptions, simulate
-    from rrtpso_ompl.ompl_setup import set_ompl_log_level
-    from rrtpso_ompl.problem import load_problem
-    from rrtpso_ompl.solve import solve
+    from rrtpso_ompl.dynamic.simulation import DynamicOptions, simulate
+    from rrtpso_ompl.model.problem import load_problem
+    from rrtpso_ompl.ompl_setup.context import set_ompl_log_level
+    from rrtpso_ompl.planners.solve import solve
 
     set_ompl_log_level(0)
     base = load_problem(BASE)
@@ -237,8 +237,8 @@ def main(argv: list[str] | None = None) -> int:
 
     from tqdm import tqdm
 
-    from rrtpso_ompl.optimum import shortest_path
-    from rrtpso_ompl.problem import load_problem
+    from rrtpso_ompl.evaluation.optimum import shortest_path
+    from rrtpso_ompl.model.problem import load_problem
 
     # Every scenario shares the static world, so one exact optimum is the reference for all.
     optimum = shortest_path(load_problem(BASE)).length

@@ -15,7 +15,7 @@ import re
 import sys
 from pathlib import Path
 
-from rrtpso_ompl.registry import default_registry
+from rrtpso_ompl.planners.registry import default_registry
 
 
 def table(name: str) -> str:

@@ -11,7 +11,7 @@ from dataclasses import replace
 
 from ompl import geometric as og
 
-from rrtpso_ompl.registry import ParamSpec, PlannerEntry
+from rrtpso_ompl.planners.registry import ParamSpec, PlannerEntry
 
 # --- parameters shared by several planners (OMPL's names) --------------------------------------
 RANGE = ParamSpec(

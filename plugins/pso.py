@@ -1,8 +1,8 @@
 """Registers PSO: the paper's particle-swarm-only baseline (random initial waypoints)."""
 
-from rrtpso_ompl.pso_planner import PSOPlanner
-from rrtpso_ompl.registry import PlannerEntry
-from rrtpso_ompl.rrtstar_pso import check_swarm_values
+from rrtpso_ompl.planners.pso_baseline import PSOPlanner
+from rrtpso_ompl.planners.registry import PlannerEntry
+from rrtpso_ompl.planners.rrtstar_pso import check_swarm_values
 
 PLANNERS = [
     PlannerEntry(

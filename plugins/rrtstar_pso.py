@@ -1,7 +1,7 @@
 """Registers RRTstarPSO: OMPL's RRT* followed by the particle swarm over its waypoints."""
 
-from rrtpso_ompl.registry import PlannerEntry
-from rrtpso_ompl.rrtstar_pso import RRTstarPSO, check_swarm_values
+from rrtpso_ompl.planners.registry import PlannerEntry
+from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSO, check_swarm_values
 
 PLANNERS = [
     PlannerEntry(

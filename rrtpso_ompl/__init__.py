@@ -16,8 +16,8 @@ import RRTstarPSO``) or through :func:`rrtpso_ompl.registry.default_registry`.
 
 from importlib.metadata import PackageNotFoundError, version
 
-from .problem import Problem, ProblemError, load_problem, problem_from_dict
-from .world import World
+from .model.problem import Problem, ProblemError, load_problem, problem_from_dict
+from .model.world import World
 
 try:
     __version__ = version("rrtpso-ompl")

@@ -21,8 +21,9 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Polygon as PolygonPatch
 
-from .problem import Circle, Polygon, Problem
-from .results import SolveResult, atomic_path
+from .model.problem import Circle, Polygon, Problem
+from .outputs import atomic_path
+from .planners.solve import SolveResult
 
 __all__ = [
     "animate_simulation",

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from rrtpso_ompl.problem import Problem, problem_from_dict
+from rrtpso_ompl.model.problem import Problem, problem_from_dict
 
 REPO = Path(__file__).resolve().parent.parent
 PROBLEMS = REPO / "problems"
@@ -35,7 +35,7 @@ def single_circle() -> Problem:
 def rrtpso_exe() -> list[str]:
     """The installed console script (tests drive the real command, as a user would)."""
     exe = shutil.which("rrtpso", path=os.path.dirname(sys.executable))
-    return [exe] if exe else [sys.executable, "-m", "rrtpso_ompl.cli"]
+    return [exe] if exe else [sys.executable, "-m", "rrtpso_ompl"]
 
 
 def write_yaml(path: Path, text: str) -> Path:

@@ -11,9 +11,9 @@ import time
 import pytest
 from conftest import PROBLEMS, rrtpso_exe
 
-from rrtpso_ompl.batch import expand_inputs, make_tasks, read_rows, run_batch
-from rrtpso_ompl.optimum import shortest_path
-from rrtpso_ompl.problem import load_problem
+from rrtpso_ompl.evaluation.batch import expand_inputs, make_tasks, read_rows, run_batch
+from rrtpso_ompl.evaluation.optimum import shortest_path
+from rrtpso_ompl.model.problem import load_problem
 
 ROW_KEYS = {"file", "problem", "planner", "seed", "run", "status", "solved", "length", "time",
             "path", "error", "budget", "optimum", "ratio"}  # fmt: skip
@@ -147,7 +147,7 @@ def test_dask_local_cluster_runs_the_same_batch(folder, tmp_path):
 def test_only_a_solved_row_gets_a_ratio():
     """An approximate path stops short of the goal, so it can be shorter than the optimum: it
     gets the optimum but no ratio (seen on the maze at 0.2 s: ratio 0.39 before the fix)."""
-    from rrtpso_ompl.batch import _Optima
+    from rrtpso_ompl.evaluation.batch import _Optima
 
     maze = str(PROBLEMS / "static" / "maze.yaml")
     optima = _Optima()

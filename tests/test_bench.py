@@ -10,10 +10,10 @@ import subprocess
 import pytest
 from conftest import PROBLEMS, rrtpso_exe
 
-from rrtpso_ompl.batch import read_rows
-from rrtpso_ompl.bench import run_bench, run_properties, summarise
-from rrtpso_ompl.optimum import shortest_path
-from rrtpso_ompl.problem import load_problem
+from rrtpso_ompl.evaluation.batch import read_rows
+from rrtpso_ompl.evaluation.bench import run_bench, run_properties, summarise
+from rrtpso_ompl.evaluation.optimum import shortest_path
+from rrtpso_ompl.model.problem import load_problem
 
 
 @pytest.fixture(scope="module")
@@ -213,7 +213,7 @@ def test_dask_local_cluster_runs_a_bench(tmp_path):
 
 @pytest.mark.parametrize("planner", ["RRTstar", "BITstar", "PRMstar", "RRTConnect", "RRTstarPSO"])
 def test_solve_records_progress_for_every_kind_of_planner(planner):
-    from rrtpso_ompl.solve import solve
+    from rrtpso_ompl.planners.solve import solve
 
     problem = load_problem(PROBLEMS / "static" / "polygon_map.yaml")
     simplify = planner != "RRTstarPSO"
@@ -236,7 +236,7 @@ def test_solve_records_progress_for_every_kind_of_planner(planner):
 
 
 def test_overview_counts_the_cells_the_first_planner_loses():
-    from rrtpso_ompl.bench import SummaryRow, overview_markdown
+    from rrtpso_ompl.evaluation.bench import SummaryRow, overview_markdown
 
     def row(problem, planner, ratio, solved=10):
         return SummaryRow(problem, 1.0, planner, 10, solved, solved / 10, 100.0, None, ratio,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from conftest import REPO as ROOT
 
-from rrtpso_ompl.bench import overview_markdown, read_report_csv
+from rrtpso_ompl.evaluation.bench import overview_markdown, read_report_csv
 
 DOCS = ROOT / "docs"
 

@@ -11,16 +11,16 @@ import numpy as np
 import pytest
 from conftest import PROBLEMS, rrtpso_exe
 
-from rrtpso_ompl.dynamic import (
+from rrtpso_ompl.dynamic.motion import Motion, ObstacleTrack, closest_approach, first_entry
+from rrtpso_ompl.dynamic.simulation import (
     DynamicOptions,
     ReplanningManager,
     capsule,
     predict_threats,
     simulate,
 )
-from rrtpso_ompl.motion import Motion, ObstacleTrack, closest_approach, first_entry
-from rrtpso_ompl.problem import MovingObstacle, load_problem, problem_from_dict
-from rrtpso_ompl.world import World
+from rrtpso_ompl.model.problem import MovingObstacle, load_problem, problem_from_dict
+from rrtpso_ompl.model.world import World
 
 ROBOT = {
     "radius": 28.5,

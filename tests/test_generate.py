@@ -15,7 +15,7 @@ import pytest
 import yaml
 from conftest import PROBLEMS
 
-from rrtpso_ompl.generate import (
+from rrtpso_ompl.evaluation.generate import (
     KINDS,
     GenerationError,
     _Tiles,
@@ -26,9 +26,15 @@ from rrtpso_ompl.generate import (
     is_solvable,
     write_problem,
 )
-from rrtpso_ompl.problem import _TOP_KEYS, Circle, ProblemError, load_problem, problem_from_dict
-from rrtpso_ompl.solve import solve
-from rrtpso_ompl.world import World
+from rrtpso_ompl.model.problem import (
+    _TOP_KEYS,
+    Circle,
+    ProblemError,
+    load_problem,
+    problem_from_dict,
+)
+from rrtpso_ompl.model.world import World
+from rrtpso_ompl.planners.solve import solve
 
 STATIC = sorted((PROBLEMS / "static").glob("*.yaml"))
 #: Small instances: the tests are about the contract, not about hard problems.

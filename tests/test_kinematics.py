@@ -14,7 +14,7 @@ import pytest
 import yaml
 from conftest import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
 
-from rrtpso_ompl.kinematics import (
+from rrtpso_ompl.kinematics.core import (
     CSV_HEADER,
     ReferenceCurve,
     integrate_wheels,
@@ -24,8 +24,8 @@ from rrtpso_ompl.kinematics import (
     track,
     wheel_speeds,
 )
-from rrtpso_ompl.problem import Robot, load_problem
-from rrtpso_ompl.world import World
+from rrtpso_ompl.model.problem import Robot, load_problem
+from rrtpso_ompl.model.world import World
 
 PAPER_ROBOT = Robot(radius=28.5, wheel_radius=7.6, track_width=38.0, speed=20.0, sample_time=0.15)
 BOUNDS = ((0.0, 0.0), (500.0, 500.0))

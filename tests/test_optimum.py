@@ -13,12 +13,12 @@ from conftest import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
 from scipy.sparse import csr_array
 from scipy.sparse.csgraph import dijkstra
 
-from rrtpso_ompl.generate import generate, grid_path
-from rrtpso_ompl.optimum import shortest_path
-from rrtpso_ompl.path_optimizer import path_length
-from rrtpso_ompl.problem import Circle, Polygon, load_problem, problem_from_dict
-from rrtpso_ompl.solve import solve
-from rrtpso_ompl.world import World
+from rrtpso_ompl.evaluation.generate import generate, grid_path
+from rrtpso_ompl.evaluation.optimum import shortest_path
+from rrtpso_ompl.model.problem import Circle, Polygon, load_problem, problem_from_dict
+from rrtpso_ompl.model.world import World
+from rrtpso_ompl.planners.path_optimizer import path_length
+from rrtpso_ompl.planners.solve import solve
 
 
 def _one_circle_length(s, g, c, rho) -> float:

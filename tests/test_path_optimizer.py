@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 from conftest import SINGLE_CIRCLE_OPTIMUM
 
-from rrtpso_ompl.path_optimizer import (
+from rrtpso_ompl.model.world import World
+from rrtpso_ompl.planners.path_optimizer import (
     PathOptimizerOptions,
     optimize_path,
     path_length,
     shortcut,
     turning_angles,
 )
-from rrtpso_ompl.world import World
 
 BOUNDS = ((0.0, 0.0), (500.0, 500.0))
 CIRCLE_WORLD = World(BOUNDS, [(250, 250, 80)], [], robot_radius=28.5)

@@ -10,9 +10,9 @@ import pytest
 from conftest import SINGLE_CIRCLE_OPTIMUM
 from ompl import base as ob
 
-from rrtpso_ompl.ompl_setup import make_context, path_to_array
-from rrtpso_ompl.registry import default_registry
-from rrtpso_ompl.solve import solve
+from rrtpso_ompl.ompl_setup.context import make_context, path_to_array
+from rrtpso_ompl.planners.registry import default_registry
+from rrtpso_ompl.planners.solve import solve
 
 REGISTRY = default_registry()
 BUDGET = 0.25
@@ -108,7 +108,7 @@ def test_rrtstarpso_works_in_a_foreign_simple_setup():
     validity function, OMPL's default motion validator) still gets a valid, shorter path."""
     from ompl import geometric as og
 
-    from rrtpso_ompl.rrtstar_pso import RRTstarPSO
+    from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSO
 
     space = ob.RealVectorStateSpace(2)
     space.setBounds(0.0, 1.0)
@@ -144,7 +144,7 @@ def test_params_by_name_and_validation(single_circle):
 
 
 def test_crash_is_reported_not_raised(single_circle, monkeypatch):
-    from rrtpso_ompl import rrtstar_pso
+    from rrtpso_ompl.planners import rrtstar_pso
 
     def boom(*args, **kwargs):
         raise RuntimeError("injected failure")
@@ -156,7 +156,7 @@ def test_crash_is_reported_not_raised(single_circle, monkeypatch):
 
 
 def test_unsolvable_problem_reports_no_solution():
-    from rrtpso_ompl.problem import problem_from_dict
+    from rrtpso_ompl.model.problem import problem_from_dict
 
     # The goal sits in a closed box: start and goal are free but no path exists.
     walls = [

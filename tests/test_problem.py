@@ -12,7 +12,7 @@ from conftest import PROBLEMS, SINGLE_CIRCLE
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from rrtpso_ompl.problem import (
+from rrtpso_ompl.model.problem import (
     Circle,
     MovingObstacle,
     Polygon,
@@ -20,7 +20,7 @@ from rrtpso_ompl.problem import (
     load_problem,
     problem_from_dict,
 )
-from rrtpso_ompl.world import World
+from rrtpso_ompl.model.world import World
 
 SHIPPED = sorted(PROBLEMS.glob("*/*.yaml"))
 

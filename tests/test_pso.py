@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rrtpso_ompl.pso import PSOOptions, minimize
+from rrtpso_ompl.planners.swarm import PSOOptions, minimize
 
 
 def sphere(x):

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from conftest import SINGLE_CIRCLE
 
-from rrtpso_ompl.registry import (
+from rrtpso_ompl.planners.registry import (
     ParamSpec,
     PlannerEntry,
     PlannerRegistry,
@@ -106,7 +106,7 @@ def test_param_conversion():
 PLUGIN_SRC = '''
 """A tiny third-party planner: the straight line from start to goal, if it is free."""
 from ompl import base as ob, geometric as og
-from rrtpso_ompl.registry import ParamSpec, PlannerEntry
+from rrtpso_ompl.planners.registry import ParamSpec, PlannerEntry
 
 
 class Straight(ob.Planner):
@@ -177,7 +177,7 @@ def test_entry_point_plugin_is_selectable_by_name(tmp_path):
     problem = tmp_path / "empty.yaml"
     problem.write_text(yaml.safe_dump(empty))
     env = {"PYTHONPATH": str(target), "PATH": str(Path(sys.executable).parent)}
-    code = "import sys; from rrtpso_ompl.cli import main; sys.exit(main(sys.argv[1:]))"
+    code = "import sys; from rrtpso_ompl.cli.main import main; sys.exit(main(sys.argv[1:]))"
     listed = subprocess.run(
         [sys.executable, "-c", code, "planners", "TinyStraight"],
         capture_output=True,

@@ -12,7 +12,7 @@ import shapely
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from rrtpso_ompl.world import World
+from rrtpso_ompl.model.world import World
 
 BOUNDS = ((0.0, 0.0), (100.0, 100.0))
 #: A fixed non-convex polygon (its re-entrant corner is at (50, 50)).

@@ -41,9 +41,9 @@ from typing import Any
 
 import numpy as np
 
+from ..model.problem import Circle, PlannerConfig, Polygon, Problem
+from ..model.world import World
 from .motion import Motion, ObstacleTrack, closest_approach, first_entry
-from .problem import Circle, PlannerConfig, Polygon, Problem
-from .world import World
 
 __all__ = [
     "DynamicOptions",
@@ -335,7 +335,7 @@ class ReplanningManager:
         rng: np.random.Generator,
         solve_fn: Callable[..., Any] | None = None,
     ) -> None:
-        from .solve import solve
+        from ..planners.solve import solve
 
         self.problem = problem
         self.options = options
@@ -352,7 +352,7 @@ class ReplanningManager:
         self.turn_slack = math.pi / turn_rate if turn_rate else 0.0
         # Detours must not reseed OMPL (once per process): planners that take a seed get one as
         # a parameter instead.
-        from .registry import default_registry
+        from ..planners.registry import default_registry
 
         entry = default_registry().get(options.planner)
         self._seed_param = any(p.name == "seed" for p in entry.params)
@@ -625,7 +625,7 @@ def simulate(
     -------
     SimulationResult
     """
-    from .solve import solve
+    from ..planners.solve import solve
 
     options = options or DynamicOptions()
     robot = problem.robot

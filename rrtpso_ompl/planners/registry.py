@@ -320,7 +320,7 @@ def _import_first_party(mod_name: str) -> Any:
         except ModuleNotFoundError as exc:
             if exc.name != "rrtpso_ompl.plugins":
                 raise
-            folder = Path(__file__).resolve().parent.parent / "plugins"
+            folder = Path(__file__).resolve().parents[2] / "plugins"
             spec = importlib.util.spec_from_file_location(
                 "rrtpso_ompl.plugins",
                 folder / "__init__.py",

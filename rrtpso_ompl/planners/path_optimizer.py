@@ -38,8 +38,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import pso
-from .world import World
+from ..model.world import World
+from . import swarm as pso
 
 __all__ = [
     "PathCost",

@@ -21,7 +21,7 @@ import numpy as np
 from ompl import base as ob
 from ompl import util as ou
 
-from .problem import touch_tolerance
+from ..model.problem import touch_tolerance
 from .registry import ParamSpec
 
 __all__ = ["PythonPlanner", "SpaceInformationCollisionModel", "collision_model_for"]

@@ -34,8 +34,8 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from .problem import Robot
-from .world import World
+from ..model.problem import Robot
+from ..model.world import World
 
 __all__ = [
     "CSV_HEADER",
@@ -268,7 +268,7 @@ class Trajectory:
 
     def write_csv(self, path: str | Path) -> None:
         """Write the CSV with exactly the header ``t,x,y,theta,v,omega,...``."""
-        from .results import publish_atomic
+        from ..outputs import publish_atomic
 
         path = Path(path)
         tmp = path.with_name(f".{path.name}.tmp")

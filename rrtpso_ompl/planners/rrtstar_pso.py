@@ -28,10 +28,10 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from . import pso
-from .ompl_setup import array_to_path, path_to_array
+from ..ompl_setup.context import array_to_path, path_to_array
+from . import swarm as pso
+from .base import PythonPlanner, collision_model_for
 from .path_optimizer import PathOptimizerOptions, optimize_path, path_length
-from .planner_base import PythonPlanner, collision_model_for
 from .registry import ParamSpec
 
 __all__ = ["RRTSTAR_PSO_PARAMS", "SWARM_PARAMS", "RRTstarPSO", "RRTstarPSOStats"]

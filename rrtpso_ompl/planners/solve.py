@@ -17,12 +17,12 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from .ompl_setup import make_context, path_to_array, seed_ompl
+from ..model.problem import Problem
+from ..model.world import World
+from ..ompl_setup.context import make_context, path_to_array, seed_ompl
+from ..outputs import SolveResult
 from .path_optimizer import path_length
-from .problem import Problem
 from .registry import PlannerRegistry, default_registry
-from .results import SolveResult
-from .world import World
 
 __all__ = ["DEFAULT_PLANNER", "DEFAULT_TIME_LIMIT", "PROGRESS_PERIOD", "solve"]
 

@@ -71,7 +71,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .results import atomic_path, write_text_atomic
+from ..outputs import atomic_path, write_text_atomic
 
 __all__ = [
     "PROPERTY_TYPES",
@@ -512,7 +512,7 @@ def format_log(experiment: Experiment) -> str:
     exp = experiment
     version = exp.version
     if not version:
-        from . import __version__
+        from .. import __version__
 
         version = __version__
     lines = [

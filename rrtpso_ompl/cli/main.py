@@ -186,10 +186,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 # --------------------------------------------------------------------------------------------
 def _cmd_solve(args: argparse.Namespace) -> int:
-    from .ompl_setup import set_ompl_log_level
-    from .problem import ProblemError, load_problem
-    from .registry import UnknownPlannerError, default_registry
-    from .solve import DEFAULT_PLANNER
+    from ..model.problem import ProblemError, load_problem
+    from ..ompl_setup.context import set_ompl_log_level
+    from ..planners.registry import UnknownPlannerError, default_registry
+    from ..planners.solve import DEFAULT_PLANNER
 
     set_ompl_log_level(args.verbose)
     try:
@@ -223,35 +223,35 @@ def _cmd_solve(args: argparse.Namespace) -> int:
     _check_output(args.plot_velocities, "--plot-velocities", image=True)
     wants_motion = args.trajectory or args.plot_velocities
     if wants_motion:
-        from .kinematics import REQUIRED_ROBOT_KEYS
+        from ..kinematics.core import REQUIRED_ROBOT_KEYS
 
         flag = "--trajectory" if args.trajectory else "--plot-velocities"
         for key in REQUIRED_ROBOT_KEYS:
             if getattr(problem.robot, key) is None:
                 raise InputError(f"{src}: robot.{key}: required for {flag}")
 
-    from .solve import solve
+    from ..planners.solve import solve
 
     result = solve(problem, name, args.time, args.seed, cli_params, simplify=args.simplify)
     motion = None
     if wants_motion and result.solved:
-        from .kinematics import drive
-        from .world import World
+        from ..kinematics.core import drive
+        from ..model.world import World
 
         motion = drive(result.path, World.from_problem(problem), problem.robot, args.profile)
     if args.plot:
-        from .plotting import plot_solution, save_figure
+        from ..plotting import plot_solution, save_figure
 
         curve = motion.curve if motion else None
         save_figure(plot_solution(problem, result, curve), args.plot)
     if motion and args.plot_velocities:
-        from .plotting import plot_velocities, save_figure
+        from ..plotting import plot_velocities, save_figure
 
         save_figure(plot_velocities(motion.trajectory, problem.units), args.plot_velocities)
     if motion and args.trajectory:
         motion.trajectory.write_csv(args.trajectory)
     if args.json:
-        from .results import write_json_atomic
+        from ..outputs import write_json_atomic
 
         data = result.to_dict()
         if motion:
@@ -266,10 +266,10 @@ def _cmd_solve(args: argparse.Namespace) -> int:
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
-    from .ompl_setup import set_ompl_log_level
-    from .problem import ProblemError, load_problem
-    from .registry import UnknownPlannerError, default_registry
-    from .solve import DEFAULT_PLANNER
+    from ..model.problem import ProblemError, load_problem
+    from ..ompl_setup.context import set_ompl_log_level
+    from ..planners.registry import UnknownPlannerError, default_registry
+    from ..planners.solve import DEFAULT_PLANNER
 
     set_ompl_log_level(args.verbose)
     try:
@@ -307,7 +307,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     if args.gif and Path(args.gif).suffix.lower() != ".gif":
         raise InputError(f"--gif: '{args.gif}' must end in .gif")
 
-    from .dynamic import DynamicOptions, simulate
+    from ..dynamic.simulation import DynamicOptions, simulate
 
     options = DynamicOptions(
         planner=entry.name,
@@ -327,15 +327,15 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
         sim = simulate(problem, options, seed=seed, progress=progress)
     if args.plot:
-        from .plotting import plot_simulation, save_figure
+        from ..plotting import plot_simulation, save_figure
 
         save_figure(plot_simulation(problem, sim), args.plot)
     if args.gif and sim.motion is not None:
-        from .plotting import animate_simulation
+        from ..plotting import animate_simulation
 
         animate_simulation(problem, sim, args.gif)
     if args.json:
-        from .results import write_json_atomic
+        from ..outputs import write_json_atomic
 
         write_json_atomic(sim.to_dict(), args.json)
     verdict = "reached the goal" if sim.reached_goal else f"did not reach the goal ({sim.status})"
@@ -455,7 +455,7 @@ def _check_run_options(args: argparse.Namespace) -> None:
 
 def _check_planners(names: list[str], items: list[str], flag: str) -> dict[str, dict[str, str]]:
     """Resolve planner names and check --param against each; returns params per planner."""
-    from .registry import UnknownPlannerError, default_registry
+    from ..planners.registry import UnknownPlannerError, default_registry
 
     registry = default_registry()
     params = _parse_params(items, flag)
@@ -477,7 +477,7 @@ def _check_planners(names: list[str], items: list[str], flag: str) -> dict[str, 
 
 
 def _cmd_batch(args: argparse.Namespace) -> int:
-    from .batch import make_tasks, run_batch
+    from ..evaluation.batch import make_tasks, run_batch
 
     _check_run_options(args)
     planners = _planner_list(args.planner, "RRTstarPSO")
@@ -532,7 +532,7 @@ def _add_generate_parser(sub: Any) -> None:
 
 
 def _cmd_generate(args: argparse.Namespace) -> int:
-    from .generate import generate_to_file
+    from ..evaluation.generate import generate_to_file
 
     keys = ("size", "n", "cells", "robot_radius", "radius_range", "vertices", "gap", "wall",
             "algorithm", "name")  # fmt: skip
@@ -567,7 +567,7 @@ def _add_bench_parser(sub: Any) -> None:
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
-    from .bench import run_bench
+    from ..evaluation.bench import run_bench
 
     try:
         times = [float(t) for t in args.time.split(",") if t.strip()]
@@ -592,7 +592,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
             resume=args.resume, progress=bar.row, on_start=bar.started,
             command="rrtpso " + shlex.join(args.argv),
         )  # fmt: skip
-    from .plotting import plot_bench, save_figure
+    from ..plotting import plot_bench, save_figure
 
     if result.summary:
         save_figure(plot_bench(result.summary, "ratio"), out / "ratio.png")
@@ -623,8 +623,8 @@ def _add_optimum_parser(sub: Any) -> None:
 
 
 def _cmd_optimum(args: argparse.Namespace) -> int:
-    from .optimum import shortest_path
-    from .problem import ProblemError, load_problem
+    from ..evaluation.optimum import shortest_path
+    from ..model.problem import ProblemError, load_problem
 
     try:
         problem = load_problem(args.problem)
@@ -634,11 +634,11 @@ def _cmd_optimum(args: argparse.Namespace) -> int:
     _check_output(args.plot, "--plot", image=True)
     result = shortest_path(problem)
     if args.plot:
-        from .plotting import plot_optimum, save_figure
+        from ..plotting import plot_optimum, save_figure
 
         save_figure(plot_optimum(problem, result), args.plot)
     if args.json:
-        from .results import write_json_atomic
+        from ..outputs import write_json_atomic
 
         write_json_atomic(result.to_dict(), args.json)
     if result.found:
@@ -693,7 +693,7 @@ def _check_param(entry: Any, key: str, value: Any, where: str) -> None:
 
 # --------------------------------------------------------------------------------------------
 def _cmd_planners(args: argparse.Namespace) -> int:
-    from .registry import UnknownPlannerError, default_registry
+    from ..planners.registry import UnknownPlannerError, default_registry
 
     registry = default_registry()
     try:

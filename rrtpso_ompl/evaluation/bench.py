@@ -39,9 +39,9 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..outputs import atomic_path, write_text_atomic
 from .batch import Task, make_tasks, run_batch
 from .ompl_log import Experiment, PlannerRuns, build_database, write_log
-from .results import atomic_path, write_text_atomic
 
 __all__ = [
     "BenchResult",
@@ -73,7 +73,7 @@ PROGRESS_PROPERTIES: list[tuple[str, str]] = [("time", "REAL"), ("best cost", "R
 
 def is_stock(planner: str) -> bool:
     """Whether ``planner`` is one of OMPL's own (simplified after the run, as OMPL does)."""
-    from .registry import default_registry
+    from ..planners.registry import default_registry
 
     return default_registry().get(planner).source.endswith(".ompl_geometric")
 

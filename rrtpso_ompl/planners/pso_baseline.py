@@ -18,10 +18,10 @@ from typing import Any
 import numpy as np
 from ompl import base as ob
 
-from . import pso
-from .ompl_setup import array_to_path
+from ..ompl_setup.context import array_to_path
+from . import swarm as pso
+from .base import PythonPlanner, collision_model_for
 from .path_optimizer import PathCost, path_length, shortcut
-from .planner_base import PythonPlanner, collision_model_for
 from .registry import ParamSpec
 from .rrtstar_pso import SWARM_PARAMS, swarm_options
 

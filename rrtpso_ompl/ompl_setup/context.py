@@ -20,8 +20,8 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from .problem import Problem
-from .world import World
+from ..model.problem import Problem
+from ..model.world import World
 
 __all__ = [
     "ExactMotionValidator",

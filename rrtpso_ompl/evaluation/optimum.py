@@ -42,8 +42,8 @@ import scipy.sparse as sp
 import shapely
 from scipy.sparse.csgraph import dijkstra
 
-from .problem import Circle, Polygon, Problem
-from .world import World
+from ..model.problem import Circle, Polygon, Problem
+from ..model.world import World
 
 __all__ = ["OptimumResult", "Piece", "shortest_path"]
 

@@ -21,7 +21,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .results import write_text_atomic
+from ..outputs import write_text_atomic
 
 __all__ = [
     "Task",
@@ -148,9 +148,9 @@ def run_task(task: Task) -> dict[str, Any]:
     ``error`` (None, or the message for a bad file or planner), and ``budget``, the time limit
     the task asked for (None: the file's).
     """
-    from .ompl_setup import set_ompl_log_level
-    from .problem import ProblemError, load_problem
-    from .solve import solve
+    from ..model.problem import ProblemError, load_problem
+    from ..ompl_setup.context import set_ompl_log_level
+    from ..planners.solve import solve
 
     set_ompl_log_level(0)
     base = {
@@ -375,8 +375,8 @@ class _Optima:
 
     def length(self, file: str) -> float | None:
         if file not in self._cache:
+            from ..model.problem import ProblemError, load_problem
             from .optimum import shortest_path
-            from .problem import ProblemError, load_problem
 
             try:
                 self._cache[file] = shortest_path(load_problem(file)).length

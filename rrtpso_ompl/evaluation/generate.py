@@ -44,7 +44,7 @@ import yaml
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from .problem import (
+from ..model.problem import (
     _MOVING_KEYS,
     _OBSTACLE_KEYS,
     _PLANNER_KEYS,
@@ -54,8 +54,8 @@ from .problem import (
     ProblemError,
     problem_from_dict,
 )
-from .results import write_text_atomic
-from .world import World
+from ..model.world import World
+from ..outputs import write_text_atomic
 
 __all__ = [
     "KINDS",

@@ -1,0 +1,116 @@
+"""One family of errors: everything this package raises on purpose derives from :class:`RrtpsoError`.
+
+An :class:`RrtpsoError` means *the input cannot be honoured* (a problem file, a planner name, a
+parameter value, a command-line flag, an output target), never a bug. Its message is written for
+the user and names where the input came from; the command line prints it and exits with status 2,
+without a traceback. Anything else that escapes is a bug and keeps its traceback.
+
+The subclasses also derive from the built-in exception a Python caller would expect
+(``ValueError`` for bad values, ``KeyError`` for an unknown name), so ``except ValueError`` keeps
+working for code written before the family existed.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "GenerationError",
+    "ParameterError",
+    "PlannerError",
+    "ProblemError",
+    "RrtpsoError",
+    "UnknownPlannerError",
+    "UsageError",
+]
+
+
+class RrtpsoError(Exception):
+    """Base of every deliberate error of rrtpso-ompl: bad input, reported by its message alone."""
+
+    def __str__(self) -> str:
+        # KeyError quotes its argument; every error of the family reads as plain text.
+        return str(self.args[0]) if self.args else type(self).__name__
+
+
+class ProblemError(RrtpsoError, ValueError):
+    """A problem file (or dictionary) is not a valid problem.
+
+    Parameters
+    ----------
+    source : str
+        The file the problem came from (or a label such as ``"<dict>"``).
+    key : str
+        The offending key as a dotted path, e.g. ``"obstacles[2].radius"``; empty for the
+        whole file.
+    message : str
+        What is wrong, in words a user can act on.
+    """
+
+    def __init__(self, source: str, key: str, message: str) -> None:
+        self.source = str(source)
+        self.key = key
+        self.message = message
+        where = f"{self.source}: {key}" if key else self.source
+        super().__init__(f"{where}: {message}")
+
+    def __reduce__(self):
+        # Picklable, so that a worker process can send it back to its parent.
+        return (type(self), (self.source, self.key, self.message))
+
+
+class ParameterError(RrtpsoError, ValueError):
+    """A parameter name or value that its declaration does not allow.
+
+    Parameters
+    ----------
+    message : str
+        The whole message, naming the parameter (and its owner, when known).
+    name : str
+        The parameter (or ``"a + b"`` for a rule over several).
+    """
+
+    def __init__(self, message: str, name: str = "") -> None:
+        self.name = name
+        super().__init__(message)
+
+    def __reduce__(self):
+        return (type(self), (str(self), self.name))
+
+
+class PlannerError(RrtpsoError):
+    """A planner cannot be selected or configured."""
+
+
+class UnknownPlannerError(PlannerError, KeyError):
+    """No usable planner of that name.
+
+    The message lists the known names, suggests the closest one and, for a planner that exists but
+    is excluded, says why.
+    """
+
+    def __init__(self, name: str, known, reason: str = "") -> None:
+        import difflib
+
+        self.name = name
+        self.known = sorted(known, key=str.lower)
+        self.reason = reason
+        listing = ", ".join(self.known)
+        if reason:
+            text = f"planner '{name}' is unavailable ({reason}); known planners: {listing}"
+        else:
+            lower = {k.lower(): k for k in self.known}
+            close = difflib.get_close_matches(name.lower(), list(lower), n=1, cutoff=0.6)
+            hint = f" (did you mean '{lower[close[0]]}'?)" if close else ""
+            text = f"unknown planner '{name}'{hint}; known planners: {listing}"
+        super().__init__(text)
+
+    def __reduce__(self):
+        return (type(self), (self.name, self.known, self.reason))
+
+
+class UsageError(RrtpsoError):
+    """A command-line flag, argument or output target that cannot be honoured."""
+
+
+class GenerationError(RrtpsoError, ValueError):
+    """The generator's options are invalid, or no problem satisfying them was found within the
+    allowed attempts (too many or too large obstacles, too large a robot for the workspace)."""

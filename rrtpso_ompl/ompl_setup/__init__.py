@@ -1,0 +1,4 @@
+"""TODO"""
+
+from .context import *  # noqa: F403
+from .context import __all__  # noqa: F401

@@ -1,0 +1,100 @@
+"""Checks of single values, shared by the problem loader, the parameter tables and the generator.
+
+Each check returns the converted value or raises ``ValueError`` with a message that starts with
+"must", so that every caller can put its own subject in front of it (``obstacles[2].radius``,
+``parameter 'swarm_size'``, ``--n``) and report it in its own error type.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import reprlib
+from typing import Any
+
+__all__ = ["SEED_MAX", "check_integer", "check_number", "check_seed", "describe"]
+
+#: The largest seed: OMPL's ``RNG::setSeed`` takes a 32-bit unsigned integer on every platform
+#: (``std::uint_fast32_t``, which is 32 bits on some), and numpy accepts any non-negative one.
+SEED_MAX = 2**32 - 1
+
+#: Short, bounded reprs: a value may be a huge or self-referencing structure (YAML anchors).
+_REPR = reprlib.Repr()
+_REPR.maxlevel = 3
+_REPR.maxstring = _REPR.maxother = _REPR.maxlong = 40
+_REPR.maxlist = _REPR.maxtuple = _REPR.maxdict = _REPR.maxset = _REPR.maxfrozenset = 4
+
+
+def describe(value: Any) -> str:
+    """A short description of a wrong value for error messages (type and bounded repr)."""
+    if value is None:
+        return "nothing (null)"
+    try:
+        text = _REPR.repr(value)
+    except ValueError:  # an int with more digits than Python will convert to text
+        text = "(too long to show)"
+    return f"{type(value).__name__} {text}"
+
+
+def _bound_text(x: float) -> str:
+    return f"{x:g}" if isinstance(x, float) else str(x)
+
+
+def check_number(
+    value: Any,
+    *,
+    low: float | None = None,
+    high: float | None = None,
+    strict_low: bool = False,
+) -> float:
+    """A finite real number (not a bool) in ``[low, high]`` (``(low, high]`` with ``strict_low``).
+
+    Raises
+    ------
+    ValueError
+        ``"must be a number, got str 'x'"`` and the like.
+    """
+    # bool is an int subclass, but `radius: yes` is a mistake, not the number 1.
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ValueError(f"must be a number, got {describe(value)}")
+    try:
+        x = float(value)
+    except OverflowError:
+        raise ValueError("is too large for a floating-point number") from None
+    if not math.isfinite(x):
+        raise ValueError(f"must be a finite number, got {x}")
+    if low is not None and (x <= low if strict_low else x < low):
+        raise ValueError(f"must be {'>' if strict_low else '>='} {_bound_text(low)}, got {x:g}")
+    if high is not None and x > high:
+        raise ValueError(f"must be <= {_bound_text(high)}, got {x:g}")
+    return x
+
+
+def check_integer(value: Any, *, low: int | None = None, high: int | None = None) -> int:
+    """An integer (not a bool; a float with an integral value is accepted) in ``[low, high]``.
+
+    Raises
+    ------
+    ValueError
+        ``"must be an integer, got float 2.5"`` and the like.
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ValueError(f"must be an integer, got {describe(value)}")
+    if not isinstance(value, numbers.Integral):
+        if not math.isfinite(value) or value != int(value):
+            raise ValueError(f"must be an integer, got {describe(value)}")
+        value = int(value)
+    value = int(value)
+    if low is not None and value < low:
+        raise ValueError(f"must be >= {low}, got {value}")
+    if high is not None and value > high:
+        raise ValueError(f"must be <= {high}, got {value}")
+    return value
+
+
+def check_seed(value: Any) -> int:
+    """A random seed: an integer in ``[0, SEED_MAX]`` (the range OMPL's RNG takes)."""
+    try:
+        return check_integer(value, low=0, high=SEED_MAX)
+    except ValueError as exc:
+        raise ValueError(f"{exc} (seeds are integers from 0 to 2**32 - 1)") from None
