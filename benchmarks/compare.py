@@ -1,7 +1,8 @@
 """Compare RRTstarPSO with OMPL's stock planners at equal time budgets.
 
-Every run goes through :func:`rrtpso_ompl.planners.solve.solve` (same OMPL setup, same exact collision
-checker) in a fresh process (OMPL's RNG can be seeded only once per process). Stock planners are
+Every run goes through :func:`rrtpso_ompl.planners.solve.solve` (same OMPL setup, same exact
+collision checker) in a fresh process (OMPL's RNG can be seeded only once per process).
+Stock planners are
 followed by OMPL's path simplifier, as OMPL's Benchmark does, and their simplification time is
 reported separately (it is *not* charged to their budget); RRTstarPSO's simplifier and PSO run
 inside its budget.

@@ -1,4 +1,4 @@
-"""One family of errors: everything this package raises on purpose derives from :class:`RrtpsoError`.
+"""One family of errors: everything rrtpso-ompl raises on purpose derives from RrtpsoError.
 
 An :class:`RrtpsoError` means *the input cannot be honoured* (a problem file, a planner name, a
 parameter value, a command-line flag, an output target), never a bug. Its message is written for

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from conftest import REPO as ROOT
+from helpers import REPO as ROOT
 
 from rrtpso_ompl.evaluation.bench import overview_markdown, read_report_csv
 

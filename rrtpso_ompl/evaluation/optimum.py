@@ -39,9 +39,9 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-import shapely
 from scipy.sparse.csgraph import dijkstra
 
+from ..model.geometry import point_segment_distance
 from ..model.problem import Circle, Polygon, Problem
 from ..model.world import World
 
@@ -349,7 +349,7 @@ class _TangentGraph:
 
         w = self.world
         # Chunks bound the (segments x obstacles) temporaries to a few MB.
-        chunk = max(1, 200_000 // max(1, len(w.circles) + len(w._edges)))
+        chunk = max(1, 200_000 // max(1, len(w.circles) + len(w.polygon_edges)))
         pts = np.concatenate([p, q])
         point_ok = w.points_in_bounds(pts)
         for s in range(0, len(pts), chunk):
@@ -385,7 +385,7 @@ class _TangentGraph:
         sweep = np.where(rho > 0, sweep, 0.0)
         free = np.zeros(len(u), dtype=bool)
         # Chunks bound the (arcs x obstacles) temporaries to a few tens of MB.
-        chunk = max(1, 200_000 // max(1, len(self.world.circles) + len(self.world._edges)))
+        chunk = max(1, 200_000 // max(1, len(self.world.circles) + len(self.world.polygon_edges)))
         centers = self.circles[circle[u], :2]
         for s in range(0, len(u), chunk):
             k = slice(s, s + chunk)
@@ -422,8 +422,8 @@ class _TangentGraph:
                 center[:, None, :], rho[:, None], a0[:, None], sweep[:, None], obs[None, :, :2]
             )
             ok &= np.all(d >= obs[None, :, 2] + w.threshold, axis=1)
-        if len(w._edges):
-            e = w._edges
+        if len(w.polygon_edges):
+            e = w.polygon_edges
             d = _arc_segment_distance(
                 center[:, None, :],
                 rho[:, None],
@@ -435,8 +435,8 @@ class _TangentGraph:
             ok &= np.all(d >= w.threshold, axis=1)
             # An arc clear of every edge is wholly inside or outside each polygon.
             mid = a0 + 0.5 * sweep
-            inside = shapely.intersects_xy(
-                w._poly_union, center[:, 0] + rho * np.cos(mid), center[:, 1] + rho * np.sin(mid)
+            inside = w.in_polygons(
+                center[:, 0] + rho * np.cos(mid), center[:, 1] + rho * np.sin(mid)
             )
             ok &= ~inside
         return ok
@@ -506,13 +506,6 @@ def _arc_point_distance(
     return np.where(on, np.abs(r - rho), np.minimum(e0, e1))
 
 
-def _point_segment(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    ab = b - a
-    den = np.sum(ab * ab, axis=-1)
-    t = np.clip(np.sum((p - a) * ab, axis=-1) / np.where(den > 0, den, 1.0), 0.0, 1.0)
-    return np.hypot(*np.moveaxis(a + t[..., None] * ab - p, -1, 0))
-
-
 def _arc_segment_distance(
     c: np.ndarray,
     rho: np.ndarray,
@@ -531,7 +524,7 @@ def _arc_segment_distance(
     e1 = np.stack(
         [c[..., 0] + rho * np.cos(a0 + sweep), c[..., 1] + rho * np.sin(a0 + sweep)], axis=-1
     )
-    d = np.minimum(_point_segment(e0, s0, s1), _point_segment(e1, s0, s1))
+    d = np.minimum(point_segment_distance(e0, s0, s1), point_segment_distance(e1, s0, s1))
     d = np.minimum(d, _arc_point_distance(c, rho, a0, sweep, s0))
     d = np.minimum(d, _arc_point_distance(c, rho, a0, sweep, s1))
 

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
+from .geometry import point_segment_distance, point_segment_distance_xy, segments_cross
 from .problem import Circle, Polygon, Problem, clearance_threshold, touch_tolerance
 
 __all__ = ["World", "clearance_threshold"]  # the rule lives in problem (the loader shares it)
@@ -127,6 +128,18 @@ class World:
     def with_robot_radius(self, robot_radius: float) -> World:
         """The same obstacles for another robot radius."""
         return World(self.bounds, self.circles, self.polygons, robot_radius)
+
+    @property
+    def polygon_edges(self) -> np.ndarray:
+        """Every polygon edge as a row ``(ax, ay, bx, by)``: shape ``(n_edges, 4)``."""
+        return self._edges
+
+    def in_polygons(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Whether each point ``(x[i], y[i])`` lies in (or on) a polygon (circles not counted)."""
+        x = np.asarray(x, dtype=float)
+        if self._poly_union is None:
+            return np.zeros(x.shape, dtype=bool)
+        return shapely.intersects_xy(self._poly_union, x, np.asarray(y, dtype=float))
 
     @property
     def n_obstacles(self) -> int:
@@ -305,7 +318,7 @@ class World:
         c = self.circles[:, :2]
         return np.maximum(
             0.0,
-            _point_segment_distance(c[None, :, :], a[:, None, :], b[:, None, :])
+            point_segment_distance(c[None, :, :], a[:, None, :], b[:, None, :])
             - self.circles[None, :, 2],
         )
 
@@ -317,10 +330,10 @@ class World:
         B = b[:, None, :]
         # Distance between two non-crossing segments is attained at one of the four end points.
         d = np.minimum(
-            np.minimum(_point_segment_distance(A, e0, e1), _point_segment_distance(B, e0, e1)),
-            np.minimum(_point_segment_distance(e0, A, B), _point_segment_distance(e1, A, B)),
+            np.minimum(point_segment_distance(A, e0, e1), point_segment_distance(B, e0, e1)),
+            np.minimum(point_segment_distance(e0, A, B), point_segment_distance(e1, A, B)),
         )
-        d[_segments_cross(A, B, e0, e1)] = 0.0
+        d[segments_cross(A, B, e0, e1)] = 0.0
         d = d.min(axis=1)
         # A segment with no edge crossing is either wholly inside or wholly outside a polygon.
         inside = shapely.intersects_xy(self._poly_union, a[:, 0], a[:, 1])
@@ -383,7 +396,7 @@ class LocalViolation:
         B = b[:, :, None, :]
         if self.circles.shape[1]:
             c = self.circles[None, :, :, :2]
-            d = _point_segment_distance(c, A, B) - self.circles[None, :, :, 2]
+            d = point_segment_distance(c, A, B) - self.circles[None, :, :, 2]
             v += np.maximum(0.0, r_need - np.maximum(d, 0.0)).sum(axis=2)
         if len(self.edge_segments):
             # Only the segments that have candidate edges at all.
@@ -392,10 +405,10 @@ class LocalViolation:
             e0 = self.edges[None, idx, :, :2]
             e1 = self.edges[None, idx, :, 2:]
             d = np.minimum(
-                np.minimum(_point_segment_distance(A, e0, e1), _point_segment_distance(B, e0, e1)),
-                np.minimum(_point_segment_distance(e0, A, B), _point_segment_distance(e1, A, B)),
+                np.minimum(point_segment_distance(A, e0, e1), point_segment_distance(B, e0, e1)),
+                np.minimum(point_segment_distance(e0, A, B), point_segment_distance(e1, A, B)),
             )
-            d = np.where(_segments_cross(A, B, e0, e1), 0.0, d).min(axis=2)
+            d = np.where(segments_cross(A, B, e0, e1), 0.0, d).min(axis=2)
             start = a[:, idx]
             inside = shapely.intersects_xy(world._poly_union, start[..., 0], start[..., 1])
             v[:, idx] += np.maximum(0.0, r_need - np.where(inside, 0.0, d))
@@ -415,57 +428,8 @@ def _gather(near: np.ndarray, rows: np.ndarray, pad: np.ndarray) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------------------------
-# Vectorised primitives
+# Scalar polygon primitives (pure Python floats)
 # ----------------------------------------------------------------------------------------------
-def _point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Broadcast distance from points ``p`` to segments ``a-b`` (degenerate segments allowed).
-
-    Written on the x and y components: for 2-D points this is several times faster than
-    ``einsum`` over a trailing axis of length 2, and it is the PSO's inner loop.
-    """
-    abx = b[..., 0] - a[..., 0]
-    aby = b[..., 1] - a[..., 1]
-    apx = p[..., 0] - a[..., 0]
-    apy = p[..., 1] - a[..., 1]
-    len2 = abx * abx + aby * aby
-    # A zero-length segment has a zero numerator too, so t = 0 there: the distance to a point.
-    t = np.clip((apx * abx + apy * aby) / np.where(len2 > 0.0, len2, 1.0), 0.0, 1.0)
-    qx = apx - t * abx
-    qy = apy - t * aby
-    return np.sqrt(qx * qx + qy * qy)
-
-
-def _cross(o: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """z-component of (a - o) x (b - o), broadcast."""
-    return (a[..., 0] - o[..., 0]) * (b[..., 1] - o[..., 1]) - (a[..., 1] - o[..., 1]) * (
-        b[..., 0] - o[..., 0]
-    )
-
-
-def _segments_cross(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> np.ndarray:
-    """Whether segments a-b and c-d cross properly (touching cases give distance 0 anyway)."""
-    d1 = _cross(a, b, c)
-    d2 = _cross(a, b, d)
-    d3 = _cross(c, d, a)
-    d4 = _cross(c, d, b)
-    return (d1 * d2 < 0.0) & (d3 * d4 < 0.0)
-
-
-# ----------------------------------------------------------------------------------------------
-# Scalar primitives (pure Python floats)
-# ----------------------------------------------------------------------------------------------
-def _pt_seg(px: float, py: float, ax: float, ay: float, bx: float, by: float) -> float:
-    dx, dy = bx - ax, by - ay
-    len2 = dx * dx + dy * dy
-    if len2 > 0.0:
-        t = ((px - ax) * dx + (py - ay) * dy) / len2
-        t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
-    else:
-        t = 0.0
-    ex, ey = ax + t * dx - px, ay + t * dy - py
-    return math.sqrt(ex * ex + ey * ey)
-
-
 def _point_in_polygon(x: float, y: float, xs: tuple[float, ...], ys: tuple[float, ...]) -> bool:
     """Even-odd ray casting (boundary points may go either way; callers also test distance)."""
     inside = False
@@ -483,7 +447,9 @@ def _point_polygon_boundary_distance(
     x: float, y: float, xs: tuple[float, ...], ys: tuple[float, ...]
 ) -> float:
     n = len(xs)
-    return min(_pt_seg(x, y, xs[i - 1], ys[i - 1], xs[i], ys[i]) for i in range(n))
+    return min(
+        point_segment_distance_xy(x, y, xs[i - 1], ys[i - 1], xs[i], ys[i]) for i in range(n)
+    )
 
 
 def _segment_polygon_distance(
@@ -501,10 +467,10 @@ def _segment_polygon_distance(
         if d1 * d2 < 0.0 and d3 * d4 < 0.0:
             return 0.0
         d = min(
-            _pt_seg(ax, ay, cx, cy, dx, dy),
-            _pt_seg(bx, by, cx, cy, dx, dy),
-            _pt_seg(cx, cy, ax, ay, bx, by),
-            _pt_seg(dx, dy, ax, ay, bx, by),
+            point_segment_distance_xy(ax, ay, cx, cy, dx, dy),
+            point_segment_distance_xy(bx, by, cx, cy, dx, dy),
+            point_segment_distance_xy(cx, cy, ax, ay, bx, by),
+            point_segment_distance_xy(dx, dy, ax, ay, bx, by),
         )
         if d < best:
             best = d

@@ -9,7 +9,7 @@ import subprocess
 
 import numpy as np
 import pytest
-from conftest import PROBLEMS, rrtpso_exe
+from helpers import PROBLEMS, rrtpso_exe
 
 from rrtpso_ompl.dynamic.motion import Motion, ObstacleTrack, closest_approach, first_entry
 from rrtpso_ompl.dynamic.simulation import (

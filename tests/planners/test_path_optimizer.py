@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import SINGLE_CIRCLE_OPTIMUM
+from helpers import SINGLE_CIRCLE_OPTIMUM
 
 from rrtpso_ompl.model.world import World
 from rrtpso_ompl.planners.path_optimizer import (

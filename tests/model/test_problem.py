@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 import yaml
-from conftest import PROBLEMS, SINGLE_CIRCLE
+from helpers import PROBLEMS, SINGLE_CIRCLE
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 

@@ -12,7 +12,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 import yaml
-from conftest import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
+from helpers import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
 
 from rrtpso_ompl.kinematics.core import (
     CSV_HEADER,

@@ -9,7 +9,7 @@ import subprocess
 import numpy as np
 import pytest
 import shapely
-from conftest import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
+from helpers import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
 from scipy.sparse import csr_array
 from scipy.sparse.csgraph import dijkstra
 

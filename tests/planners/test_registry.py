@@ -8,7 +8,7 @@ import textwrap
 from pathlib import Path
 
 import pytest
-from conftest import SINGLE_CIRCLE
+from helpers import SINGLE_CIRCLE
 
 from rrtpso_ompl.planners.registry import (
     ParamSpec,
@@ -214,7 +214,7 @@ def test_entry_point_plugin_is_selectable_by_name(tmp_path):
 def test_documented_parameter_tables_match_the_registry():
     """docs/planners.md is generated from the registry; regenerate it when this fails
     (python benchmarks/param_tables.py)."""
-    from conftest import REPO
+    from helpers import REPO
 
     text = (REPO / "docs" / "planners.md").read_text()
     for name in ("RRTstarPSO", "PSO"):

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
+from helpers import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
 
 CONTRACT_KEYS = {"problem", "planner", "status", "solved", "length", "time", "seed", "path"}
 

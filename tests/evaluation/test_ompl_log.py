@@ -1,4 +1,4 @@
-"""OMPL benchmark logs: written by :mod:`rrtpso_ompl.evaluation.ompl_log`, read back by OMPL's own parser."""
+"""OMPL benchmark logs: written by :mod:`rrtpso_ompl.evaluation.ompl_log`, read back by OMPL."""
 
 from __future__ import annotations
 

@@ -8,7 +8,7 @@ import sqlite3
 import subprocess
 
 import pytest
-from conftest import PROBLEMS, rrtpso_exe
+from helpers import PROBLEMS, rrtpso_exe
 
 from rrtpso_ompl.evaluation.batch import read_rows
 from rrtpso_ompl.evaluation.bench import run_bench, run_properties, summarise

@@ -13,7 +13,7 @@ import re
 import numpy as np
 import pytest
 import yaml
-from conftest import PROBLEMS
+from helpers import PROBLEMS
 
 from rrtpso_ompl.evaluation.generate import (
     KINDS,
@@ -370,7 +370,7 @@ def test_generated_static_problems_regenerate_from_their_header_command(name, ki
 def test_generate_command_is_deterministic_and_checks_options(tmp_path):
     import subprocess
 
-    from conftest import rrtpso_exe
+    from helpers import rrtpso_exe
 
     a, b = tmp_path / "a.yaml", tmp_path / "b.yaml"
     for out in (a, b):

@@ -7,7 +7,7 @@ import time
 
 import numpy as np
 import pytest
-from conftest import SINGLE_CIRCLE_OPTIMUM
+from helpers import SINGLE_CIRCLE_OPTIMUM
 from ompl import base as ob
 
 from rrtpso_ompl.ompl_setup.context import make_context, path_to_array

@@ -9,7 +9,7 @@ import subprocess
 import time
 
 import pytest
-from conftest import PROBLEMS, rrtpso_exe
+from helpers import PROBLEMS, rrtpso_exe
 
 from rrtpso_ompl.evaluation.batch import expand_inputs, make_tasks, read_rows, run_batch
 from rrtpso_ompl.evaluation.optimum import shortest_path

@@ -1,0 +1,171 @@
+"""Plane geometry that every stage uses: polyline lengths, shortcutting, point-segment distances.
+
+Vectorised functions take numpy arrays with any leading shape and coordinates in the last axis;
+the scalar ``*_xy`` twins take plain floats, for OMPL's one-segment-at-a-time callbacks, where
+building arrays would cost more than the arithmetic.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+__all__ = [
+    "cross",
+    "cumulative_length",
+    "dedupe",
+    "path_length",
+    "point_segment_distance",
+    "point_segment_distance_xy",
+    "segment_lengths",
+    "segments_cross",
+    "shortcut",
+    "turning_angles",
+    "wrap_angle",
+]
+
+#: Segments per vectorised visibility call in :func:`shortcut` (bounds its temporary arrays).
+_CHUNK = 4096
+
+
+def segment_lengths(path: np.ndarray) -> np.ndarray:
+    """Lengths of the segments of a polyline ``(n, 2)``: shape ``(n - 1,)``."""
+    p = np.asarray(path, dtype=float).reshape(-1, 2)
+    d = np.diff(p, axis=0)
+    return np.hypot(d[:, 0], d[:, 1])
+
+
+def path_length(path: np.ndarray) -> float:
+    """Euclidean length of a polyline ``(n, 2)`` (0 for fewer than two points)."""
+    return float(segment_lengths(path).sum())
+
+
+def cumulative_length(path: np.ndarray) -> np.ndarray:
+    """Arc length at each vertex of a polyline: ``(n,)``, starting at 0."""
+    return np.concatenate([[0.0], np.cumsum(segment_lengths(path))])
+
+
+def dedupe(points: np.ndarray, tol: float = 0.0) -> np.ndarray:
+    """Drop each point within ``tol`` of the one before it (``tol = 0``: exact repeats)."""
+    p = np.asarray(points, dtype=float)
+    if len(p) < 2:
+        return p
+    keep = np.concatenate([[True], segment_lengths(p) > tol])
+    return p[keep]
+
+
+def wrap_angle(a: float) -> float:
+    """Angle in (-pi, pi], radians."""
+    return math.atan2(math.sin(a), math.cos(a))
+
+
+def point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Broadcast distance from points ``p`` to segments ``a-b`` (zero-length segments allowed).
+
+    Written on the x and y components: for 2-D points this is several times faster than
+    ``einsum`` over a trailing axis of length 2, and it is the swarm's inner loop.
+    """
+    abx = b[..., 0] - a[..., 0]
+    aby = b[..., 1] - a[..., 1]
+    apx = p[..., 0] - a[..., 0]
+    apy = p[..., 1] - a[..., 1]
+    len2 = abx * abx + aby * aby
+    # A zero-length segment has a zero numerator too, so t = 0 there: the distance to a point.
+    t = np.clip((apx * abx + apy * aby) / np.where(len2 > 0.0, len2, 1.0), 0.0, 1.0)
+    qx = apx - t * abx
+    qy = apy - t * aby
+    return np.sqrt(qx * qx + qy * qy)
+
+
+def point_segment_distance_xy(
+    px: float, py: float, ax: float, ay: float, bx: float, by: float
+) -> float:
+    """:func:`point_segment_distance` for one point and one segment, in plain floats."""
+    dx, dy = bx - ax, by - ay
+    len2 = dx * dx + dy * dy
+    if len2 > 0.0:
+        t = ((px - ax) * dx + (py - ay) * dy) / len2
+        t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
+    else:
+        t = 0.0
+    ex, ey = ax + t * dx - px, ay + t * dy - py
+    return math.sqrt(ex * ex + ey * ey)
+
+
+def cross(o: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """z-component of (a - o) x (b - o), broadcast."""
+    return (a[..., 0] - o[..., 0]) * (b[..., 1] - o[..., 1]) - (a[..., 1] - o[..., 1]) * (
+        b[..., 0] - o[..., 0]
+    )
+
+
+def segments_cross(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """Whether segments a-b and c-d cross properly (touching cases give distance 0 anyway)."""
+    d1 = cross(a, b, c)
+    d2 = cross(a, b, d)
+    d3 = cross(c, d, a)
+    d4 = cross(c, d, b)
+    return (d1 * d2 < 0.0) & (d3 * d4 < 0.0)
+
+
+def turning_angles(paths: np.ndarray) -> np.ndarray:
+    """Turning angle (radians, in [0, pi]) at each interior vertex of ``(..., n, 2)`` polylines."""
+    seg = np.diff(paths, axis=-2)
+    a, b = seg[..., :-1, :], seg[..., 1:, :]
+    z = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    dot = np.einsum("...i,...i->...", a, b)
+    return np.abs(np.arctan2(z, dot))
+
+
+def shortcut(
+    path: np.ndarray, segments_free: Callable[[np.ndarray, np.ndarray], np.ndarray]
+) -> np.ndarray:
+    """Greedy shortcutting: from each kept vertex jump to the farthest vertex in free sight.
+
+    Parameters
+    ----------
+    path : (n, 2) array_like
+        A valid polyline (each of its own segments free).
+    segments_free : callable
+        ``segments_free(a, b)`` for ``(m, 2)`` end points returns ``(m,)`` booleans (exact, e.g.
+        :meth:`~rrtpso_ompl.model.World.segments_free`).
+
+    Returns
+    -------
+    (k, 2) ndarray
+        A subset of the input's vertices, end points kept: never longer, and valid whenever the
+        input is, since every new segment passed ``segments_free``.
+
+    Notes
+    -----
+    The look-ahead window starts at 64 vertices and doubles while its far end is in sight, so a
+    long winding route (a grid path of thousands of vertices) is not tested against every later
+    vertex; the visibility calls are chunked to bound their memory.
+    """
+    p = np.asarray(path, dtype=float).reshape(-1, 2)
+    if len(p) <= 2:
+        return p.copy()
+    keep = [0]
+    i = 0
+    last = len(p) - 1
+    while i < last:
+        window = 64
+        while True:
+            j = np.arange(i + 1, min(last, i + window) + 1)
+            sight = np.concatenate(
+                [
+                    segments_free(np.broadcast_to(p[i], (len(chunk), 2)), p[chunk])
+                    for chunk in np.array_split(j, max(1, math.ceil(len(j) / _CHUNK)))
+                ]
+            )
+            # The next vertex is in sight on a valid input; on an invalid one, step to it anyway.
+            seen = np.flatnonzero(sight)
+            best = int(j[seen[-1]]) if len(seen) else i + 1
+            if best < i + window or best == last:
+                break
+            window *= 2
+        i = best
+        keep.append(i)
+    return p[keep]
