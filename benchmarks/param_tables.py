@@ -19,15 +19,8 @@ from rrtpso_ompl.planners.registry import default_registry
 
 
 def table(name: str) -> str:
-    """The markdown table of planner ``name``'s parameters."""
-    entry = default_registry().get(name)
-    rows = ["| name | type | default | unit | range | meaning |", "|---|---|---|---|---|---|"]
-    for p in entry.params:
-        rows.append(
-            f"| `{p.name}` | {p.type.__name__} | {p.default} | {p.unit or '–'} | "
-            f"{p.range_text()} | {p.doc} |"
-        )
-    return "\n".join(rows)
+    """The markdown table of planner ``name``'s parameters (from its declarations)."""
+    return default_registry().get(name).params.markdown()
 
 
 def update(path: Path) -> None:

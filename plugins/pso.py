@@ -1,8 +1,7 @@
 """Registers PSO: the paper's particle-swarm-only baseline (random initial waypoints)."""
 
 from rrtpso_ompl.planners.pso_baseline import PSOPlanner
-from rrtpso_ompl.planners.registry import PlannerEntry
-from rrtpso_ompl.planners.rrtstar_pso import check_swarm_values
+from rrtpso_ompl.planners.registry import Capabilities, PlannerEntry
 
 PLANNERS = [
     PlannerEntry(
@@ -11,7 +10,7 @@ PLANNERS = [
         params=PSOPlanner.PARAMS,
         description="Particle swarm over random waypoints (the paper's PSO baseline, Table 3)",
         aliases=("geometric::PSO",),
-        optimizing=True,
-        check=check_swarm_values,
+        capabilities=Capabilities(optimizing=True),
+        configure=PSOPlanner.set_params,
     )
 ]

@@ -1,7 +1,7 @@
 """Registers RRTstarPSO: OMPL's RRT* followed by the particle swarm over its waypoints."""
 
-from rrtpso_ompl.planners.registry import PlannerEntry
-from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSO, check_swarm_values
+from rrtpso_ompl.planners.registry import Capabilities, PlannerEntry
+from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSO
 
 PLANNERS = [
     PlannerEntry(
@@ -10,7 +10,7 @@ PLANNERS = [
         params=RRTstarPSO.PARAMS,
         description="RRT* for a share of the budget, then PSO over its waypoints (the paper)",
         aliases=("geometric::RRTstarPSO", "RRT*PSO"),
-        optimizing=True,
-        check=check_swarm_values,
+        capabilities=Capabilities(optimizing=True),
+        configure=RRTstarPSO.set_params,
     )
 ]

@@ -1,27 +1,60 @@
 """rrtpso-ompl: the hybrid RRT*PSO path planner as a first-class OMPL planner.
 
-Stages, one module each: :mod:`~rrtpso_ompl.problem` (files) -> :mod:`~rrtpso_ompl.world`
-(exact geometry) -> :mod:`~rrtpso_ompl.ompl_setup` (OMPL objects) -> planners
-(:mod:`~rrtpso_ompl.rrtstar_pso`, :mod:`~rrtpso_ompl.pso_planner`, OMPL's own) ->
-:mod:`~rrtpso_ompl.path_optimizer` and :mod:`~rrtpso_ompl.pso` (post-optimiser) ->
-:mod:`~rrtpso_ompl.results` / :mod:`~rrtpso_ompl.plotting`. Around them:
-:mod:`~rrtpso_ompl.kinematics` (wheel speeds), :mod:`~rrtpso_ompl.dynamic` (moving obstacles),
-:mod:`~rrtpso_ompl.optimum` (the exact shortest path), :mod:`~rrtpso_ompl.batch` and
-:mod:`~rrtpso_ompl.bench` (many runs, OMPL benchmark logs via :mod:`~rrtpso_ompl.ompl_log`),
-:mod:`~rrtpso_ompl.generate` (random worlds).
+One subpackage per stage, each with a short ``__init__`` that is its public face:
 
-The planner classes import OMPL; import them from their modules (``from rrtpso_ompl.rrtstar_pso
-import RRTstarPSO``) or through :func:`rrtpso_ompl.registry.default_registry`.
+- :mod:`rrtpso_ompl.model`: problem files and the world's exact geometry;
+- :mod:`rrtpso_ompl.ompl_setup`: the problem as OMPL objects (space, checkers, seeding);
+- :mod:`rrtpso_ompl.planners`: RRTstarPSO, the swarm, the PSO baseline, OMPL's planners by name,
+  and :func:`~rrtpso_ompl.planners.solve`, the one door to planning;
+- :mod:`rrtpso_ompl.kinematics`: reference path, velocities and wheel speeds;
+- :mod:`rrtpso_ompl.dynamic`: moving obstacles, prediction and replanning;
+- :mod:`rrtpso_ompl.evaluation`: the exact optimum, batches, benchmarks in OMPL's format,
+  generated problems;
+- :mod:`rrtpso_ompl.cli`: the ``rrtpso`` command; :mod:`rrtpso_ompl.plotting`: every figure.
+
+The names below are importable from here; ``solve`` and ``RRTstarPSO`` load OMPL on first use,
+so ``import rrtpso_ompl`` alone stays light.
 """
 
+from importlib import import_module
 from importlib.metadata import PackageNotFoundError, version
+from typing import Any
 
-from .model.problem import Problem, ProblemError, load_problem, problem_from_dict
-from .model.world import World
+from .errors import ParameterError, PlannerError, ProblemError, RrtpsoError, UnknownPlannerError
+from .model import Problem, World, load_problem, problem_from_dict
 
 try:
     __version__ = version("rrtpso-ompl")
 except PackageNotFoundError:  # running from a source tree that was never installed
     __version__ = "0+unknown"
 
-__all__ = ["Problem", "ProblemError", "World", "__version__", "load_problem", "problem_from_dict"]
+#: Names that need OMPL, imported on first access (PEP 562).
+_LAZY = {
+    "solve": "rrtpso_ompl.planners",
+    "SolveResult": "rrtpso_ompl.planners",
+    "RRTstarPSO": "rrtpso_ompl.planners",
+    "default_registry": "rrtpso_ompl.planners",
+}
+
+__all__ = [
+    "ParameterError",
+    "PlannerError",
+    "Problem",
+    "ProblemError",
+    "RRTstarPSO",
+    "RrtpsoError",
+    "SolveResult",
+    "UnknownPlannerError",
+    "World",
+    "__version__",
+    "default_registry",
+    "load_problem",
+    "problem_from_dict",
+    "solve",
+]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        return getattr(import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'rrtpso_ompl' has no attribute {name!r}")

@@ -1,4 +1,4 @@
-"""Typed results: what a solve returns and what ``rrtpso solve --json`` writes."""
+"""Publishing results: files appear whole or not at all, and JSON holds only what JSON can."""
 
 from __future__ import annotations
 
@@ -8,95 +8,19 @@ import os
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 __all__ = [
-    "SolveResult",
     "atomic_path",
+    "finite",
+    "json_line",
     "publish_atomic",
     "write_json_atomic",
     "write_text_atomic",
 ]
-
-
-@dataclass(frozen=True)
-class SolveResult:
-    """The outcome of solving one problem with one planner.
-
-    Attributes
-    ----------
-    problem : str
-        Problem name.
-    planner : str
-        Planner name as selected.
-    status : str
-        ``"exact"``, ``"approximate"`` or ``"none"`` (the contract's three values).
-    ompl_status : str
-        OMPL's own status text (``"Exact solution"``, ``"Timeout"``, ``"Crash"``, ...).
-    solved : bool
-        True only for an exact path that passed the exact validity check.
-    length : float or None
-        Euclidean length of ``path`` in problem units.
-    time : float
-        Wall-clock seconds spent in the planner.
-    seed : int or None
-        The seed OMPL and numpy ran with.
-    path : (n, 2) ndarray
-        The returned polyline (empty when there is none).
-    time_limit : float
-        The budget, seconds.
-    params : dict
-        Planner parameters as applied.
-    stages : dict
-        Per-stage figures (for RRTstarPSO: RRT* and PSO lengths, times, iterations, PSO best cost
-        per iteration).
-    clearance : float or None
-        Smallest distance from the path to an obstacle, minus the robot radius (>= 0 when valid).
-    valid : bool
-        Whether ``path`` passed the exact check (bounds, every segment, robot radius).
-    """
-
-    problem: str
-    planner: str
-    status: str
-    ompl_status: str
-    solved: bool
-    length: float | None
-    time: float
-    seed: int | None
-    path: np.ndarray = field(repr=False)
-    time_limit: float = 0.0
-    params: dict[str, Any] = field(default_factory=dict)
-    stages: dict[str, Any] = field(default_factory=dict)
-    clearance: float | None = None
-    valid: bool = False
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dictionary with the contract's keys first."""
-        return {
-            "problem": self.problem,
-            "planner": self.planner,
-            "status": self.status,
-            "solved": self.solved,
-            "length": self.length,
-            "time": self.time,
-            "seed": self.seed,
-            "path": np.asarray(self.path, dtype=float).reshape(-1, 2).tolist(),
-            "ompl_status": self.ompl_status,
-            "time_limit": self.time_limit,
-            "valid": self.valid,
-            "clearance": _finite(self.clearance),
-            "params": self.params,
-            "stages": self.stages,
-        }
-
-
-def _finite(x: float | None) -> float | None:
-    return None if x is None or not math.isfinite(x) else float(x)
 
 
 def publish_atomic(tmp: str | Path, path: str | Path) -> None:
@@ -141,8 +65,24 @@ def write_text_atomic(text: str, path: str | Path) -> Path:
 
 def write_json_atomic(data: Any, path: str | Path) -> None:
     """Write JSON through a temporary file and a rename, so a reader never sees half a file."""
-    text = json.dumps(data, indent=2, allow_nan=False, default=_json_default) + "\n"
+    text = json.dumps(finite(data), indent=2, allow_nan=False, default=_json_default) + "\n"
     write_text_atomic(text, path)
+
+
+def json_line(row: Any) -> str:
+    """One JSON-lines row: compact, NaN and infinities as null, ending in a newline."""
+    return json.dumps(finite(row), allow_nan=False, default=_json_default) + "\n"
+
+
+def finite(obj: Any) -> Any:
+    """The same data with NaN and infinities as None (JSON has neither)."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: finite(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [finite(v) for v in obj]
+    return obj
 
 
 def _json_default(obj: Any) -> Any:

@@ -12,7 +12,7 @@ import numbers
 import reprlib
 from typing import Any
 
-__all__ = ["SEED_MAX", "check_integer", "check_number", "check_seed", "describe"]
+__all__ = ["SEED_MAX", "check_integer", "check_number", "check_seed", "describe", "short_repr"]
 
 #: The largest seed: OMPL's ``RNG::setSeed`` takes a 32-bit unsigned integer on every platform
 #: (``std::uint_fast32_t``, which is 32 bits on some), and numpy accepts any non-negative one.
@@ -25,15 +25,19 @@ _REPR.maxstring = _REPR.maxother = _REPR.maxlong = 40
 _REPR.maxlist = _REPR.maxtuple = _REPR.maxdict = _REPR.maxset = _REPR.maxfrozenset = 4
 
 
+def short_repr(value: Any) -> str:
+    """A repr of at most a few dozen characters, however large or nested the value."""
+    try:
+        return _REPR.repr(value)
+    except ValueError:  # an int with more digits than Python will convert to text
+        return "(too long to show)"
+
+
 def describe(value: Any) -> str:
     """A short description of a wrong value for error messages (type and bounded repr)."""
     if value is None:
         return "nothing (null)"
-    try:
-        text = _REPR.repr(value)
-    except ValueError:  # an int with more digits than Python will convert to text
-        text = "(too long to show)"
-    return f"{type(value).__name__} {text}"
+    return f"{type(value).__name__} {short_repr(value)}"
 
 
 def _bound_text(x: float) -> str:

@@ -12,16 +12,16 @@ from __future__ import annotations
 
 import glob
 import json
-import math
 import multiprocessing as mp
 import time
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..outputs import write_text_atomic
+from ..errors import RrtpsoError
+from ..outputs import json_line, write_text_atomic
 
 __all__ = [
     "Task",
@@ -149,7 +149,7 @@ def run_task(task: Task) -> dict[str, Any]:
     the task asked for (None: the file's).
     """
     from ..model.problem import ProblemError, load_problem
-    from ..ompl_setup.context import set_ompl_log_level
+    from ..ompl_setup import set_ompl_log_level
     from ..planners.solve import solve
 
     set_ompl_log_level(0)
@@ -174,10 +174,10 @@ def run_task(task: Task) -> dict[str, Any]:
             simplify=task.simplify,
             progress=task.progress,
         )
-    except ProblemError as exc:
+    except ProblemError as exc:  # it names the file already
         return _error_row(base, str(exc))
-    except (KeyError, ValueError) as exc:  # unknown planner, bad parameter
-        return _error_row(base, f"{task.file}: {exc.args[0] if exc.args else exc}")
+    except RrtpsoError as exc:  # unknown planner, bad parameter
+        return _error_row(base, f"{task.file}: {exc}")
     row = {**base, **result.to_dict()}
     row["file"] = task.file
     row["run"] = task.run
@@ -231,31 +231,6 @@ def read_rows(path: str | Path) -> list[dict[str, Any]]:
 
 def _row_key(row: Mapping[str, Any]) -> tuple[str, str, int, float | None]:
     return (row.get("file"), row.get("planner"), row.get("seed"), row.get("budget"))
-
-
-def _json_line(row: Mapping[str, Any]) -> str:
-    return json.dumps(_finite(row), allow_nan=False, default=_plain) + "\n"
-
-
-def _finite(obj: Any) -> Any:
-    """NaN and infinities become null (JSON has neither)."""
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_finite(v) for v in obj]
-    return obj
-
-
-def _plain(obj: Any) -> Any:
-    import numpy as np
-
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, np.generic):
-        return obj.item()
-    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -344,7 +319,7 @@ def run_batch(
     if on_start is not None:
         on_start(len(todo), len(tasks) - len(todo))
     # Rewrite the kept rows first: this drops a torn last line and retried error rows.
-    write_text_atomic("".join(_json_line(r) for r in kept), out)
+    write_text_atomic("".join(json_line(r) for r in kept), out)
     rows = list(kept)
     if executor == "local":
         results = _local_results(todo, max(1, jobs))
@@ -359,7 +334,7 @@ def run_batch(
         for row in results:
             if optima is not None:
                 optima.annotate(row)
-            fh.write(_json_line(row))  # one whole line per write: never a torn row mid-file
+            fh.write(json_line(row))  # one whole line per write: never a torn row mid-file
             fh.flush()
             rows.append(row)
             if progress is not None:
@@ -391,8 +366,3 @@ class _Optima:
         # shorter than the optimum.
         length = row.get("length") if row.get("solved") else None
         row["ratio"] = length / opt if length is not None and opt else None
-
-
-def task_dict(task: Task) -> dict[str, Any]:
-    """A task as plain data (for logs and reports)."""
-    return asdict(task)

@@ -13,17 +13,20 @@ checker for every planner), then writes
   path length over the exact optimum (:mod:`rrtpso_ompl.optimum`) and the median time;
 - ``ratio.png`` and ``success.png`` (drawn by the command line; this module draws nothing).
 
-How runs map to OMPL's properties, as Planner Arena expects them:
+How runs map to OMPL's properties, as Planner Arena expects them: each planner's stats say it
+themselves (:class:`~rrtpso_ompl.planners.result.BenchmarkRun`, carried in every row), so nothing
+here knows a planner by name.
 
-- OMPL's stock planners are followed by OMPL's path simplifier, as in OMPL's ``Benchmark``:
-  ``time`` is the planner's, ``solution length`` its raw path, ``simplified solution length``
-  the simplified one, ``simplification time`` the simplifier's.
+- Planners whose registry entry asks for it (OMPL's own) are followed by OMPL's path simplifier,
+  as in OMPL's ``Benchmark``: ``time`` is the planner's, ``solution length`` its raw path,
+  ``simplified solution length`` the simplified one, ``simplification time`` the simplifier's.
 - For RRTstarPSO the RRT* stage is the planner and the swarm the simplifier: ``simplification
   time`` is the PSO's time, ``time`` the rest of the solve (the RRT* stage and OMPL's simplifier,
   when on), so ``time + simplification time`` is the whole solve, within the budget;
-  ``solution length`` is the RRT* path and ``simplified solution length`` the PSO result. Other
-  planners of this package are not simplified.
-- Every planner gets progress rows ``time, best cost`` (see :func:`rrtpso_ompl.solve.solve`).
+  ``solution length`` is the RRT* path and ``simplified solution length`` the PSO result. The PSO
+  baseline has no simplification stage.
+- Planner-specific figures (RRT*'s ``iterations``, the swarm's ``pso iterations``) are further
+  run properties, and every planner gets progress rows ``time, best cost``.
 """
 
 from __future__ import annotations
@@ -40,6 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from ..outputs import atomic_path, write_text_atomic
+from ..planners.result import BenchmarkRun
 from .batch import Task, make_tasks, run_batch
 from .ompl_log import Experiment, PlannerRuns, build_database, write_log
 
@@ -68,14 +72,15 @@ RUN_PROPERTIES: list[tuple[str, str]] = [
     ("length over optimum", "REAL"),
     ("seed", "INTEGER"),
 ]
+_COMMON_NAMES = {name for name, _ in RUN_PROPERTIES}
 PROGRESS_PROPERTIES: list[tuple[str, str]] = [("time", "REAL"), ("best cost", "REAL")]
 
 
-def is_stock(planner: str) -> bool:
-    """Whether ``planner`` is one of OMPL's own (simplified after the run, as OMPL does)."""
+def _simplified_in_benchmarks(planner: str) -> bool:
+    """Whether benchmarks follow ``planner`` with OMPL's simplifier (its registry entry says)."""
     from ..planners.registry import default_registry
 
-    return default_registry().get(planner).source.endswith(".ompl_geometric")
+    return default_registry().get(planner).capabilities.simplify_in_benchmark
 
 
 def bench_tasks(
@@ -85,12 +90,18 @@ def bench_tasks(
     times: Sequence[float],
     seed: int = 1,
     params: Mapping[str, Mapping[str, Any]] | None = None,
+    simplify: bool | None = None,
 ) -> list[Task]:
-    """Every problem x budget x planner x run (run ``r`` seeded ``seed + r`` at every budget)."""
+    """Every problem x budget x planner x run (run ``r`` seeded ``seed + r`` at every budget).
+
+    ``simplify`` None follows each planner's registry entry (OMPL's planners are simplified, as
+    in OMPL's Benchmark); True or False applies to every planner.
+    """
+    how = _simplified_in_benchmarks if simplify is None else simplify
     tasks = []
     for budget in times:
         tasks += make_tasks(items, planners, runs=runs, seed=seed, time_limit=budget,
-                            params=params, simplify=is_stock, keep_path=False,
+                            params=params, simplify=how, keep_path=False,
                             progress=True)  # fmt: skip
     return tasks
 
@@ -150,6 +161,7 @@ def run_bench(
     progress: Callable[[dict[str, Any]], None] | None = None,
     on_start: Callable[[int, int], None] | None = None,
     command: str | None = None,
+    simplify: bool | None = None,
 ) -> BenchResult:
     """Run a benchmark and write its results to ``out_dir`` (see the module docstring).
 
@@ -169,6 +181,9 @@ def run_bench(
         As for :func:`rrtpso_ompl.batch.run_batch` and :func:`~rrtpso_ompl.batch.make_tasks`.
     command : str, optional
         The command line that ran the benchmark, quoted at the top of ``report.md``.
+    simplify : bool, optional
+        Follow every planner with OMPL's simplifier (True), none (False, e.g. the paper's
+        Table 3 of raw paths), or as its registry entry says (None).
 
     Returns
     -------
@@ -176,7 +191,7 @@ def run_bench(
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    tasks = bench_tasks(items, planners, runs, times, seed, params)
+    tasks = bench_tasks(items, planners, runs, times, seed, params, simplify)
     rows = run_batch(tasks, out / "runs.jsonl", jobs=jobs, resume=resume, executor=executor,
                      scheduler=scheduler, progress=progress, on_start=on_start)  # fmt: skip
     errors = sorted({r["error"] for r in rows if r.get("error")})
@@ -195,38 +210,37 @@ def run_bench(
 # Rows -> OMPL experiments
 # ----------------------------------------------------------------------------------------------
 def run_properties(row: Mapping[str, Any]) -> dict[str, Any]:
-    """One batch row as OMPL run properties (see the module docstring for the mapping)."""
-    st = row.get("stages") or {}
+    """One batch row as OMPL run properties: the planner's own figures (its ``benchmark`` run),
+    the checks of the harness and the ratio to the optimum."""
+    run = BenchmarkRun.from_dict(row.get("benchmark") or {"time": row.get("time") or 0.0})
     solved = bool(row.get("solved"))
     final = row.get("length") if solved else None
-    if "pso_length" in st:  # RRTstarPSO: the swarm is its simplifier
-        total = row.get("time")
-        simp_time = st.get("pso_time")
-        plan_time = None if total is None else total - (simp_time or 0.0)
-        raw = st.get("rrt_length")
-        simplified = final
-    elif "unsimplified_length" in st:  # a stock planner and OMPL's simplifier
-        plan_time = row.get("time")
-        raw = st.get("unsimplified_length")
-        simplified, simp_time = final, st.get("simplification_time")
-        total = (plan_time or 0.0) + (simp_time or 0.0)
-    else:
-        plan_time, raw, simplified, simp_time = row.get("time"), final, None, None
-        total = plan_time
+    has_path = row.get("status") in ("exact", "approximate")
     optimum = row.get("optimum")
     return {
-        "time": plan_time,
+        "time": run.time,
         "solved": solved,
         "status": row.get("ompl_status") or "Unknown status",
         "correct solution": bool(row.get("valid")),
-        "solution length": raw if row.get("status") in ("exact", "approximate") else None,
-        "simplified solution length": simplified,
-        "simplification time": simp_time,
-        "total time": total,
+        "solution length": run.solution_length if has_path else None,
+        "simplified solution length": run.simplified_length if solved else None,
+        "simplification time": run.simplification_time,
+        "total time": run.total_time,
         "solution clearance": row.get("clearance") if solved else None,
         "length over optimum": final / optimum if final is not None and optimum else None,
         "seed": row.get("seed"),
+        **{name: value for name, (_, value) in run.properties.items()},
     }
+
+
+def _planner_properties(rows: Iterable[Mapping[str, Any]]) -> list[tuple[str, str]]:
+    """The run properties of one planner's block: the common ones, then its own (typed)."""
+    own: dict[str, str] = {}
+    for r in rows:
+        for name, (ptype, _) in BenchmarkRun.from_dict(r.get("benchmark") or {"time": 0.0}
+                                                       ).properties.items():  # fmt: skip
+            own.setdefault(name, ptype)
+    return RUN_PROPERTIES + [(n, own[n]) for n in sorted(own) if n not in _COMMON_NAMES]
 
 
 def _experiment_name(problem: str, budget: float) -> str:
@@ -267,11 +281,11 @@ def to_experiments(
                 PlannerRuns(
                     name=planner,
                     settings=settings,
-                    run_properties=RUN_PROPERTIES,
+                    run_properties=_planner_properties(mine),
                     runs=[run_properties(r) for r in mine],
                     progress_properties=PROGRESS_PROPERTIES,
                     progress=[
-                        [tuple(p) for p in (r.get("stages") or {}).get("progress", [])]
+                        [tuple(p) for p in (r.get("benchmark") or {}).get("progress", [])]
                         for r in mine
                     ],
                 )

@@ -1,1 +1,40 @@
-"""TODO"""
+"""The problem and its world: files in, exact geometry out (no OMPL, no matplotlib).
+
+- :mod:`.problem`: problem files (YAML) to frozen dataclasses, every bad input one
+  :class:`~rrtpso_ompl.errors.ProblemError` naming the file and the key;
+- :mod:`.world`: :class:`World`, the static obstacles prepared for exact collision checks
+  (scalar for OMPL's callbacks, vectorised for the swarm);
+- :mod:`.geometry`: polyline lengths, shortcutting and point-segment distances, used by every
+  stage.
+"""
+
+from .geometry import path_length, shortcut
+from .problem import (
+    Circle,
+    MovingObstacle,
+    Obstacle,
+    PlannerConfig,
+    Polygon,
+    Problem,
+    ProblemError,
+    Robot,
+    load_problem,
+    problem_from_dict,
+)
+from .world import World
+
+__all__ = [
+    "Circle",
+    "MovingObstacle",
+    "Obstacle",
+    "PlannerConfig",
+    "Polygon",
+    "Problem",
+    "ProblemError",
+    "Robot",
+    "World",
+    "load_problem",
+    "path_length",
+    "problem_from_dict",
+    "shortcut",
+]

@@ -13,7 +13,6 @@ from __future__ import annotations
 import difflib
 import math
 import numbers
-import reprlib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,6 +22,9 @@ from typing import Any
 import numpy as np
 import shapely
 import yaml
+
+from ..errors import ProblemError
+from ..validation import check_number, check_seed, describe, short_repr
 
 __all__ = [
     "Circle",
@@ -40,32 +42,6 @@ __all__ = [
 ]
 
 Point = tuple[float, float]
-
-
-class ProblemError(ValueError):
-    """A problem file (or dictionary) is not a valid problem.
-
-    Parameters
-    ----------
-    source : str
-        The file the problem came from (or a label such as ``"<dict>"``).
-    key : str
-        The offending key as a dotted path, e.g. ``"obstacles[2].radius"``; empty for the
-        whole file.
-    message : str
-        What is wrong, in words a user can act on.
-    """
-
-    def __init__(self, source: str, key: str, message: str) -> None:
-        self.source = str(source)
-        self.key = key
-        self.message = message
-        where = f"{self.source}: {key}" if key else self.source
-        super().__init__(f"{where}: {message}")
-
-    def __reduce__(self):
-        # Picklable, so that a worker process can send it back to its parent.
-        return (type(self), (self.source, self.key, self.message))
 
 
 @dataclass(frozen=True)
@@ -301,8 +277,6 @@ _OBSTACLE_KEYS = {
     "polygon": ("type", "points"),
 }
 _MOVING_KEYS = ("radius", "start", "speed", "heading_deg")
-#: OMPL's ``RNG.setSeed`` takes an unsigned 64-bit integer; a larger seed would fail mid-run.
-_MAX_SEED = 2**64 - 1
 
 
 class _Validator:
@@ -326,7 +300,7 @@ class _Validator:
         if not isinstance(value, Mapping):
             subject = "the file" if not key else "this key"
             raise self.error(
-                key, f"{subject} must be a mapping of keys to values, got {_describe(value)}"
+                key, f"{subject} must be a mapping of keys to values, got {describe(value)}"
             )
         for k in value:
             if not isinstance(k, str) or k not in allowed:
@@ -344,39 +318,31 @@ class _Validator:
     def sequence(self, doc: Mapping[str, Any], key: str) -> list[Any] | tuple[Any, ...]:
         value = _get(doc, key, [])
         if not isinstance(value, list | tuple):
-            raise self.error(key, f"must be a list, got {_describe(value)}")
+            raise self.error(key, f"must be a list, got {describe(value)}")
         return value
 
     # -- scalars -----------------------------------------------------------------------------------
     def number(self, value: Any, key: str, low: float | None = None, strict: bool = False) -> float:
-        # bool is an int subclass, but `radius: yes` is a mistake, not the number 1.
-        if isinstance(value, bool) or not isinstance(value, numbers.Real):
-            raise self.error(key, f"must be a number, got {_describe(value)}{_number_hint(value)}")
         try:
-            x = float(value)
-        except OverflowError:
-            raise self.error(key, "is too large for a floating-point number") from None
-        if not math.isfinite(x):
-            raise self.error(key, f"must be a finite number, got {x}")
-        if low is not None and (x <= low if strict else x < low):
-            raise self.error(key, f"must be {'>' if strict else '>='} {low:g}, got {x:g}")
-        return x
+            return check_number(value, low=low, strict_low=strict)
+        except ValueError as exc:
+            raise self.error(key, f"{exc}{_number_hint(value)}") from None
 
     def string(self, value: Any, key: str, empty: bool = False) -> str:
         if not isinstance(value, str) or (not empty and not value.strip()):
             kind = "string" if empty else "non-empty string"
-            raise self.error(key, f"must be a {kind}, got {_describe(value)}")
+            raise self.error(key, f"must be a {kind}, got {describe(value)}")
         return value
 
     def point(self, value: Any, key: str) -> Point:
         if not isinstance(value, list | tuple) or len(value) != 2:
-            raise self.error(key, f"must be a point [x, y], got {_describe(value)}")
+            raise self.error(key, f"must be a point [x, y], got {describe(value)}")
         return (self.number(value[0], f"{key}[0]"), self.number(value[1], f"{key}[1]"))
 
     # -- sections ----------------------------------------------------------------------------------
     def bounds(self, value: Any, key: str) -> tuple[Point, Point]:
         if not isinstance(value, list | tuple) or len(value) != 2:
-            raise self.error(key, f"must be [[xmin, ymin], [xmax, ymax]], got {_describe(value)}")
+            raise self.error(key, f"must be [[xmin, ymin], [xmax, ymax]], got {describe(value)}")
         lo, hi = self.point(value[0], f"{key}[0]"), self.point(value[1], f"{key}[1]")
         if not (lo[0] < hi[0] and lo[1] < hi[1]):
             raise self.error(key, f"needs xmin < xmax and ymin < ymax, got {lo} and {hi}")
@@ -407,24 +373,23 @@ class _Validator:
             limit = self.number(limit, f"{key}.time_limit", low=0.0, strict=True)
         seed = doc.get("seed")
         if seed is not None:
-            if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
-                raise self.error(
-                    f"{key}.seed", f"must be a non-negative integer, got {_describe(seed)}"
-                )
-            if seed > _MAX_SEED:
-                raise self.error(f"{key}.seed", "must be at most 2**64 - 1 (OMPL's seed range)")
-            seed = int(seed)
+            if not isinstance(seed, numbers.Integral):  # 1.0 is a typo here, not a seed
+                raise self.error(f"{key}.seed", f"must be an integer, got {describe(seed)}")
+            try:
+                seed = check_seed(seed)
+            except ValueError as exc:
+                raise self.error(f"{key}.seed", str(exc)) from None
         params = _get(doc, "params", {})
         if not isinstance(params, Mapping) or not all(isinstance(k, str) for k in params):
             raise self.error(
                 f"{key}.params",
-                f"must be a mapping of parameter names to values, got {_describe(params)}",
+                f"must be a mapping of parameter names to values, got {describe(params)}",
             )
         return PlannerConfig(ptype, limit, seed, MappingProxyType(dict(params)))
 
     def obstacle(self, value: Any, key: str) -> Obstacle:
         if not isinstance(value, Mapping):
-            raise self.error(key, f"must be a mapping with a 'type', got {_describe(value)}")
+            raise self.error(key, f"must be a mapping with a 'type', got {describe(value)}")
         known = ", ".join(_OBSTACLE_KEYS)
         kind = value.get("type")
         if kind is None:
@@ -432,7 +397,7 @@ class _Validator:
         if not isinstance(kind, str) or kind not in _OBSTACLE_KEYS:
             did = _did_you_mean(str(kind), tuple(_OBSTACLE_KEYS)) if isinstance(kind, str) else ""
             raise self.error(
-                f"{key}.type", f"unknown obstacle type {_describe(kind)}{did}; known types: {known}"
+                f"{key}.type", f"unknown obstacle type {describe(kind)}{did}; known types: {known}"
             )
         allowed = _OBSTACLE_KEYS[kind]
         doc = self.mapping(value, key, allowed, required=allowed, what=f" for a {kind}")
@@ -451,7 +416,7 @@ class _Validator:
 
     def polygon(self, value: Any, key: str) -> Polygon:
         if not isinstance(value, list | tuple):
-            raise self.error(key, f"must be a list of points, got {_describe(value)}")
+            raise self.error(key, f"must be a list of points, got {describe(value)}")
         ring: list[Point] = []
         for i, p in enumerate(value):
             q = self.point(p, f"{key}[{i}]")
@@ -535,7 +500,7 @@ class _SafeLoader(yaml.SafeLoader):
             raise yaml.constructor.ConstructorError(
                 None,
                 None,
-                f"cannot read the value {_REPR.repr(node.value)}: {exc}",
+                f"cannot read the value {short_repr(node.value)}: {exc}",
                 node.start_mark,
             ) from None
 
@@ -576,7 +541,7 @@ def _refuse_duplicate_keys(root: yaml.Node) -> None:
                         raise yaml.constructor.ConstructorError(
                             None,
                             None,
-                            f"duplicate key {_REPR.repr(key.value)} "
+                            f"duplicate key {short_repr(key.value)} "
                             f"(first written at line {other.start_mark.line + 1})",
                             key.start_mark,
                         )
@@ -675,21 +640,3 @@ def _number_hint(value: Any) -> str:
             fixed = f"{mantissa}.0e{exponent}"
         return f" (YAML reads {value} as text, not a number: write {fixed})"
     return " (a number in quotes is text: remove the quotes)"
-
-
-#: Short, bounded reprs: a value may be a huge or self-referencing structure (YAML anchors).
-_REPR = reprlib.Repr()
-_REPR.maxlevel = 3
-_REPR.maxstring = _REPR.maxother = _REPR.maxlong = 40
-_REPR.maxlist = _REPR.maxtuple = _REPR.maxdict = _REPR.maxset = _REPR.maxfrozenset = 4
-
-
-def _describe(value: Any) -> str:
-    """A short description of a wrong value for error messages."""
-    if value is None:
-        return "nothing (null)"
-    try:
-        text = _REPR.repr(value)
-    except ValueError:  # an int with more digits than Python will convert to text
-        text = "(too long to show)"
-    return f"{type(value).__name__} {text}"

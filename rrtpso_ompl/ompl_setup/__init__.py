@@ -1,4 +1,31 @@
-"""TODO"""
+"""From a problem to OMPL objects: the only place that builds them for a problem.
 
-from .context import *  # noqa: F403
-from .context import __all__  # noqa: F401
+- :func:`make_context`: ``RealVectorStateSpace(2)`` with the problem's bounds, a validity checker
+  and an *exact* motion validator over the :class:`~rrtpso_ompl.model.World`, the path-length
+  objective, start and goal (:mod:`.context`);
+- :func:`path_to_array`, :func:`array_to_path`: paths as numpy arrays (:mod:`.convert`);
+- :func:`seed_ompl`, :func:`set_ompl_log_level`: OMPL's process-wide seed, once per process
+  before any OMPL object exists, and its log level (:mod:`.process`).
+"""
+
+from .context import (
+    EXACT_GOAL_THRESHOLD,
+    ExactMotionValidator,
+    PlanningContext,
+    WorldValidityChecker,
+    make_context,
+)
+from .convert import array_to_path, path_to_array
+from .process import seed_ompl, set_ompl_log_level
+
+__all__ = [
+    "EXACT_GOAL_THRESHOLD",
+    "ExactMotionValidator",
+    "PlanningContext",
+    "WorldValidityChecker",
+    "array_to_path",
+    "make_context",
+    "path_to_array",
+    "seed_ompl",
+    "set_ompl_log_level",
+]

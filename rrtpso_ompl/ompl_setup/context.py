@@ -1,4 +1,4 @@
-"""Everything that turns a :class:`~rrtpso_ompl.problem.Problem` into OMPL objects.
+"""A :class:`~rrtpso_ompl.model.Problem` as OMPL objects: a ready ``og.SimpleSetup``.
 
 * ``RealVectorStateSpace(2)`` with the problem's bounds (the robot's centre);
 * a state validity checker and an *exact* motion validator over the same
@@ -6,77 +6,26 @@
   it keeps the robot radius from every obstacle);
 * the path-length objective, the start and the goal (with its tolerance).
 
-Also the process-wide OMPL housekeeping: seeding OMPL's RNG once per process and its log level.
 See ``docs/design.md`` for why some OMPL calls are avoided from Python (the bindings notes).
 """
 
 from __future__ import annotations
 
-import logging
 from dataclasses import dataclass
 
 import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
-from ompl import util as ou
 
 from ..model.problem import Problem
 from ..model.world import World
 
-__all__ = [
-    "ExactMotionValidator",
-    "PlanningContext",
-    "WorldValidityChecker",
-    "array_to_path",
-    "make_context",
-    "path_to_array",
-    "seed_ompl",
-    "set_ompl_log_level",
-]
-
-log = logging.getLogger(__name__)
+__all__ = ["EXACT_GOAL_THRESHOLD", "ExactMotionValidator", "PlanningContext",
+           "WorldValidityChecker", "make_context"]  # fmt: skip
 
 #: Goal threshold used for ``goal_tolerance == 0``: OMPL's GoalState accepts ``d < threshold`` so a
 #: zero threshold would never be met; a path ending exactly at the sampled goal state has d = 0.
 EXACT_GOAL_THRESHOLD = 1e-9
-
-_seeded: int | None = None
-
-
-def seed_ompl(seed: int | None) -> bool:
-    """Seed OMPL's global RNG, once per process, before any OMPL object samples.
-
-    OMPL derives every planner's and sampler's seed from one process-wide generator, and refuses a
-    new seed once that generator has started. So the first call wins; later calls with another
-    seed return False (and log a warning) instead of silently pretending to reseed.
-
-    Returns
-    -------
-    bool
-        Whether OMPL now runs with ``seed``.
-    """
-    global _seeded
-    if seed is None:
-        return _seeded is None
-    if _seeded is None:
-        ou.RNG.setSeed(int(seed))
-        _seeded = int(seed)
-        return True
-    if _seeded != seed:
-        log.warning(
-            "OMPL was already seeded with %d in this process; seed %d cannot take effect "
-            "(run each seed in its own process for reproducible results)",
-            _seeded,
-            seed,
-        )
-        return False
-    return True
-
-
-def set_ompl_log_level(verbose: int = 0) -> None:
-    """OMPL's own log level: warnings only (0), Info (1) or Debug (2+)."""
-    level = {0: ou.LOG_WARN, 1: ou.LOG_INFO}.get(verbose, ou.LOG_DEBUG)
-    ou.setLogLevel(level)
 
 
 class WorldValidityChecker(ob.StateValidityChecker):
@@ -112,17 +61,11 @@ class ExactMotionValidator(ob.MotionValidator):
     def __init__(self, si: ob.SpaceInformation, world: World) -> None:
         super().__init__(si)
         self.world = world
-        self.n_checked = 0
-        self.n_invalid = 0
 
     def checkMotion(self, s1, s2, *last_valid) -> bool:
-        self.n_checked += 1
-        ok = self.world.in_bounds(s2[0], s2[1]) and self.world.motion_free(
+        return self.world.in_bounds(s2[0], s2[1]) and self.world.motion_free(
             s1[0], s1[1], s2[0], s2[1]
         )
-        if not ok:
-            self.n_invalid += 1
-        return ok
 
 
 @dataclass
@@ -173,20 +116,3 @@ def make_context(problem: Problem, world: World | None = None) -> PlanningContex
     ss.setStartAndGoalStates(start, goal, threshold)
     ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
     return PlanningContext(problem, world, ss, si, space, checker, validator)
-
-
-def path_to_array(path: og.PathGeometric) -> np.ndarray:
-    """Waypoints of an OMPL geometric path as an ``(n, 2)`` array (copied)."""
-    return np.array([(s[0], s[1]) for s in path.getStates()], dtype=float).reshape(-1, 2)
-
-
-def array_to_path(si: ob.SpaceInformation, xy: np.ndarray) -> og.PathGeometric:
-    """An OMPL geometric path through the waypoints ``xy`` ``(n, 2)``."""
-    path = og.PathGeometric(si)
-    # The binding hands ownership of an allocated state to Python (freeing it here would free it
-    # twice); append copies it into the path.
-    state = si.allocState()
-    for x, y in np.asarray(xy, dtype=float):
-        state[0], state[1] = float(x), float(y)
-        path.append(state)
-    return path

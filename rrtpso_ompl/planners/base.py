@@ -1,7 +1,10 @@
 """What every Python planner of this project shares on top of ``ob.Planner``.
 
-* Parameters by name from a :class:`~rrtpso_ompl.registry.ParamSpec` table (``set_param``,
-  ``get_param``, ``param_values``), because ``Planner.params()`` is unusable from Python.
+* Parameters by name from its declared :class:`~rrtpso_ompl.planners.params.ParamTable`
+  (``set_param``, ``set_params``, ``get_param``, ``param_values``), because ``Planner.params()``
+  is unusable from Python.
+* Typed statistics of the last solve (:class:`PlannerStats`), which know their own part in OMPL's
+  benchmark terms: planning time, simplification, planner-specific run properties and progress.
 * ``solve`` never raises: an exception inside is logged and reported as ``PlannerStatus.CRASH``
   (an exception escaping a Python planner would abort a whole OMPL Benchmark).
 * The collision model: the vectorised :class:`~rrtpso_ompl.world.World` when the space
@@ -14,7 +17,7 @@
 from __future__ import annotations
 
 import logging
-import math
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -22,11 +25,73 @@ from ompl import base as ob
 from ompl import util as ou
 
 from ..model.problem import touch_tolerance
-from .registry import ParamSpec
+from .params import ParamSpec, ParamTable
+from .result import BenchmarkRun
 
-__all__ = ["PythonPlanner", "SpaceInformationCollisionModel", "collision_model_for"]
+__all__ = [
+    "BUDGET",
+    "SEED",
+    "PlannerStats",
+    "PythonPlanner",
+    "SpaceInformationCollisionModel",
+    "collision_model_for",
+]
 
 log = logging.getLogger(__name__)
+
+
+#: The time a planner may split between its stages (OMPL's termination condition does not say how
+#: much is left, so planners that split their time are told the whole of it).
+BUDGET = ParamSpec(
+    "budget",
+    float,
+    0.0,
+    "Total time the caller gives solve(); 0 = unknown: the planner then runs until the "
+    "termination condition and bounds its later stages by their iterations only.",
+    unit="s",
+    low=0.0,
+)
+#: The seed of a planner's own numpy Generator.
+SEED = ParamSpec(
+    "seed",
+    int,
+    -1,
+    "Seed of the planner's numpy Generator; -1 draws it from OMPL's RNG "
+    "(so ompl.util.RNG.setSeed makes the whole run reproducible).",
+    low=-1,
+    high=2**32 - 1,
+)
+
+
+@dataclass
+class PlannerStats:
+    """The figures of one solve; the base class holds none.
+
+    Each planner's stats subclass this dataclass with their own fields and say, in
+    :meth:`benchmark_run`, which part of the run OMPL's Benchmark would call planning and which
+    simplification, and which planner-specific run properties they add. The harness (``solve``,
+    ``batch``, ``bench``) asks the stats instead of guessing from their keys.
+    """
+
+    def benchmark_run(self, elapsed: float, length: float | None) -> BenchmarkRun:
+        """The run in OMPL's terms.
+
+        Parameters
+        ----------
+        elapsed : float
+            Seconds the whole solve took.
+        length : float or None
+            Length of the path the planner returned (None without one).
+        """
+        return BenchmarkRun(time=elapsed, solution_length=length, progress=self.progress())
+
+    def progress(self) -> list[tuple[float, float]]:
+        """``(time s, best cost)`` samples the planner took itself (none by default)."""
+        return []
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dictionary of the figures (the ``stages`` of a solve result)."""
+        return asdict(self)
 
 
 class SpaceInformationCollisionModel:
@@ -85,39 +150,47 @@ def collision_model_for(si: ob.SpaceInformation) -> Any:
 
 
 class PythonPlanner(ob.Planner):
-    """Base class: a parameter table, crash-safe ``solve`` and per-solve statistics.
+    """Base class: declared parameters, crash-safe ``solve`` and per-solve statistics.
 
-    Subclasses define ``PARAMS`` (a tuple of ParamSpec) and implement ``_solve(ptc)`` returning an
-    ``ob.PlannerStatus``; the statistics of the last solve go to ``self.last_stats``.
+    Subclasses define ``PARAMS`` (a :class:`~rrtpso_ompl.planners.params.ParamTable`) and
+    implement ``_solve(ptc)`` returning an ``ob.PlannerStatus``; the statistics of the last solve
+    (a :class:`PlannerStats`) go to ``self.last_stats``.
     """
 
-    PARAMS: tuple[ParamSpec, ...] = ()
+    PARAMS: ParamTable = ParamTable()
 
     def __init__(self, si: ob.SpaceInformation, name: str, **params: Any) -> None:
         super().__init__(si, name)
-        self._values: dict[str, Any] = {p.name: p.default for p in self.PARAMS}
-        for key, value in params.items():
-            self.set_param(key, value)
+        self._values: dict[str, Any] = self.PARAMS.defaults()
+        self.set_params(params)
         self._ompl_rng: ou.RNG | None = None
-        self.last_stats: Any = None
+        self.last_stats: PlannerStats | None = None
 
     # -- parameters ----------------------------------------------------------------------------
     @classmethod
     def param_spec(cls, name: str) -> ParamSpec:
-        """The spec of parameter ``name`` (``KeyError`` listing the known names otherwise)."""
-        for p in cls.PARAMS:
-            if p.name == name:
-                return p
-        known = ", ".join(p.name for p in cls.PARAMS)
-        raise KeyError(f"{cls.__name__} has no parameter '{name}' (known: {known})")
+        """The spec of parameter ``name`` (``ParameterError`` listing the known names otherwise)."""
+        return cls.PARAMS[name]
+
+    def set_params(self, values: dict[str, Any]) -> None:
+        """Set several parameters at once, validated together (rules such as ``c1 + c2 < 4``
+        apply to the new values jointly, not one by one)."""
+        merged = {**self._values, **values}
+        converted = self.PARAMS.validate(merged, owner=self.getName())
+        for name in values:
+            self._apply(name, converted[name])
 
     def set_param(self, name: str, value: Any) -> None:
-        """Set a parameter by name; the value is validated against its spec."""
-        self._values[name] = self.param_spec(name).convert(value)
+        """Set a parameter by name; the value is validated against its declaration."""
+        self.set_params({name: value})
+
+    def _apply(self, name: str, value: Any) -> None:
+        """Store a validated value (subclasses may forward it, e.g. to an inner OMPL planner)."""
+        self._values[name] = value
 
     def get_param(self, name: str) -> Any:
         """Current value of parameter ``name``."""
-        self.param_spec(name)
+        self.PARAMS[name]
         return self._values[name]
 
     def param_values(self) -> dict[str, Any]:
@@ -164,7 +237,3 @@ class PythonPlanner(ob.Planner):
         if self._ompl_rng is None:
             self._ompl_rng = ou.RNG()
         return np.random.default_rng(self._ompl_rng.uniformInt(0, 2**31 - 2))
-
-    @staticmethod
-    def _finite_or_none(x: float) -> float | None:
-        return float(x) if math.isfinite(x) else None

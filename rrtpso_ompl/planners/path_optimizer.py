@@ -34,76 +34,64 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from ..model.geometry import path_length, shortcut, turning_angles
 from ..model.world import World
 from . import swarm as pso
+from .params import ParamSpec, ParamTable
+from .swarm import SWARM_PARAMS, PSOOptions
 
 __all__ = [
+    "OPTIMIZER_PARAMS",
     "PathCost",
     "PathOptimizationResult",
     "PathOptimizerOptions",
     "optimize_path",
-    "path_length",
-    "shortcut",
 ]
 
 
-@dataclass(frozen=True, kw_only=True)
-class PathOptimizerOptions:
-    """Settings of the PSO path optimiser.
+#: The path optimiser's own parameters; with the swarm's they make :class:`PathOptimizerOptions`.
+OPTIMIZER_PARAMS = ParamTable(
+    ParamSpec("smoothness_weight", float, 0.0,
+              "Cost per squared radian of turning at a waypoint (0 = shortest path only).",
+              unit="length/rad^2", low=0.0),
+    ParamSpec("violation_weight", float, 10.0,
+              "Penalty per unit of intrusion of a candidate segment into an obstacle's safety "
+              "zone.", low=1e-9),
+    ParamSpec("init_spread", float, 0.05,
+              "Spread of the initial swarm around the seed path, as a fraction of the shorter "
+              "segment next to each waypoint.", low=0.0, high=10.0),
+    ParamSpec("v_max_fraction", float, 0.1,
+              "Velocity clamp per coordinate, as a fraction of the mean segment length of the "
+              "seed path.", low=1e-6, high=10.0),
+    ParamSpec("box_fraction", float, 0.5,
+              "Each PSO round keeps every waypoint within this fraction of its longer segment "
+              "from its seed position (exact obstacle culling).", low=1e-3, high=100.0),
+    ParamSpec("prune", bool, True, "Shortcut the seed path's waypoints (exactly) before the "
+              "swarm runs."),
+    ParamSpec("refine_rounds", int, 4,
+              "Extra PSO rounds with mid-points inserted on segments that run along an obstacle.",
+              low=0, high=20),
+    ParamSpec("refine_margin", float, 0.05,
+              "A segment runs along an obstacle when its clearance is below robot radius x "
+              "(1 + refine_margin).", low=0.0, high=10.0),
+    ParamSpec("max_waypoints", int, 48, "Most waypoints refinement may create.",
+              low=2, high=10_000),
+)  # fmt: skip
 
-    Parameters
-    ----------
-    pso : PSOOptions
-        Swarm settings for each optimisation round.
-    smoothness_weight : float
-        ``lambda_s``: cost per squared radian of turning, in length units; 0 optimises length only.
-    violation_weight : float
-        ``lambda_v``: cost per unit length of intrusion into an obstacle's safety zone.
-    init_spread : float
-        Standard deviation of the initial swarm around the seed path, as a fraction of the length
-        of the shorter segment next to each waypoint.
-    v_max_fraction : float
-        Velocity clamp per coordinate, as a fraction of the mean segment length of the seed path.
-    box_fraction : float
-        Each round confines every waypoint to a square around its seed position, of half-width
-        ``box_fraction`` times the longer of its two segments (and the workspace bounds). Only
-        obstacles that can reach such a box are checked, which keeps the check exact and makes
-        it several times cheaper in clutter; later rounds re-centre the boxes.
-    prune : bool
-        Shortcut the input before the swarm runs.
-    refine_rounds : int
-        Extra rounds with mid-points inserted on segments that run along obstacles.
-    refine_margin : float
-        A segment "runs along" an obstacle when its clearance is below
-        ``robot_radius * (1 + refine_margin)``.
-    max_waypoints : int
-        Upper bound on the number of waypoints refinement may create.
-    """
+PathOptimizerOptions = (SWARM_PARAMS + OPTIMIZER_PARAMS).options_class(
+    "PathOptimizerOptions",
+    """Settings of the PSO path optimiser: the swarm's (eqs. 4-5) and the optimiser's own.
 
-    pso: pso.PSOOptions = field(
-        default_factory=lambda: pso.PSOOptions(iterations=100, tolerance=1e-6, patience=15)
-    )
-    smoothness_weight: float = 0.0
-    violation_weight: float = 10.0
-    init_spread: float = 0.05
-    v_max_fraction: float = 0.1
-    box_fraction: float = 0.5
-    prune: bool = True
-    refine_rounds: int = 4
-    refine_margin: float = 0.05
-    max_waypoints: int = 48
-
-    def __post_init__(self) -> None:
-        if self.smoothness_weight < 0 or self.violation_weight <= 0:
-            raise ValueError("smoothness_weight must be >= 0 and violation_weight > 0")
-        if self.init_spread < 0 or self.v_max_fraction <= 0 or self.box_fraction <= 0:
-            raise ValueError("init_spread >= 0, v_max_fraction > 0 and box_fraction > 0")
-        if self.refine_rounds < 0 or self.refine_margin < 0 or self.max_waypoints < 2:
-            raise ValueError("refine_rounds >= 0, refine_margin >= 0 and max_waypoints >= 2")
+    Each round confines every waypoint to a square around its seed position, of half-width
+    ``box_fraction`` times the longer of its two segments (and the workspace bounds). Only
+    obstacles that can reach such a box are checked, which keeps the check exact and makes it
+    several times cheaper in clutter; later rounds re-centre the boxes.""",
+    __name__,
+)
 
 
 @dataclass(frozen=True)
@@ -137,12 +125,6 @@ class PathOptimizationResult:
     n_evaluations: int
     rounds: int
     time: float
-
-
-def path_length(path: np.ndarray) -> float:
-    """Euclidean length of a polyline ``(n, 2)``."""
-    p = np.asarray(path, dtype=float)
-    return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) if len(p) > 1 else 0.0
 
 
 class PathCost:
@@ -194,36 +176,6 @@ class PathCost:
         return cost, violation
 
 
-def turning_angles(paths: np.ndarray) -> np.ndarray:
-    """Turning angle (radians, in [0, pi]) at each interior waypoint of ``(..., n, 2)`` paths."""
-    seg = np.diff(paths, axis=-2)
-    a, b = seg[..., :-1, :], seg[..., 1:, :]
-    cross = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-    dot = np.einsum("...i,...i->...", a, b)
-    return np.abs(np.arctan2(cross, dot))
-
-
-def shortcut(path: np.ndarray, world: World) -> np.ndarray:
-    """Greedy exact shortcutting: from each kept waypoint jump to the farthest visible one.
-
-    Returns a path with a subset of the input's waypoints (end points kept) that is never longer and
-    valid whenever the input is.
-    """
-    p = np.asarray(path, dtype=float)
-    if len(p) <= 2:
-        return p.copy()
-    keep = [0]
-    i = 0
-    n = len(p)
-    while i < n - 1:
-        free = world.segments_free(p[i], p[i + 1 :])
-        # The next waypoint is always reachable on a valid input; jump to the farthest free one.
-        j = i + 1 + int(np.flatnonzero(free)[-1]) if free.any() else i + 1
-        keep.append(j)
-        i = j
-    return p[keep]
-
-
 def _refine(path: np.ndarray, world: World, margin: float, max_waypoints: int) -> np.ndarray:
     """Insert the mid-point of every segment that runs along an obstacle (clearance tight)."""
     r = world.robot_radius
@@ -271,7 +223,7 @@ def _pso_round(
         cost_model.start, cost_model.goal, world, cost_model.smoothness_weight, violation
     )
 
-    n = options.pso.swarm_size
+    n = options.swarm_size
     x0 = interior.reshape(-1)
     init = x0 + rng.standard_normal((n, 2 * k)) * sigma
     init[0] = x0  # the seed path itself is a particle, so G_best starts valid
@@ -281,10 +233,15 @@ def _pso_round(
         c, v = round_cost.terms(x)
         return np.where(v > 0.0, c + offset + options.violation_weight * v, c)
 
-    v_max = options.pso.v_max or options.v_max_fraction * float(seg_len.mean())
-    swarm = replace(options.pso, v_max=v_max)
     res = pso.minimize(
-        cost, lo.reshape(-1), hi.reshape(-1), swarm, rng, init=init, terminate=terminate
+        cost,
+        lo.reshape(-1),
+        hi.reshape(-1),
+        PSOOptions.from_values(asdict(options)),
+        rng,
+        init=init,
+        v_max=options.v_max_fraction * float(seg_len.mean()),
+        terminate=terminate,
     )
     best = np.vstack([seed_path[:1], res.position.reshape(k, 2), seed_path[-1:]])
     return best, res
@@ -342,7 +299,7 @@ def optimize_path(
         return result(original, [], 0, 0, 0)
 
     cost_model = PathCost(original[0], original[-1], world, options.smoothness_weight)
-    current = shortcut(original, world) if options.prune else original
+    current = shortcut(original, world.segments_free) if options.prune else original
     history: list[np.ndarray] = []
     iters = evals = rounds = 0
     for r in range(1 + options.refine_rounds):
@@ -365,7 +322,7 @@ def optimize_path(
 
     # Drop waypoints that ended up collinear or redundant, then keep the contract: valid and never
     # longer than the input, else the input itself.
-    current = shortcut(current, world)
+    current = shortcut(current, world.segments_free)
     if world.path_valid(current) and path_length(current) < input_length:
         return result(current, history, iters, evals, rounds)
     return result(original, history, iters, evals, rounds)

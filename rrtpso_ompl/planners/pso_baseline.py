@@ -12,73 +12,53 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from ompl import base as ob
 
-from ..ompl_setup.context import array_to_path
+from ..model.geometry import path_length, shortcut
+from ..ompl_setup import array_to_path
 from . import swarm as pso
-from .base import PythonPlanner, collision_model_for
-from .path_optimizer import PathCost, path_length, shortcut
-from .registry import ParamSpec
-from .rrtstar_pso import SWARM_PARAMS, swarm_options
+from .base import BUDGET, SEED, PlannerStats, PythonPlanner, collision_model_for
+from .params import ParamSpec, ParamTable
+from .path_optimizer import OPTIMIZER_PARAMS, PathCost
+from .result import BenchmarkRun
+from .swarm import SWARM_PARAMS, PSOOptions
 
 __all__ = ["PSO_PARAMS", "PSOPlanner", "PSOPlannerStats"]
 
-_BASELINE_OVERRIDES = {
-    "iterations": ParamSpec(
-        "iterations", int, 200, "PSO iterations per swarm (eqs. 4-5).", low=1, high=1_000_000
-    ),
-    "tolerance": ParamSpec(
-        "tolerance",
-        float,
-        0.0,
-        "End a swarm early when the best cost "
-        "improved by less than this (relative) over `patience` iterations; "
-        "0 = always run all iterations.",
-        low=0.0,
-        high=1.0,
-    ),
-    "v_max_fraction": ParamSpec(
-        "v_max_fraction",
-        float,
-        0.1,
-        "Velocity clamp per coordinate, as a fraction of the workspace's larger side.",
-        low=1e-6,
-        high=10.0,
-    ),
-}
-
-PSO_PARAMS: tuple[ParamSpec, ...] = (
-    ParamSpec(
-        "n_waypoints", int, 5, "Free interior waypoints per candidate path.", low=1, high=1000
-    ),
-    ParamSpec(
-        "budget",
-        float,
-        0.0,
-        "Total time the caller gives solve() (0 = unknown: only the "
-        "termination condition and the iterations bound the run).",
-        unit="s",
-        low=0.0,
-    ),
-    ParamSpec(
-        "restarts",
-        bool,
-        True,
-        "Start a new random swarm when one ends without a valid path and time remains.",
-    ),
-    # The baseline runs a fixed number of iterations per swarm, as in the paper, and its particles
-    # roam the whole workspace, so its velocity clamp is relative to the workspace.
-    *(_BASELINE_OVERRIDES.get(p.name, p) for p in SWARM_PARAMS),
-)
+#: The baseline's parameters. Its particles roam the whole workspace, so its velocity clamp is
+#: relative to the workspace (not to a seed path's segments, as in RRTstarPSO's optimiser), and it
+#: runs a fixed number of iterations per swarm, as in the paper.
+PSO_PARAMS = (
+    ParamTable(
+        ParamSpec("n_waypoints", int, 5, "Free interior waypoints per candidate path.",
+                  low=1, high=1000),
+        BUDGET,
+        ParamSpec("restarts", bool, True,
+                  "Start a new random swarm when one ends without a valid path and time remains."),
+        SEED,
+        ParamSpec("v_max_workspace_fraction", float, 0.1,
+                  "Velocity clamp per coordinate, as a fraction of the workspace's larger side.",
+                  low=1e-6, high=10.0),
+    )
+    + SWARM_PARAMS.replace(
+        iterations={"default": 200, "low": 1, "doc": "PSO iterations per swarm (eqs. 4-5)."},
+        tolerance={"default": 0.0},
+    )
+    + OPTIMIZER_PARAMS.subset("smoothness_weight", "violation_weight")
+)  # fmt: skip
 
 
 @dataclass
-class PSOPlannerStats:
-    """Figures of one PSO-baseline solve (lengths in problem units, times in seconds)."""
+class PSOPlannerStats(PlannerStats):
+    """Figures of one PSO-baseline solve (lengths in problem units, times in seconds).
+
+    The whole solve is planning in OMPL's benchmark terms: the baseline has no separate
+    simplification stage.
+    """
 
     pso_length: float | None = None
     pso_time: float = 0.0
@@ -87,9 +67,16 @@ class PSOPlannerStats:
     swarms: int = 0
     pso_history: list[float] = field(default_factory=list)
 
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dictionary."""
-        return asdict(self)
+    def benchmark_run(self, elapsed: float, length: float | None) -> BenchmarkRun:
+        return BenchmarkRun(
+            time=elapsed,
+            solution_length=length,
+            properties={
+                "swarms": ("INTEGER", self.swarms),
+                "pso iterations": ("INTEGER", self.pso_iterations),
+                "pso evaluations": ("INTEGER", self.pso_evaluations),
+            },
+        )
 
 
 class PSOPlanner(PythonPlanner):
@@ -141,11 +128,12 @@ class PSOPlanner(PythonPlanner):
         def terminate() -> bool:
             return ptc() or time.perf_counter() >= deadline
 
-        options = swarm_options(values, values["v_max_fraction"] * max(xmax - xmin, ymax - ymin))
+        options = PSOOptions.from_values(values)
+        v_max = values["v_max_workspace_fraction"] * max(xmax - xmin, ymax - ymin)
         rng = self._rng()
         best: np.ndarray | None = None
         while not terminate():
-            res = pso.minimize(cost, lower, upper, options, rng, terminate=terminate)
+            res = pso.minimize(cost, lower, upper, options, rng, v_max=v_max, terminate=terminate)
             stats.swarms += 1
             stats.pso_iterations += res.n_iterations
             stats.pso_evaluations += res.n_evaluations
@@ -159,7 +147,9 @@ class PSOPlanner(PythonPlanner):
         stats.pso_time = time.perf_counter() - t0
         if best is None:
             return ob.PlannerStatus(ob.PlannerStatus.TIMEOUT)
-        best = shortcut(best, model)  # drop waypoints the swarm left redundant; never longer
+        best = shortcut(
+            best, model.segments_free
+        )  # drop waypoints the swarm left redundant; never longer
         stats.pso_length = path_length(best)
         pdef = self.getProblemDefinition()
         pdef.clearSolutionPaths()

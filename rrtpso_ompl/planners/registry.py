@@ -21,18 +21,22 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import logging
-import math
 import sys
-from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
+from ..errors import ParameterError, UnknownPlannerError
+from .params import ParamSpec, ParamTable
+
 __all__ = [
     "ENTRY_POINT_GROUP",
+    "Capabilities",
     "ParamSpec",
+    "ParamTable",
     "PlannerEntry",
     "PlannerRegistry",
     "UnknownPlannerError",
@@ -44,103 +48,28 @@ log = logging.getLogger(__name__)
 ENTRY_POINT_GROUP = "rrtpso_ompl.planners"
 FIRST_PARTY_PLUGINS = ("rrtstar_pso", "pso", "ompl_geometric")
 
-_TRUE = {"1", "true", "yes", "on"}
-_FALSE = {"0", "false", "no", "off"}
-
 
 @dataclass(frozen=True)
-class ParamSpec:
-    """One planner parameter.
+class Capabilities:
+    """What the harness may ask of a planner (OMPL's ``PlannerSpecs``, which Python cannot read).
 
     Parameters
     ----------
-    name : str
-        snake_case name; OMPL's name where OMPL has one (``range``, ``goal_bias``).
-    type : type
-        ``float``, ``int``, ``bool`` or ``str``.
-    default : Any
-        Default value (as the planner itself uses it).
-    doc : str
-        What the parameter does to the search.
-    unit : str
-        Unit of the value ("" for dimensionless), e.g. ``"length"`` for the problem's unit, ``"s"``.
-    low, high : float or None
-        Inclusive range of numeric values; None for unbounded.
-    choices : tuple or None
-        Allowed values of a ``str`` parameter.
-    setter : str or None
-        For stock OMPL planners: the setter method to call (``"setRange"``).
-    getter : str or None
-        For stock OMPL planners: the matching getter, used to check defaults against OMPL.
+    optimizing : bool
+        The planner improves its path with more time (asymptotically optimal or anytime).
+    progress_polling : bool
+        It has ``bestCost()`` and evaluates its termination condition only in the planning
+        thread, so a Python condition may sample its best cost while it runs. (PRM and PRM*
+        evaluate it in a second thread as well, which would wait for the GIL forever.) Planners
+        of this package report their own progress instead.
+    simplify_in_benchmark : bool
+        Benchmarks follow it with OMPL's path simplifier, as OMPL's ``Benchmark`` does for its
+        planners; the planners of this package optimise their own paths.
     """
 
-    name: str
-    type: type
-    default: Any
-    doc: str
-    unit: str = ""
-    low: float | None = None
-    high: float | None = None
-    choices: tuple[Any, ...] | None = None
-    setter: str | None = None
-    getter: str | None = None
-
-    def convert(self, value: Any) -> Any:
-        """Validate ``value`` (a Python value or a command-line string) and convert it.
-
-        Raises
-        ------
-        ValueError
-            With a message naming the parameter, the expected type and range.
-        """
-        v = value
-        if isinstance(v, str) and self.type is not str:
-            v = v.strip()
-            if self.type is bool:
-                if v.lower() in _TRUE:
-                    v = True
-                elif v.lower() in _FALSE:
-                    v = False
-                else:
-                    raise ValueError(f"parameter '{self.name}' expects a boolean, got '{value}'")
-            else:
-                try:
-                    v = self.type(float(v)) if self.type is int and "." not in v else self.type(v)
-                except ValueError:
-                    raise ValueError(
-                        f"parameter '{self.name}' expects {self.type.__name__}, got '{value}'"
-                    ) from None
-        if self.type is bool:
-            if not isinstance(v, bool):
-                if isinstance(v, int) and v in (0, 1):
-                    v = bool(v)
-                else:
-                    raise ValueError(f"parameter '{self.name}' expects a boolean, got {value!r}")
-        elif self.type is int:
-            if isinstance(v, bool) or not isinstance(v, int | float) or v != int(v):
-                raise ValueError(f"parameter '{self.name}' expects an integer, got {value!r}")
-            v = int(v)
-        elif self.type is float:
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-                raise ValueError(f"parameter '{self.name}' expects a finite number, got {value!r}")
-            v = float(v)
-        elif self.type is str and not isinstance(v, str):
-            raise ValueError(f"parameter '{self.name}' expects a string, got {value!r}")
-        if (self.low is not None and v < self.low) or (self.high is not None and v > self.high):
-            raise ValueError(f"parameter '{self.name}' must be in {self.range_text()}, got {v!r}")
-        if self.choices is not None and v not in self.choices:
-            raise ValueError(f"parameter '{self.name}' must be one of {list(self.choices)}")
-        return v
-
-    def range_text(self) -> str:
-        """The allowed range as text, e.g. ``[0, 1]``."""
-        if self.choices is not None:
-            return "{" + ", ".join(map(str, self.choices)) + "}"
-        if self.type is bool:
-            return "{false, true}"
-        lo = "-inf" if self.low is None else f"{self.low:g}"
-        hi = "inf" if self.high is None else f"{self.high:g}"
-        return f"[{lo}, {hi}]"
+    optimizing: bool = False
+    progress_polling: bool = False
+    simplify_in_benchmark: bool = False
 
 
 @dataclass(frozen=True)
@@ -153,48 +82,61 @@ class PlannerEntry:
         The name users type (``"RRTstarPSO"``).
     factory : callable
         ``factory(si) -> ob.Planner``.
-    params : tuple of ParamSpec
-        The parameters the planner accepts by name.
+    params : ParamTable or sequence of ParamSpec
+        The parameters the planner accepts by name (a sequence is made a table).
     description : str
         One line for listings.
     aliases : tuple of str
         Other names (e.g. MoveIt's ``"geometric::RRTstar"``).
-    optimizing : bool
-        Whether the planner improves its path with more time (for reports).
+    capabilities : Capabilities
+        What the harness may ask of it.
+    stats : callable, optional
+        ``stats(planner) -> PlannerStats`` after a solve; by default the planner's own
+        ``last_stats`` (planners of this package), else the figures every planner has.
     configure : callable, optional
         ``configure(planner, values)`` applies validated parameter values; by default each value
         goes to the ``setter`` method named in its ParamSpec, or to ``planner.set_param(name, v)``.
-    check : callable, optional
-        ``check(values)`` with every parameter (defaults filled in) raises ``ValueError`` for
-        combinations that no single value reveals (e.g. ``c1 + c2 < 4``).
     source : str
         Which plugin registered it (filled by the registry).
     """
 
     name: str
     factory: Callable[[Any], Any]
-    params: tuple[ParamSpec, ...] = ()
+    params: ParamTable = field(default_factory=ParamTable)
     description: str = ""
     aliases: tuple[str, ...] = ()
-    optimizing: bool = False
+    capabilities: Capabilities = field(default_factory=Capabilities)
+    stats: Callable[[Any], Any] | None = None
     configure: Callable[[Any, Mapping[str, Any]], None] | None = None
-    check: Callable[[dict[str, Any]], None] | None = None
     source: str = field(default="", compare=False)
 
+    def __post_init__(self) -> None:
+        if not isinstance(self.params, ParamTable):
+            object.__setattr__(self, "params", ParamTable(*self.params))
+
+    @property
+    def optimizing(self) -> bool:
+        """Whether the planner improves its path with more time."""
+        return self.capabilities.optimizing
+
+    def takes(self, name: str) -> bool:
+        """Whether the planner has a parameter ``name`` (such as ``budget`` or ``seed``)."""
+        return name in self.params
+
     def param(self, name: str) -> ParamSpec:
-        """The spec of parameter ``name``; ``KeyError`` listing the known names otherwise."""
-        for p in self.params:
-            if p.name == name:
-                return p
-        known = ", ".join(p.name for p in self.params) or "none"
-        raise KeyError(f"planner '{self.name}' has no parameter '{name}' (known: {known})")
+        """The spec of parameter ``name``; :class:`~rrtpso_ompl.errors.ParameterError` otherwise."""
+        if name not in self.params:
+            known = ", ".join(self.params.names()) or "none"
+            raise ParameterError(
+                f"planner '{self.name}' has no parameter '{name}' (known: {known})", name
+            )
+        return self.params[name]
 
     def validate(self, values: Mapping[str, Any] | None) -> dict[str, Any]:
-        """Check names and values; return the converted values (``KeyError``/``ValueError``)."""
-        converted = {k: self.param(k).convert(v) for k, v in (values or {}).items()}
-        if self.check is not None:
-            self.check({**{p.name: p.default for p in self.params}, **converted})
-        return converted
+        """Check names, values and rules; return the converted values (``ParameterError``)."""
+        for key in values or {}:
+            self.param(key)
+        return self.params.validate(values, owner=self.name)
 
     def make(self, si: Any, values: Mapping[str, Any] | None = None) -> Any:
         """Create the planner for ``si`` and apply the parameter ``values``."""
@@ -205,29 +147,22 @@ class PlannerEntry:
                 self.configure(planner, converted)
             else:
                 for k, v in converted.items():
-                    spec = self.param(k)
+                    spec = self.params[k]
                     if spec.setter:
                         getattr(planner, spec.setter)(v)
                     else:
                         planner.set_param(k, v)
         return planner
 
+    def collect_stats(self, planner: Any) -> Any:
+        """The figures of the planner's last solve (a :class:`~rrtpso_ompl.planners.base.
+        PlannerStats`)."""
+        from .base import PlannerStats
 
-class UnknownPlannerError(KeyError):
-    """No usable planner of that name; the message lists the known names (and says why a
-    planner that exists but is excluded cannot be used)."""
-
-    def __init__(self, name: str, known: Iterable[str], reason: str = "") -> None:
-        self.name = name
-        self.known = sorted(known, key=str.lower)
-        self.reason = reason
-        super().__init__(name)
-
-    def __str__(self) -> str:
-        known = ", ".join(self.known)
-        if self.reason:
-            return f"planner '{self.name}' is unavailable ({self.reason}); known planners: {known}"
-        return f"unknown planner '{self.name}'; known planners: {known}"
+        if self.stats is not None:
+            return self.stats(planner)
+        own = getattr(planner, "last_stats", None)
+        return own if isinstance(own, PlannerStats) else PlannerStats()
 
 
 class PlannerRegistry:
@@ -245,11 +180,6 @@ class PlannerRegistry:
             raise TypeError(f"expected a PlannerEntry, got {type(entry).__name__}")
         if not entry.name or not callable(entry.factory):
             raise ValueError("a PlannerEntry needs a name and a callable factory")
-        names = [p.name for p in entry.params]
-        if len(set(names)) != len(names):
-            raise ValueError(f"planner '{entry.name}' declares a parameter twice")
-        for spec in entry.params:
-            spec.convert(spec.default)  # a default outside its own range is a plugin bug
         for n in (entry.name, *entry.aliases):
             if n in self._lookup:
                 owner = self._entries[self._lookup[n]]
@@ -335,8 +265,6 @@ def _import_first_party(mod_name: str) -> Any:
 
 
 def _with_source(entry: PlannerEntry, source: str) -> PlannerEntry:
-    from dataclasses import replace
-
     return replace(entry, source=source)
 
 

@@ -28,208 +28,48 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from ..ompl_setup.context import array_to_path, path_to_array
-from . import swarm as pso
-from .base import PythonPlanner, collision_model_for
-from .path_optimizer import PathOptimizerOptions, optimize_path, path_length
-from .registry import ParamSpec
+from ..model.geometry import path_length
+from ..ompl_setup import array_to_path, path_to_array
+from .base import BUDGET, SEED, PlannerStats, PythonPlanner, collision_model_for
+from .ompl_planners import RRTSTAR_PARAMS
+from .params import ParamSpec, ParamTable
+from .path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions, optimize_path
+from .result import BenchmarkRun
+from .swarm import SWARM_PARAMS
 
-__all__ = ["RRTSTAR_PSO_PARAMS", "SWARM_PARAMS", "RRTstarPSO", "RRTstarPSOStats"]
+#: The RRT* parameters RRTstarPSO passes on to its inner og.RRTstar.
+_INNER = ("range", "goal_bias", "rewire_factor", "informed_sampling", "tree_pruning")
 
-#: Parameters of the swarm and of the path optimiser, shared with the PSO baseline planner.
-SWARM_PARAMS: tuple[ParamSpec, ...] = (
-    ParamSpec(
-        "swarm_size",
-        int,
-        30,
-        "Number of particles (candidate paths) in the swarm.",
-        low=2,
-        high=10000,
-    ),
-    ParamSpec(
-        "iterations",
-        int,
-        100,
-        "PSO iterations per optimisation round (eqs. 4-5).",
-        low=0,
-        high=1_000_000,
-    ),
-    ParamSpec(
-        "w", float, 0.7298, "Inertia weight of the particle velocity (eq. 4).", low=0.0, high=1.5
-    ),
-    ParamSpec(
-        "c1",
-        float,
-        1.49618,
-        "Cognitive coefficient: pull to the particle's best (eq. 4); c1 + c2 < 4.",
-        low=0.0,
-        high=4.0,
-    ),
-    ParamSpec(
-        "c2",
-        float,
-        1.49618,
-        "Social coefficient: pull to the swarm's best (eq. 4); c1 + c2 < 4.",
-        low=0.0,
-        high=4.0,
-    ),
-    ParamSpec(
-        "tolerance",
-        float,
-        1e-6,
-        "End a PSO round early when the best cost improved by less "
-        "than this (relative) over `patience` iterations; 0 = always run all iterations.",
-        low=0.0,
-        high=1.0,
-    ),
-    ParamSpec(
-        "patience", int, 15, "Window of the early stop, in iterations.", low=1, high=1_000_000
-    ),
-    ParamSpec(
-        "w_damping",
-        float,
-        1.0,
-        "Factor applied to w after every iteration (1 = constant).",
-        low=1e-6,
-        high=1.0,
-    ),
-    ParamSpec(
-        "v_max_fraction",
-        float,
-        0.1,
-        "Velocity clamp per coordinate, as a fraction of the mean segment length of the seed path.",
-        low=1e-6,
-        high=10.0,
-    ),
-    ParamSpec(
-        "smoothness_weight",
-        float,
-        0.0,
-        "Cost per squared radian of turning at a waypoint (0 = shortest path only).",
-        unit="length/rad^2",
-        low=0.0,
-    ),
-    ParamSpec(
-        "violation_weight",
-        float,
-        10.0,
-        "Penalty per unit of intrusion of a candidate segment into an obstacle's safety zone.",
-        low=1e-9,
-    ),
-    ParamSpec(
-        "seed",
-        int,
-        -1,
-        "Seed of the PSO's numpy Generator; -1 draws it from OMPL's RNG "
-        "(so ompl.util.RNG.setSeed makes the whole run reproducible).",
-        low=-1,
-        high=2**32 - 1,
-    ),
-)
+__all__ = ["RRTSTAR_PSO_PARAMS", "RRTstarPSO", "RRTstarPSOStats"]
 
-RRTSTAR_PSO_PARAMS: tuple[ParamSpec, ...] = (
-    ParamSpec(
-        "range",
-        float,
-        0.0,
-        "RRT*: longest motion added to the tree; 0 lets OMPL choose (20% of the space's extent).",
-        unit="length",
-        low=0.0,
-    ),
-    ParamSpec(
-        "goal_bias", float, 0.05, "RRT*: probability of sampling the goal.", low=0.0, high=1.0
-    ),
-    ParamSpec(
-        "rewire_factor",
-        float,
-        1.1,
-        "RRT*: scale of the rewiring radius (>= 1 keeps asymptotic optimality).",
-        low=1.0,
-        high=10.0,
-    ),
-    ParamSpec(
-        "informed_sampling",
-        bool,
-        False,
-        "RRT*: once a path exists, sample only where a shorter one can be (OMPL's informed "
-        "sampling, as in InformedRRTstar); off = the paper's plain RRT*.",
-    ),
-    ParamSpec(
-        "tree_pruning",
-        bool,
-        False,
-        "RRT*: prune tree vertices that cannot lead to a shorter path (with informed_sampling "
-        "this is OMPL's InformedRRTstar).",
-    ),
-    ParamSpec(
-        "budget",
-        float,
-        0.0,
-        "Total time the caller gives solve(); 0 = unknown: RRT* then "
-        "runs until the termination condition and the PSO runs its iterations after it.",
-        unit="s",
-        low=0.0,
-    ),
-    ParamSpec(
-        "rrt_time_fraction",
-        float,
-        0.9,
-        "Share of the budget given to RRT*; the PSO gets the rest.",
-        low=1e-3,
-        high=1.0,
-    ),
-    ParamSpec(
-        "rrt_max_iterations",
-        int,
-        0,
-        "Stop RRT* after this many iterations (0 = no limit); "
-        "with a bounded PSO this makes runs reproducible regardless of machine speed.",
-        low=0,
-    ),
-    *SWARM_PARAMS,
-    ParamSpec(
-        "init_spread",
-        float,
-        0.05,
-        "Spread of the initial swarm around the RRT* path, as a "
-        "fraction of the shorter segment next to each waypoint.",
-        low=0.0,
-        high=10.0,
-    ),
-    ParamSpec(
-        "box_fraction",
-        float,
-        0.5,
-        "Each PSO round keeps every waypoint within this "
-        "fraction of its longer segment from its seed position (exact obstacle culling).",
-        low=1e-3,
-        high=100.0,
-    ),
-    ParamSpec(
-        "simplify",
-        bool,
-        True,
-        "Run OMPL's path simplifier (simplifyMax: vertex reduction and shortcutting through the "
-        "exact motion validator, about a millisecond) on RRT*'s path before the swarm.",
-    ),
-    ParamSpec("prune", bool, True, "Shortcut RRT*'s waypoints (exactly) before the swarm runs."),
-    ParamSpec(
-        "refine_rounds",
-        int,
-        4,
-        "Extra PSO rounds with mid-points inserted on segments that run along an obstacle.",
-        low=0,
-        high=20,
-    ),
-    ParamSpec("max_waypoints", int, 48, "Most waypoints refinement may create.", low=2, high=10000),
-)
+#: RRTstarPSO's parameters: those of its inner RRT* (OMPL's own declarations, passed on through
+#: their setters), its own, then the swarm's and the path optimiser's.
+RRTSTAR_PSO_PARAMS = (
+    ParamTable(*(RRTSTAR_PARAMS[n] for n in _INNER))
+    + ParamTable(
+        BUDGET,
+        ParamSpec("rrt_time_fraction", float, 0.9,
+                  "Share of the budget given to RRT*; the PSO gets the rest.", low=1e-3, high=1.0),
+        ParamSpec("rrt_max_iterations", int, 0,
+                  "Stop RRT* after this many iterations (0 = no limit); with a bounded PSO this "
+                  "makes runs reproducible regardless of machine speed.", low=0),
+        ParamSpec("simplify", bool, True,
+                  "Run OMPL's path simplifier (simplifyMax: vertex reduction and shortcutting "
+                  "through the exact motion validator, about a millisecond) on RRT*'s path before "
+                  "the swarm."),
+        SEED,
+    )
+    + SWARM_PARAMS
+    + OPTIMIZER_PARAMS
+)  # fmt: skip
 
 
 @dataclass
-class RRTstarPSOStats:
+class RRTstarPSOStats(PlannerStats):
     """Per-stage figures of one RRTstarPSO solve (the ``stages`` of a solve result).
 
-    Lengths are in problem units, times in seconds.
+    Lengths are in problem units, times in seconds. In OMPL's benchmark terms the RRT* stage and
+    OMPL's simplifier are the planning, the swarm is the simplification.
     """
 
     rrt_length: float | None = None
@@ -255,29 +95,27 @@ class RRTstarPSOStats:
         d["rrt_progress"] = [list(p) for p in self.rrt_progress]
         return d
 
+    def progress(self) -> list[tuple[float, float]]:
+        """RRT*'s best cost over time, then the length after OMPL's simplifier."""
+        rows = list(self.rrt_progress)
+        if self.simplified_length is not None:
+            rows.append((self.rrt_time + self.simplify_time, self.simplified_length))
+        return rows
 
-def swarm_options(values: dict[str, Any], v_max: float | None = None) -> pso.PSOOptions:
-    """The :class:`~rrtpso_ompl.pso.PSOOptions` named by the :data:`SWARM_PARAMS` values."""
-    names = ("swarm_size", "iterations", "w", "c1", "c2", "w_damping", "tolerance", "patience")
-    return pso.PSOOptions(**{n: values[n] for n in names}, v_max=v_max)
-
-
-#: Our parameters that belong to the inner og.RRTstar, with its setter.
-_INNER_SETTERS = {
-    "range": "setRange",
-    "goal_bias": "setGoalBias",
-    "rewire_factor": "setRewireFactor",
-    "informed_sampling": "setInformedSampling",
-    "tree_pruning": "setTreePruning",
-}
-
-
-def check_swarm_values(values: dict[str, Any]) -> None:
-    """Constraints between swarm parameters (one value alone cannot break them)."""
-    if values["c1"] + values["c2"] >= 4.0:
-        raise ValueError(
-            f"parameters 'c1' + 'c2' must be < 4 (paper Table 2), got {values['c1']} + "
-            f"{values['c2']}"
+    def benchmark_run(self, elapsed: float, length: float | None) -> BenchmarkRun:
+        swarm_ran = self.pso_length is not None
+        return BenchmarkRun(
+            time=elapsed - self.pso_time,
+            solution_length=self.rrt_length,
+            simplification_time=self.pso_time if swarm_ran else None,
+            simplified_length=length if swarm_ran else None,
+            properties={
+                "rrt iterations": ("INTEGER", self.rrt_iterations),
+                "pso iterations": ("INTEGER", self.pso_iterations),
+                "pso evaluations": ("INTEGER", self.pso_evaluations),
+                "pso rounds": ("INTEGER", self.pso_rounds),
+            },
+            progress=self.progress(),
         )
 
 
@@ -307,8 +145,8 @@ class RRTstarPSO(PythonPlanner):
     def setup(self) -> None:
         super().setup()
         self.inner.setProblemDefinition(self.getProblemDefinition())
-        for name, setter in _INNER_SETTERS.items():
-            getattr(self.inner, setter)(self._values[name])
+        for name in _INNER:
+            getattr(self.inner, self.PARAMS[name].setter)(self._values[name])
         self.inner.setup()
         if self._values["range"] == 0.0:
             self._values["range"] = self.inner.getRange()  # report what OMPL chose
@@ -318,11 +156,11 @@ class RRTstarPSO(PythonPlanner):
         super().clear()
         self.inner.clear()
 
-    def set_param(self, name: str, value: Any) -> None:
-        super().set_param(name, value)
-        if getattr(self, "_inner_ready", False) and name in _INNER_SETTERS:
+    def _apply(self, name: str, value: Any) -> None:
+        super()._apply(name, value)
+        if getattr(self, "_inner_ready", False) and name in _INNER:
             # Keep the inner RRT* in step when a parameter changes after setup().
-            getattr(self.inner, _INNER_SETTERS[name])(self._values[name])
+            getattr(self.inner, self.PARAMS[name].setter)(value)
 
     # ------------------------------------------------------------------------------------------
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
@@ -360,17 +198,7 @@ class RRTstarPSO(PythonPlanner):
 
         # --- stage 3: PSO over the candidate nodes --------------------------------------------
         model = collision_model_for(self.getSpaceInformation())
-        options = PathOptimizerOptions(
-            pso=swarm_options(values),
-            smoothness_weight=values["smoothness_weight"],
-            violation_weight=values["violation_weight"],
-            init_spread=values["init_spread"],
-            v_max_fraction=values["v_max_fraction"],
-            box_fraction=values["box_fraction"],
-            prune=values["prune"],
-            refine_rounds=values["refine_rounds"],
-            max_waypoints=values["max_waypoints"],
-        )
+        options = PathOptimizerOptions.from_values(values)
         budget = values["budget"]
         # With a known budget the PSO stops at its end (and at the outer condition); without one
         # the outer condition has already fired, so the swarm is bounded by its iterations only.

@@ -2,8 +2,8 @@
 
 ``solve(problem, "RRTstarPSO", time_limit=1.0, seed=1)`` builds the OMPL setup, creates the
 planner by name with its parameters, runs it, validates the returned path exactly and returns a
-:class:`~rrtpso_ompl.results.SolveResult`. The command line, the benchmark script and the tests all
-go through here, so every planner is measured the same way.
+:class:`~rrtpso_ompl.planners.result.SolveResult`. The command line, batches, benchmarks, the
+dynamic replanner and the tests all go through here, so every planner is measured the same way.
 """
 
 from __future__ import annotations
@@ -11,33 +11,98 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from ompl import base as ob
-from ompl import geometric as og
 
+from ..model.geometry import path_length
 from ..model.problem import Problem
 from ..model.world import World
-from ..ompl_setup.context import make_context, path_to_array, seed_ompl
-from ..outputs import SolveResult
-from .path_optimizer import path_length
-from .registry import PlannerRegistry, default_registry
+from ..ompl_setup import PlanningContext, make_context, path_to_array, seed_ompl
+from ..validation import check_number
+from .registry import PlannerEntry, PlannerRegistry, default_registry
+from .result import BenchmarkRun, SolveResult
 
-__all__ = ["DEFAULT_PLANNER", "DEFAULT_TIME_LIMIT", "PROGRESS_PERIOD", "solve"]
+__all__ = [
+    "DEFAULT_PLANNER",
+    "DEFAULT_TIME_LIMIT",
+    "PROGRESS_PERIOD",
+    "PlannerRequest",
+    "resolve_request",
+    "solve",
+]
 
 DEFAULT_PLANNER = "RRTstarPSO"
 DEFAULT_TIME_LIMIT = 1.0
 #: Seconds between progress samples (OMPL's ``Benchmark::Request::timeBetweenUpdates``).
 PROGRESS_PERIOD = 0.05
 
-#: The anytime planners whose termination condition is polled in the planning thread only.
-_SINGLE_THREADED_ANYTIME = (og.RRTstar, og.InformedRRTstar, og.SORRTstar, og.BITstar)
-
 _STATUS = {
     ob.PlannerStatus.EXACT_SOLUTION: "exact",
     ob.PlannerStatus.APPROXIMATE_SOLUTION: "approximate",
 }
+
+
+@dataclass(frozen=True)
+class PlannerRequest:
+    """A planner, its budget, seed and validated parameters, resolved for one problem.
+
+    Attributes
+    ----------
+    entry : PlannerEntry
+        The registered planner.
+    time_limit : float
+        Seconds.
+    seed : int or None
+        OMPL's seed (and the planner's numpy seed when it takes one).
+    values : dict
+        Validated parameters: the file's ``planner.params`` under the caller's, plus ``budget``
+        and ``seed`` for planners that take them.
+    """
+
+    entry: PlannerEntry
+    time_limit: float
+    seed: int | None
+    values: dict[str, Any]
+
+
+def resolve_request(
+    problem: Problem,
+    planner: str | None = None,
+    time_limit: float | None = None,
+    seed: int | None = None,
+    params: Mapping[str, Any] | None = None,
+    registry: PlannerRegistry | None = None,
+) -> PlannerRequest:
+    """What to run: the caller's choices over the problem's ``planner`` section over defaults.
+
+    Raises
+    ------
+    UnknownPlannerError, ParameterError
+        For an unknown planner, parameter name or value, or a time limit that is not a positive
+        number of seconds.
+    """
+    from ..errors import ParameterError
+
+    registry = registry or default_registry()
+    cfg = problem.planner
+    entry = registry.get(planner or cfg.type or DEFAULT_PLANNER)
+    limit = time_limit if time_limit is not None else (cfg.time_limit or DEFAULT_TIME_LIMIT)
+    try:
+        limit = check_number(limit, low=0.0, strict_low=True)
+    except ValueError as exc:
+        raise ParameterError(f"time limit {exc}", "time_limit") from None
+    seed = seed if seed is not None else cfg.seed
+    values: dict[str, Any] = {**cfg.params, **(params or {})}
+    # Planners that split their time (RRTstarPSO) need to know it: OMPL's termination condition
+    # does not say how much is left.
+    if entry.takes("budget") and "budget" not in values:
+        values["budget"] = limit
+    if seed is not None and entry.takes("seed") and "seed" not in values:
+        values["seed"] = seed
+    return PlannerRequest(entry, limit, seed, entry.validate(values))
 
 
 def solve(
@@ -70,6 +135,8 @@ def solve(
     simplify : bool
         Run OMPL's path simplifier on an exact result, as OMPL's Benchmark does: after the
         planner's budget, with its time reported separately (``stages["simplification_time"]``).
+    progress : bool
+        Sample the best cost over time (``result.benchmark.progress``), as OMPL's Benchmark does.
     registry : PlannerRegistry, optional
         Where to look the planner up; the default registry when omitted.
     world : World, optional
@@ -83,92 +150,124 @@ def solve(
 
     Raises
     ------
-    UnknownPlannerError, KeyError, ValueError
+    UnknownPlannerError, ParameterError
         For an unknown planner, parameter name or value (before anything is planned).
     """
-    registry = registry or default_registry()
-    cfg = problem.planner
-    name = planner or cfg.type or DEFAULT_PLANNER
-    entry = registry.get(name)
-    if time_limit is None:
-        time_limit = cfg.time_limit or DEFAULT_TIME_LIMIT
-    time_limit = float(time_limit)
-    if not (time_limit > 0 and math.isfinite(time_limit)):
-        raise ValueError(f"time limit must be a positive number of seconds, got {time_limit}")
-    seed = seed if seed is not None else cfg.seed
-    values: dict[str, Any] = {**cfg.params, **(params or {})}
-    # Planners that split their time (RRTstarPSO) need to know it: OMPL's termination condition
-    # does not say how much is left.
-    if any(p.name == "budget" for p in entry.params) and "budget" not in values:
-        values["budget"] = time_limit
-    if seed is not None and any(p.name == "seed" for p in entry.params) and "seed" not in values:
-        values["seed"] = seed
-    values = entry.validate(values)
-
-    seed_ompl(seed)
+    request = resolve_request(problem, planner, time_limit, seed, params, registry)
+    seed_ompl(request.seed)
     ctx = make_context(problem, world)
-    instance = entry.make(ctx.si, values)
+    instance = request.entry.make(ctx.si, request.values)
     ctx.ss.setPlanner(instance)
     ctx.ss.setup()
 
-    sampler = _ProgressSampler(instance, time_limit) if progress else None
+    sampler = _ProgressSampler(instance, request) if progress else None
     t0 = time.perf_counter()
     if sampler is not None and sampler.polls:
         sampler.t0 = t0
         status = ctx.ss.solve(ob.PlannerTerminationCondition(sampler))
     else:
-        status = ctx.ss.solve(ob.timedPlannerTerminationCondition(time_limit))
+        status = ctx.ss.solve(ob.timedPlannerTerminationCondition(request.time_limit))
     elapsed = time.perf_counter() - t0
-    pdef = ctx.ss.getProblemDefinition()
-    simplification_time = None
-    unsimplified: np.ndarray | None = None
-    if pdef.hasSolution():
-        unsimplified = path_to_array(pdef.getSolutionPath())
-    if simplify and ctx.ss.haveExactSolutionPath():
-        t1 = time.perf_counter()
-        ctx.ss.simplifySolution()
-        simplification_time = time.perf_counter() - t1
-
     code = status.getStatus()
-    path = np.empty((0, 2))
-    if pdef.hasSolution():
-        path = path_to_array(pdef.getSolutionPath())
-    valid = len(path) > 0 and ctx.world.path_valid(path)
-    label = _STATUS.get(code, "none") if valid else "none"
-    if label == "none":
-        path = np.empty((0, 2))
-    clearance = ctx.world.path_clearance(path) - ctx.world.robot_radius if valid else None
 
-    stats = getattr(instance, "last_stats", None)
-    stages = stats.to_dict() if stats is not None else {}
-    applied = instance.param_values() if hasattr(instance, "param_values") else dict(values)
-    if isinstance(instance, og.RRTstar | og.InformedRRTstar | og.SORRTstar):
-        best = instance.bestCost().value()
-        stages = {
-            "iterations": instance.numIterations(),
-            "best_cost": best if math.isfinite(best) else None,
-        }
-    if simplification_time is not None:
-        stages["simplification_time"] = simplification_time
-        stages["unsimplified_length"] = path_length(unsimplified)
-        stages["unsimplified_valid"] = bool(ctx.world.path_valid(unsimplified))
+    pdef = ctx.ss.getProblemDefinition()
+    raw = path_to_array(pdef.getSolutionPath()) if pdef.hasSolution() else None
+    stats = request.entry.collect_stats(instance)
+    stages = stats.to_dict()
+    run = stats.benchmark_run(elapsed, _length(raw))
+    if simplify and ctx.ss.haveExactSolutionPath():
+        run, simplification = _simplify(ctx, run, raw)
+        stages.update(simplification)
+    path, label, valid = _checked_path(ctx, pdef, code)
     if sampler is not None:
-        stages["progress"] = sampler.rows(stats, elapsed, unsimplified, code)
+        # The last row is the planner's own path at the end of its budget (before any
+        # simplification by the harness).
+        final = _length(raw) if code == ob.PlannerStatus.EXACT_SOLUTION else None
+        run = _with_progress(run, sampler.rows(), elapsed, final)
     return SolveResult(
         problem=problem.name,
-        planner=entry.name,
+        planner=request.entry.name,
         status=label,
         ompl_status=str(status),
         solved=label == "exact",
-        length=path_length(path) if len(path) else None,
+        length=_length(path),
         time=elapsed,
-        seed=seed,
+        seed=request.seed,
         path=path,
-        time_limit=time_limit,
-        params=applied,
+        time_limit=request.time_limit,
+        params=_applied(instance, request.values),
         stages=stages,
-        clearance=clearance,
-        valid=bool(valid),
+        clearance=ctx.world.path_clearance(path) - ctx.world.robot_radius if valid else None,
+        valid=valid,
+        benchmark=run,
+    )
+
+
+def _length(path: np.ndarray | None) -> float | None:
+    return path_length(path) if path is not None and len(path) else None
+
+
+def _applied(instance: Any, values: dict[str, Any]) -> dict[str, Any]:
+    """The parameters as the planner applied them (ours report OMPL's choices, e.g. range)."""
+    own = getattr(instance, "param_values", None)
+    return own() if callable(own) else dict(values)
+
+
+def _simplify(
+    ctx: PlanningContext, run: BenchmarkRun, raw: np.ndarray
+) -> tuple[BenchmarkRun, dict[str, Any]]:
+    """OMPL's simplifier after the planner, as in OMPL's Benchmark (timed separately)."""
+    t1 = time.perf_counter()
+    ctx.ss.simplifySolution()
+    seconds = time.perf_counter() - t1
+    length = path_length(path_to_array(ctx.ss.getProblemDefinition().getSolutionPath()))
+    own = run.simplification_time or 0.0  # a planner's own simplification stage comes first
+    run = BenchmarkRun(
+        time=run.time,
+        solution_length=run.solution_length,
+        simplification_time=own + seconds,
+        simplified_length=length,
+        properties=run.properties,
+        progress=run.progress,
+    )
+    stages = {
+        "simplification_time": seconds,
+        "unsimplified_length": path_length(raw),
+        "unsimplified_valid": bool(ctx.world.path_valid(raw)),
+    }
+    return run, stages
+
+
+def _checked_path(ctx: PlanningContext, pdef: Any, code: Any) -> tuple[np.ndarray, str, bool]:
+    """The returned path if it passes the exact check, with its status label."""
+    path = path_to_array(pdef.getSolutionPath()) if pdef.hasSolution() else np.empty((0, 2))
+    valid = len(path) > 0 and bool(ctx.world.path_valid(path))
+    label = _STATUS.get(code, "none") if valid else "none"
+    if label == "none":
+        return np.empty((0, 2)), label, False
+    return path, label, valid
+
+
+def _with_progress(
+    run: BenchmarkRun, sampled: list[tuple[float, float]], elapsed: float, final: float | None
+) -> BenchmarkRun:
+    """The run with its progress rows: the planner's own or the sampled best costs, then the
+    returned length at ``elapsed``; times strictly increasing (OMPL's database keys progress rows
+    by run and time)."""
+    rows = list(run.progress or sampled)
+    if final is not None:
+        rows.append((elapsed, final))
+    out: list[tuple[float, float]] = []
+    for t, c in rows:
+        if not out or t > out[-1][0]:
+            out.append((float(t), float(c)))
+    return BenchmarkRun(
+        time=run.time,
+        solution_length=run.solution_length,
+        simplification_time=run.simplification_time,
+        simplified_length=run.simplified_length,
+        properties=run.properties,
+        progress=out,
     )
 
 
@@ -177,20 +276,21 @@ class _ProgressSampler:
     :data:`PROGRESS_PERIOD` seconds.
 
     OMPL polls the condition from the planning thread, so reading ``bestCost`` here is safe; a
-    sampling thread could not run at all, since ``solve`` holds the GIL. Only planners with a
-    ``bestCost`` are given this Python condition (:attr:`polls`): PRM and PRM* evaluate their
-    condition in a second thread as well, which would wait for the GIL forever; the others run
-    with OMPL's own timed condition and get their one progress row at the end.
+    sampling thread could not run at all, since ``solve`` holds the GIL. Only planners whose
+    registry entry says so (:attr:`Capabilities.progress_polling`) are given this Python
+    condition: PRM and PRM* evaluate their condition in a second thread as well, which would
+    wait for the GIL forever. The others run with OMPL's own timed condition and report their own
+    progress, if any.
     """
 
-    def __init__(self, planner: Any, time_limit: float) -> None:
-        self.time_limit = time_limit
+    def __init__(self, planner: Any, request: PlannerRequest) -> None:
+        self.time_limit = request.time_limit
         self.t0 = time.perf_counter()
         self._next = PROGRESS_PERIOD
-        self._best = getattr(planner, "bestCost", None)
-        #: Whether to poll this condition (only for single-threaded anytime planners).
-        self.polls = self._best is not None and isinstance(planner, _SINGLE_THREADED_ANYTIME)
-        self._rows: list[list[float]] = []
+        #: Whether to poll this condition.
+        self.polls = request.entry.capabilities.progress_polling
+        self._best = planner.bestCost if self.polls else None
+        self._rows: list[tuple[float, float]] = []
 
     def __call__(self) -> bool:
         t = time.perf_counter() - self.t0
@@ -198,25 +298,9 @@ class _ProgressSampler:
             self._next = (math.floor(t / PROGRESS_PERIOD) + 1) * PROGRESS_PERIOD
             cost = self._best().value()
             if math.isfinite(cost):
-                self._rows.append([t, cost])
+                self._rows.append((t, cost))
         return t >= self.time_limit
 
-    def rows(
-        self, stats: Any, elapsed: float, path: np.ndarray | None, code: Any
-    ) -> list[list[float]]:
-        """The best cost over time, ending with the returned path's length at ``elapsed``."""
-        rows = list(self._rows)
-        if stats is not None and hasattr(stats, "rrt_progress"):
-            # RRTstarPSO: its RRT* samples, then OMPL's simplifier, then the swarm's result.
-            rows = [list(r) for r in stats.rrt_progress]
-            if stats.simplified_length is not None:
-                rows.append([stats.rrt_time + stats.simplify_time, stats.simplified_length])
-        exact = code == ob.PlannerStatus.EXACT_SOLUTION
-        if exact and path is not None and len(path):
-            rows.append([elapsed, path_length(path)])
-        # Strictly increasing times: OMPL's database keys progress rows by (run, time).
-        out: list[list[float]] = []
-        for t, c in rows:
-            if not out or t > out[-1][0]:
-                out.append([float(t), float(c)])
-        return out
+    def rows(self) -> list[tuple[float, float]]:
+        """The sampled ``(time s, best cost)`` rows."""
+        return list(self._rows)

@@ -25,61 +25,41 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["PSOOptions", "PSOResult", "minimize"]
+from .params import ParamSpec, ParamTable, Rule
+
+__all__ = ["SWARM_PARAMS", "PSOOptions", "PSOResult", "minimize"]
 
 CostFunction = Callable[[np.ndarray], np.ndarray]
 
 
-@dataclass(frozen=True, kw_only=True)
-class PSOOptions:
-    """Settings of the particle swarm (paper Table 2).
+#: The swarm's parameters (paper Table 2, plus early stopping and inertia damping).
+SWARM_PARAMS = ParamTable(
+    ParamSpec("swarm_size", int, 30, "Number of particles (candidate paths) in the swarm.",
+              low=2, high=10_000),
+    ParamSpec("iterations", int, 100, "PSO iterations per optimisation round (eqs. 4-5).",
+              low=0, high=1_000_000),
+    ParamSpec("w", float, 0.7298, "Inertia weight of the particle velocity (eq. 4).",
+              low=0.0, high=1.5),
+    ParamSpec("c1", float, 1.49618,
+              "Cognitive coefficient: pull to the particle's best (eq. 4); c1 + c2 < 4.",
+              low=0.0, high=4.0),
+    ParamSpec("c2", float, 1.49618,
+              "Social coefficient: pull to the swarm's best (eq. 4); c1 + c2 < 4.",
+              low=0.0, high=4.0),
+    ParamSpec("tolerance", float, 1e-6,
+              "End a PSO round early when the best cost improved by less than this (relative) "
+              "over `patience` iterations; 0 = always run all iterations.",
+              low=0.0, high=1.0),
+    ParamSpec("patience", int, 15, "Window of the early stop, in iterations.",
+              low=1, high=1_000_000),
+    ParamSpec("w_damping", float, 1.0, "Factor applied to w after every iteration (1 = constant).",
+              low=1e-6, high=1.0),
+    rules=[Rule(("c1", "c2"), lambda c1, c2: c1 + c2 < 4.0, "c1 + c2 < 4 (paper Table 2)")],
+)  # fmt: skip
 
-    Parameters
-    ----------
-    swarm_size : int
-        Number of particles, >= 2.
-    iterations : int
-        Maximum number of iterations (velocity and position updates), >= 0.
-    w : float
-        Inertia weight of the velocity (eq. 4), in [0, 1.5].
-    c1, c2 : float
-        Cognitive and social acceleration coefficients (eq. 4); the paper requires c1 + c2 < 4.
-    w_damping : float
-        Factor applied to ``w`` after each iteration, in (0, 1]; 1 keeps ``w`` constant.
-    v_max : float or None
-        Velocity clamp per dimension, in the unit of the positions; None for no clamp.
-    tolerance : float
-        Stop early when the best cost improved by less than ``tolerance`` (relative) over the
-        last ``patience`` iterations; 0 disables early stopping.
-    patience : int
-        Window for ``tolerance``, in iterations.
-    """
-
-    swarm_size: int = 30
-    iterations: int = 100
-    w: float = 0.7298
-    c1: float = 1.49618
-    c2: float = 1.49618
-    w_damping: float = 1.0
-    v_max: float | None = None
-    tolerance: float = 0.0
-    patience: int = 20
-
-    def __post_init__(self) -> None:
-        if self.swarm_size < 2:
-            raise ValueError(f"swarm_size must be >= 2, got {self.swarm_size}")
-        if self.iterations < 0:
-            raise ValueError(f"iterations must be >= 0, got {self.iterations}")
-        if not 0.0 <= self.w <= 1.5:
-            raise ValueError(f"w must be in [0, 1.5], got {self.w}")
-        if self.c1 < 0 or self.c2 < 0 or self.c1 + self.c2 >= 4.0:
-            raise ValueError(f"need c1, c2 >= 0 and c1 + c2 < 4, got c1={self.c1}, c2={self.c2}")
-        if not 0.0 < self.w_damping <= 1.0:
-            raise ValueError(f"w_damping must be in (0, 1], got {self.w_damping}")
-        if self.v_max is not None and self.v_max <= 0:
-            raise ValueError(f"v_max must be > 0 or None, got {self.v_max}")
-        if self.tolerance < 0 or self.patience < 1:
-            raise ValueError("tolerance must be >= 0 and patience >= 1")
+PSOOptions = SWARM_PARAMS.options_class(
+    "PSOOptions", "Settings of the particle swarm (paper Table 2).", __name__
+)
 
 
 @dataclass(frozen=True)
@@ -122,6 +102,7 @@ def minimize(
     *,
     init: np.ndarray | None = None,
     init_velocity: np.ndarray | None = None,
+    v_max: float | None = None,
     terminate: Callable[[], bool] | None = None,
 ) -> PSOResult:
     """Minimise ``cost`` over the box ``[lower, upper]`` with a global-best PSO.
@@ -141,6 +122,10 @@ def minimize(
     init_velocity : (n_particles, dims) array_like, optional
         Initial velocities; zero when omitted (the paper's step 1 uses random velocities; zero is
         the standard choice when the swarm is seeded around a known solution, as RRT*PSO does).
+    v_max : float, optional
+        Velocity clamp per dimension, in the unit of the positions (``|V| <= v_max``); None for
+        no clamp. It depends on the problem's scale, so the caller derives it (it is not one of
+        the swarm's declared parameters).
     terminate : callable, optional
         Polled once per iteration; the run stops when it returns True (e.g. OMPL's
         ``PlannerTerminationCondition``).
@@ -159,7 +144,8 @@ def minimize(
     else:
         x = np.clip(np.asarray(init, dtype=float).reshape(n, dims), lower, upper)
     v = np.zeros((n, dims)) if init_velocity is None else np.asarray(init_velocity, float).copy()
-    v_max = options.v_max
+    if v_max is not None and not v_max > 0:
+        raise ValueError(f"v_max must be > 0 or None, got {v_max}")
 
     f = np.asarray(cost(x), dtype=float)
     pbest_x, pbest_f = x.copy(), f.copy()

@@ -14,6 +14,7 @@ from rrtpso_ompl.evaluation.batch import read_rows
 from rrtpso_ompl.evaluation.bench import run_bench, run_properties, summarise
 from rrtpso_ompl.evaluation.optimum import shortest_path
 from rrtpso_ompl.model.problem import load_problem
+from rrtpso_ompl.planners.result import BenchmarkRun
 
 
 @pytest.fixture(scope="module")
@@ -168,18 +169,29 @@ def test_bad_options_exit_2(args, message, tmp_path):
     assert not (tmp_path / "o").exists()
 
 
-def test_property_mapping_for_each_kind_of_planner():
+def test_property_mapping_takes_each_planner_s_own_figures():
+    """The row's ``benchmark`` record (made by the planner's stats) decides the mapping; nothing
+    is guessed from the keys of ``stages``."""
+    swarm = BenchmarkRun(time=0.85, solution_length=700.0, simplification_time=0.15,
+                         simplified_length=650.0, properties={"pso rounds": ("INTEGER", 3)})
     pso_row = {"solved": True, "status": "exact", "ompl_status": "Exact solution", "valid": True,
                "length": 650.0, "time": 1.0, "optimum": 647.5, "seed": 3, "clearance": 0.1,
-               "stages": {"rrt_time": 0.8, "simplify_time": 0.05, "rrt_length": 700.0,
-                          "pso_length": 650.0, "pso_time": 0.15}}  # fmt: skip
+               "stages": {"pso_length": 650.0, "pso_time": 0.15},
+               "benchmark": swarm.to_dict()}  # fmt: skip
     p = run_properties(pso_row)
     assert p["time"] == pytest.approx(0.85) and p["simplification time"] == 0.15
     assert p["solution length"] == 700.0 and p["simplified solution length"] == 650.0
     assert p["length over optimum"] == pytest.approx(650 / 647.5) and p["total time"] == 1.0
+    assert p["pso rounds"] == 3
+    # A planner whose stats have pso_* keys but no simplification stage (the PSO baseline).
+    baseline = {**pso_row, "benchmark": BenchmarkRun(time=1.0, solution_length=650.0).to_dict()}
+    p = run_properties(baseline)
+    assert p["time"] == 1.0 and p["simplification time"] is None
+    assert p["solution length"] == 650.0 and p["simplified solution length"] is None
     stock = {"solved": True, "status": "exact", "ompl_status": "Exact solution", "valid": True,
              "length": 660.0, "time": 1.0, "optimum": 647.5, "seed": 3,
-             "stages": {"unsimplified_length": 720.0, "simplification_time": 0.01}}  # fmt: skip
+             "benchmark": BenchmarkRun(time=1.0, solution_length=720.0, simplification_time=0.01,
+                                       simplified_length=660.0).to_dict()}  # fmt: skip
     p = run_properties(stock)
     assert p["time"] == 1.0 and p["total time"] == pytest.approx(1.01)
     assert p["solution length"] == 720.0 and p["simplified solution length"] == 660.0
@@ -219,7 +231,7 @@ def test_solve_records_progress_for_every_kind_of_planner(planner):
     simplify = planner != "RRTstarPSO"
     result = solve(problem, planner, time_limit=0.3, seed=2, simplify=simplify, progress=True)
     assert result.solved  # and PRM*, whose condition runs in a second thread, did not hang
-    rows = result.stages["progress"]
+    rows = result.benchmark.progress
     times = [t for t, _ in rows]
     costs = [c for _, c in rows]
     assert rows and all(b > a for a, b in itertools.pairwise(times))

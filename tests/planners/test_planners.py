@@ -10,7 +10,8 @@ import pytest
 from helpers import SINGLE_CIRCLE_OPTIMUM
 from ompl import base as ob
 
-from rrtpso_ompl.ompl_setup.context import make_context, path_to_array
+from rrtpso_ompl.errors import ParameterError
+from rrtpso_ompl.ompl_setup import make_context, path_to_array
 from rrtpso_ompl.planners.registry import default_registry
 from rrtpso_ompl.planners.solve import solve
 
@@ -137,7 +138,7 @@ def test_params_by_name_and_validation(single_circle):
     assert planner.get_param("prune") is False
     with pytest.raises(ValueError, match="goal_bias"):
         entry.make(ctx.si, {"goal_bias": 1.5})
-    with pytest.raises(KeyError, match="known"):
+    with pytest.raises(ParameterError, match="known"):
         entry.make(ctx.si, {"no_such_param": 1})
     stock = REGISTRY.get("RRTstar").make(ctx.si, {"range": 42.0, "rewire_factor": 1.5})
     assert stock.getRange() == 42.0 and stock.getRewireFactor() == 1.5

@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rrtpso_ompl.planners.swarm import PSOOptions, minimize
+from rrtpso_ompl.errors import ParameterError
+from rrtpso_ompl.planners.swarm import SWARM_PARAMS, PSOOptions, minimize
 
 
 def sphere(x):
@@ -263,9 +264,10 @@ def test_velocity_clamp():
         cost,
         np.zeros(1),
         np.full(1, 100.0),
-        PSOOptions(swarm_size=4, iterations=5, v_max=0.5),
+        PSOOptions(swarm_size=4, iterations=5),
         np.random.default_rng(0),
         init=np.array([[0.0], [10.0], [20.0], [30.0]]),  # the best pulls the others hard
+        v_max=0.5,
     )
     steps = np.abs(np.diff(np.stack(seen), axis=0))
     assert steps.max() <= 0.5 + 1e-12
@@ -298,7 +300,7 @@ def test_uniform_initialisation_uses_the_rng():
     assert np.array_equal(seen[0], np.tile([2.0, 6.0], (4, 1)))
 
 
-def reference_pso(cost, lo, hi, opts: PSOOptions, x, v, r: float, iterations: int):
+def reference_pso(cost, lo, hi, opts: PSOOptions, v_max, x, v, r: float, iterations: int):
     """Eqs. 4-5 with inertia damping, velocity clamp and walls, replayed by hand with constant
     r1 = r2 = r. Returns the swarm at every evaluation."""
     x, v = x.copy(), v.copy()
@@ -310,8 +312,8 @@ def reference_pso(cost, lo, hi, opts: PSOOptions, x, v, r: float, iterations: in
     swarms = [x.copy()]
     for _ in range(iterations):
         v = w * v + opts.c1 * r * (pbest_x - x) + opts.c2 * r * (gbest_x - x)
-        if opts.v_max is not None:
-            v = np.clip(v, -opts.v_max, opts.v_max)
+        if v_max is not None:
+            v = np.clip(v, -v_max, v_max)
         x = x + v
         for i in range(x.shape[0]):
             for j in range(x.shape[1]):
@@ -335,14 +337,15 @@ def test_several_iterations_match_a_hand_written_reference():
     x0 = rng.uniform(-1, 1, (5, 2))
     v0 = rng.uniform(-0.5, 0.5, (5, 2))
     lo, hi = np.array([-1.0, -1.0]), np.array([1.0, 1.0])
-    opts = PSOOptions(swarm_size=5, iterations=8, w=0.9, c1=1.0, c2=2.5, w_damping=0.8, v_max=0.7)
+    opts = PSOOptions(swarm_size=5, iterations=8, w=0.9, c1=1.0, c2=2.5, w_damping=0.8, tolerance=0)
+    v_max = 0.7
 
     def cost(x):
         return np.sum((x - np.array([3.0, 0.2])) ** 2, axis=1)  # pulls everyone into the wall
 
     wrapped, seen = recording(cost)
-    minimize(wrapped, lo, hi, opts, ConstRNG(0.37), init=x0, init_velocity=v0)
-    expected = reference_pso(cost, lo, hi, opts, x0, v0, 0.37, 8)
+    minimize(wrapped, lo, hi, opts, ConstRNG(0.37), init=x0, init_velocity=v0, v_max=v_max)
+    expected = reference_pso(cost, lo, hi, opts, v_max, x0, v0, 0.37, 8)
     assert len(seen) == len(expected) == 9
     for got, want in zip(seen, expected, strict=True):
         assert np.allclose(got, want, rtol=0, atol=1e-12)
@@ -366,16 +369,33 @@ def test_several_iterations_match_a_hand_written_reference():
         {"c2": -0.1},
         {"w_damping": 0.0},
         {"w_damping": 1.01},
-        {"v_max": 0.0},
-        {"v_max": -1.0},
         {"tolerance": -1e-9},
         {"patience": 0},
     ],
     ids=lambda k: ",".join(f"{key}={val}" for key, val in k.items()),
 )
 def test_invalid_options_are_rejected(kwargs):
-    with pytest.raises(ValueError):
+    with pytest.raises(ParameterError):
         PSOOptions(**kwargs)
+
+
+@pytest.mark.parametrize("v_max", [0.0, -1.0, float("nan")])
+def test_invalid_velocity_clamp_is_rejected(v_max):
+    with pytest.raises(ValueError, match="v_max"):
+        minimize(
+            lambda x: x.sum(axis=1),
+            np.zeros(1),
+            np.ones(1),
+            PSOOptions(),
+            np.random.default_rng(0),
+            v_max=v_max,
+        )
+
+
+def test_options_defaults_are_the_declared_ones():
+    """One declaration per parameter: the options class takes its defaults from the table."""
+    assert PSOOptions().swarm_size == SWARM_PARAMS["swarm_size"].default
+    assert {f: getattr(PSOOptions(), f) for f in SWARM_PARAMS.names()} == SWARM_PARAMS.defaults()
 
 
 @pytest.mark.parametrize(
@@ -389,7 +409,6 @@ def test_invalid_options_are_rejected(kwargs):
         {"c1": 0.0, "c2": 0.0},
         {"w_damping": 1.0},
         {"w_damping": 1e-3},
-        {"v_max": 1e-6},
         {"tolerance": 0.0, "patience": 1},
     ],
     ids=lambda k: ",".join(f"{key}={val}" for key, val in k.items()),

@@ -1,0 +1,313 @@
+"""Planner parameters, each declared once.
+
+OMPL declares a planner parameter in one line, ``declareParam<double>("range", this,
+&RRTstar::setRange, &RRTstar::getRange, "0.:1.:10000.")``, and everything else (benchmark logs,
+MoveIt's configuration) reads that declaration back. ``Planner.params()`` is not usable from the
+OMPL 2.0 Python bindings, so the declarations live here instead, one :class:`ParamSpec` per
+parameter (name, type, default, unit, range, documentation and, for OMPL's own planners, the
+setter and getter), gathered in a :class:`ParamTable` with the rules that tie several parameters
+together (``c1 + c2 < 4``).
+
+Everything else is derived from the tables: the options objects the algorithms take
+(:meth:`ParamTable.options_class`), the validation of YAML ``planner.params``, ``--param`` and
+Python keyword arguments (:meth:`ParamTable.validate`, one
+:class:`~rrtpso_ompl.errors.ParameterError` for every violation, as scikit-learn's
+``_parameter_constraints`` do), the listing of ``rrtpso planners`` and the tables in
+``docs/planners.md``. Defaults therefore agree everywhere by construction.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from ..errors import ParameterError
+from ..validation import check_integer, check_number, describe
+
+__all__ = ["ParamSpec", "ParamTable", "Rule"]
+
+_TRUE = {"1", "true", "yes", "on"}
+_FALSE = {"0", "false", "no", "off"}
+
+
+@dataclass(frozen=True)
+class ParamSpec:
+    """One planner parameter.
+
+    Parameters
+    ----------
+    name : str
+        snake_case name; OMPL's name where OMPL has one (``range``, ``goal_bias``).
+    type : type
+        ``float``, ``int``, ``bool`` or ``str``.
+    default : Any
+        Default value (as the planner itself uses it).
+    doc : str
+        What the parameter does to the search.
+    unit : str
+        Unit of the value ("" for dimensionless), e.g. ``"length"`` for the problem's unit, ``"s"``.
+    low, high : float or None
+        Inclusive range of numeric values; None for unbounded.
+    choices : tuple or None
+        Allowed values of a ``str`` parameter.
+    setter : str or None
+        For OMPL planners: the setter method to call (``"setRange"``).
+    getter : str or None
+        For OMPL planners: the matching getter, used to check defaults against OMPL.
+    """
+
+    name: str
+    type: type
+    default: Any
+    doc: str
+    unit: str = ""
+    low: float | None = None
+    high: float | None = None
+    choices: tuple[Any, ...] | None = None
+    setter: str | None = None
+    getter: str | None = None
+
+    def convert(self, value: Any, owner: str = "") -> Any:
+        """Validate ``value`` (a Python value or a command-line string) and convert it.
+
+        Parameters
+        ----------
+        value : Any
+            The value as given (``"50"`` from the command line, ``50`` from YAML or Python).
+        owner : str
+            The planner, named in the message.
+
+        Raises
+        ------
+        ParameterError
+            Naming the parameter, the expected type and range, and the value given.
+        """
+        try:
+            return self._convert(self._parse(value))
+        except ValueError as exc:
+            of = f" of {owner}" if owner else ""
+            raise ParameterError(f"parameter '{self.name}'{of} {exc}", self.name) from None
+
+    def _parse(self, value: Any) -> Any:
+        """A command-line string to a Python value of the declared type."""
+        if not isinstance(value, str) or self.type is str:
+            return value
+        text = value.strip()
+        if self.type is bool:
+            if text.lower() in _TRUE:
+                return True
+            if text.lower() in _FALSE:
+                return False
+            raise ValueError(f"must be a boolean (true/false), got '{value}'")
+        try:
+            number = float(text)
+        except ValueError:
+            raise ValueError(f"must be {'an integer' if self.type is int else 'a number'}, "
+                             f"got '{value}'") from None  # fmt: skip
+        if self.type is int and math.isfinite(number) and "." not in text and "e" not in text:
+            return int(text)  # exact, also beyond 2**53
+        return number
+
+    def _convert(self, v: Any) -> Any:
+        if self.type is bool:
+            if isinstance(v, bool):
+                return v
+            if isinstance(v, int) and v in (0, 1):
+                return bool(v)
+            raise ValueError(f"must be a boolean, got {describe(v)}")
+        if self.type is int:
+            return check_integer(v, low=_int(self.low), high=_int(self.high))
+        if self.type is float:
+            return check_number(v, low=self.low, high=self.high)
+        if not isinstance(v, str):
+            raise ValueError(f"must be a string, got {describe(v)}")
+        if self.choices is not None and v not in self.choices:
+            raise ValueError(f"must be one of {list(self.choices)}, got '{v}'")
+        return v
+
+    def range_text(self) -> str:
+        """The allowed range as text, e.g. ``[0, 1]``."""
+        if self.choices is not None:
+            return "{" + ", ".join(map(str, self.choices)) + "}"
+        if self.type is bool:
+            return "{false, true}"
+        lo = "-inf" if self.low is None else f"{self.low:g}"
+        hi = "inf" if self.high is None else f"{self.high:g}"
+        return f"[{lo}, {hi}]"
+
+
+def _int(x: float | None) -> int | None:
+    return None if x is None else int(x)
+
+
+@dataclass(frozen=True)
+class Rule:
+    """A constraint over several parameters that no single value reveals.
+
+    Parameters
+    ----------
+    names : tuple of str
+        The parameters involved, in the order ``holds`` takes them.
+    holds : callable
+        ``holds(*values) -> bool``.
+    text : str
+        The rule as users read it, e.g. ``"c1 + c2 < 4 (paper Table 2)"``.
+    """
+
+    names: tuple[str, ...]
+    holds: Callable[..., bool]
+    text: str
+
+
+class ParamTable:
+    """The declared parameters of a planner (or of one stage of it), with their rules.
+
+    Parameters
+    ----------
+    *params : ParamSpec
+        The parameters, in the order listings show them; names must be unique.
+    rules : iterable of Rule
+        Constraints over several parameters.
+    """
+
+    def __init__(self, *params: ParamSpec, rules: Iterable[Rule] = ()) -> None:
+        self._params = {p.name: p for p in params}
+        if len(self._params) != len(params):
+            raise ValueError("a parameter table declares a parameter twice")
+        self.rules = tuple(r for r in rules if set(r.names) <= set(self._params))
+        for spec in params:
+            spec.convert(spec.default)  # a default outside its own range is a declaration bug
+
+    # -- a sequence of specs ---------------------------------------------------------------------
+    def __iter__(self) -> Iterator[ParamSpec]:
+        return iter(self._params.values())
+
+    def __len__(self) -> int:
+        return len(self._params)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._params
+
+    def __getitem__(self, name: str) -> ParamSpec:
+        """The spec of ``name``; :class:`ParameterError` listing the known names otherwise."""
+        try:
+            return self._params[name]
+        except KeyError:
+            known = ", ".join(self._params) or "none"
+            raise ParameterError(f"no parameter '{name}' (known: {known})", name) from None
+
+    def names(self) -> list[str]:
+        """Parameter names in declaration order."""
+        return list(self._params)
+
+    def defaults(self) -> dict[str, Any]:
+        """Every parameter at its default."""
+        return {p.name: p.default for p in self}
+
+    # -- composition -----------------------------------------------------------------------------
+    def __add__(self, other: ParamTable) -> ParamTable:
+        """Both tables' parameters (and rules); a name in both is a declaration bug."""
+        return ParamTable(*self, *other, rules=(*self.rules, *other.rules))
+
+    def with_defaults(self, **defaults: Any) -> ParamTable:
+        """The same parameters with other defaults (a planner that sets its own)."""
+        return self.replace(**{k: {"default": v} for k, v in defaults.items()})
+
+    def replace(self, **changes: Mapping[str, Any]) -> ParamTable:
+        """The same table with fields of some specs replaced: ``replace(iterations={...})``."""
+        for name in changes:
+            self[name]  # raises ParameterError for an unknown name
+        specs = [dataclasses.replace(p, **changes[p.name]) if p.name in changes else p
+                 for p in self]  # fmt: skip
+        return ParamTable(*specs, rules=self.rules)
+
+    def subset(self, *names: str) -> ParamTable:
+        """A table of some of the parameters (and the rules among them), in the order given."""
+        return ParamTable(*(self[n] for n in names), rules=self.rules)
+
+    def without(self, *names: str) -> ParamTable:
+        """The table without some parameters (and the rules that involve them)."""
+        return ParamTable(*(p for p in self if p.name not in names), rules=self.rules)
+
+    # -- validation ------------------------------------------------------------------------------
+    def validate(self, values: Mapping[str, Any] | None, owner: str = "") -> dict[str, Any]:
+        """Check names and values; return the converted values (only those given).
+
+        The rules are checked on the given values over the defaults, so that a value that breaks
+        a rule only together with a default is refused too.
+
+        Raises
+        ------
+        ParameterError
+            For an unknown name, a wrong value or a broken rule.
+        """
+        of = f" of {owner}" if owner else ""
+        converted = {}
+        for key, value in (values or {}).items():
+            if key not in self._params:
+                known = ", ".join(self._params) or "none"
+                raise ParameterError(f"{owner or 'the planner'} has no parameter '{key}' "
+                                     f"(known: {known})", key)  # fmt: skip
+            converted[key] = self._params[key].convert(value, owner)
+        merged = {**self.defaults(), **converted}
+        for rule in self.rules:
+            if not rule.holds(*(merged[n] for n in rule.names)):
+                given = ", ".join(f"{n} = {merged[n]!r}" for n in rule.names)
+                raise ParameterError(f"parameters{of} must satisfy {rule.text}, got {given}",
+                                     " + ".join(rule.names))  # fmt: skip
+        return converted
+
+    # -- derived objects ---------------------------------------------------------------------------
+    def options_class(self, name: str, doc: str, module: str) -> type:
+        """A frozen, keyword-only dataclass with one field per parameter (its default too).
+
+        The class validates itself on construction with :meth:`validate` and has a
+        ``from_values(mapping)`` constructor that picks its own fields out of a larger mapping
+        (a planner's values). Its docstring lists every parameter with type, unit, range and doc.
+        """
+        table = self
+        fields = [(p.name, p.type, dataclasses.field(default=p.default)) for p in self]
+
+        def __post_init__(self) -> None:
+            table.validate(dataclasses.asdict(self), owner=name)
+
+        @classmethod
+        def from_values(cls, values: Mapping[str, Any]):
+            return cls(**{k: values[k] for k in table.names() if k in values})
+
+        cls = dataclasses.make_dataclass(
+            name,
+            fields,
+            namespace={
+                "__post_init__": __post_init__,
+                "from_values": from_values,
+                "PARAMS": table,
+            },
+            frozen=True,
+            kw_only=True,
+        )
+        cls.__module__ = module
+        cls.__doc__ = f"{doc}\n\n{self.numpydoc()}"
+        return cls
+
+    def markdown(self) -> str:
+        """The table as markdown (name, type, default, unit, range, meaning), as in the docs."""
+        rows = ["| name | type | default | unit | range | meaning |", "|---|---|---|---|---|---|"]
+        for p in self:
+            rows.append(
+                f"| `{p.name}` | {p.type.__name__} | {p.default} | {p.unit or '–'} | "
+                f"{p.range_text()} | {p.doc} |"
+            )
+        return "\n".join(rows)
+
+    def numpydoc(self) -> str:
+        """A numpydoc ``Parameters`` section of the table."""
+        lines = ["Parameters", "----------"]
+        for p in self:
+            unit = f", in {p.unit}" if p.unit else ""
+            lines.append(f"{p.name} : {p.type.__name__}, default {p.default!r}")
+            lines.append(f"    {p.doc} Range {p.range_text()}{unit}.")
+        return "\n".join(lines)

@@ -1,0 +1,99 @@
+"""Parameters declared once: tables, rules, derived options classes and docs."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from rrtpso_ompl.errors import ParameterError, RrtpsoError
+from rrtpso_ompl.planners import PathOptimizerOptions, PSOOptions, default_registry
+from rrtpso_ompl.planners.params import ParamSpec, ParamTable, Rule
+from rrtpso_ompl.planners.path_optimizer import OPTIMIZER_PARAMS
+from rrtpso_ompl.planners.swarm import SWARM_PARAMS
+
+TABLE = ParamTable(
+    ParamSpec("a", float, 1.0, "first", low=0.0, high=3.0),
+    ParamSpec("b", float, 1.0, "second", low=0.0, high=3.0),
+    ParamSpec("n", int, 4, "count", low=1),
+    ParamSpec("on", bool, False, "flag"),
+    ParamSpec("mode", str, "x", "mode", choices=("x", "y")),
+    rules=[Rule(("a", "b"), lambda a, b: a + b < 4, "a + b < 4")],
+)
+
+
+@pytest.mark.parametrize(
+    ("given", "expected"),
+    [
+        ({"a": "2.5"}, {"a": 2.5}),
+        ({"n": "12"}, {"n": 12}),
+        ({"n": 12.0}, {"n": 12}),
+        ({"n": "1e2"}, {"n": 100}),
+        ({"on": "yes"}, {"on": True}),
+        ({"on": 1}, {"on": True}),
+        ({"mode": "y"}, {"mode": "y"}),
+    ],
+)
+def test_values_are_converted(given, expected):
+    assert TABLE.validate(given) == expected
+
+
+@pytest.mark.parametrize(
+    ("given", "words"),
+    [
+        ({"a": 3.5}, "parameter 'a' of P must be <= 3"),
+        ({"a": -1}, "must be >= 0"),
+        ({"a": "inf"}, "finite"),
+        ({"a": True}, "must be a number"),
+        ({"n": 2.5}, "must be an integer"),
+        ({"n": "two"}, "must be an integer"),
+        ({"n": 0}, "must be >= 1"),
+        ({"on": "maybe"}, "boolean"),
+        ({"mode": "z"}, "one of"),
+        ({"zzz": 1}, "P has no parameter 'zzz' (known: a, b, n, on, mode)"),
+        ({"a": 2.5, "b": 2.0}, "parameters of P must satisfy a + b < 4, got a = 2.5, b = 2.0"),
+        ({"a": 3.0}, "a + b < 4"),  # breaks the rule together with b's default
+    ],
+)
+def test_every_violation_is_one_parameter_error(given, words):
+    with pytest.raises(ParameterError, match=None) as info:
+        TABLE.validate(given, owner="P")
+    assert words in str(info.value)
+    assert isinstance(info.value, RrtpsoError) and isinstance(info.value, ValueError)
+
+
+def test_a_declaration_bug_is_caught_when_the_table_is_built():
+    with pytest.raises(ParameterError):
+        ParamTable(ParamSpec("x", float, 5.0, "default out of range", low=0, high=1))
+    with pytest.raises(ValueError, match="twice"):
+        ParamTable(ParamSpec("x", float, 0.0, ""), ParamSpec("x", float, 0.0, ""))
+
+
+def test_options_classes_take_fields_and_defaults_from_the_tables():
+    fields = {f.name: f.default for f in dataclasses.fields(PathOptimizerOptions)}
+    assert fields == {**SWARM_PARAMS.defaults(), **OPTIMIZER_PARAMS.defaults()}
+    assert {f.name for f in dataclasses.fields(PSOOptions)} == set(SWARM_PARAMS.names())
+    # ... validate with the same rules, and document every parameter.
+    with pytest.raises(ParameterError, match="c1 \\+ c2 < 4"):
+        PathOptimizerOptions(c1=2.0, c2=2.0)
+    assert all(f"{name} : " in PathOptimizerOptions.__doc__ for name in fields)
+    # from_values picks its own fields out of a planner's values.
+    values = default_registry().get("RRTstarPSO").params.defaults()
+    assert PSOOptions.from_values({**values, "swarm_size": 7}).swarm_size == 7
+
+
+def test_planners_share_declarations_instead_of_copying_them():
+    reg = default_registry()
+    rrt, ours = reg.get("RRTstar").params, reg.get("RRTstarPSO").params
+    for name in ("range", "goal_bias", "rewire_factor", "informed_sampling", "tree_pruning"):
+        assert ours[name] is rrt[name]  # the inner RRT*'s parameters are OMPL's declarations
+    baseline = reg.get("PSO").params
+    assert baseline["c1"] is ours["c1"] and baseline["iterations"].default == 200
+    assert "v_max_fraction" not in baseline  # its clamp is relative to the workspace instead
+    assert baseline.rules and ours.rules  # the c1 + c2 rule travels with the swarm's table
+
+
+def test_markdown_lists_every_parameter_in_order():
+    lines = TABLE.markdown().splitlines()
+    assert lines[0].startswith("| name | type | default")
+    assert [line.split("`")[1] for line in lines[2:]] == TABLE.names()
