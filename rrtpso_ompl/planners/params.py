@@ -118,10 +118,11 @@ class ParamSpec:
             if isinstance(v, int) and v in (0, 1):
                 return bool(v)
             raise ValueError(f"must be a boolean, got {describe(v)}")
-        if self.type is int:
-            return check_integer(v, low=_int(self.low), high=_int(self.high))
-        if self.type is float:
-            return check_number(v, low=self.low, high=self.high)
+        if self.type in (int, float):
+            x = check_integer(v) if self.type is int else check_number(v)
+            if (self.low is not None and x < self.low) or (self.high is not None and x > self.high):
+                raise ValueError(f"must be in {self.range_text()}, got {x!r}")
+            return x
         if not isinstance(v, str):
             raise ValueError(f"must be a string, got {describe(v)}")
         if self.choices is not None and v not in self.choices:
@@ -137,10 +138,6 @@ class ParamSpec:
         lo = "-inf" if self.low is None else f"{self.low:g}"
         hi = "inf" if self.high is None else f"{self.high:g}"
         return f"[{lo}, {hi}]"
-
-
-def _int(x: float | None) -> int | None:
-    return None if x is None else int(x)
 
 
 @dataclass(frozen=True)

@@ -41,13 +41,13 @@ def test_values_are_converted(given, expected):
 @pytest.mark.parametrize(
     ("given", "words"),
     [
-        ({"a": 3.5}, "parameter 'a' of P must be <= 3"),
-        ({"a": -1}, "must be >= 0"),
+        ({"a": 3.5}, "parameter 'a' of P must be in [0, 3], got 3.5"),
+        ({"a": -1}, "must be in [0, 3]"),
         ({"a": "inf"}, "finite"),
         ({"a": True}, "must be a number"),
         ({"n": 2.5}, "must be an integer"),
         ({"n": "two"}, "must be an integer"),
-        ({"n": 0}, "must be >= 1"),
+        ({"n": 0}, "must be in [1, inf], got 0"),
         ({"on": "maybe"}, "boolean"),
         ({"mode": "z"}, "one of"),
         ({"zzz": 1}, "P has no parameter 'zzz' (known: a, b, n, on, mode)"),
