@@ -252,6 +252,11 @@ def plot_velocities(traj: Any, units: str = "") -> Figure:
     return fig
 
 
+def image_formats() -> set[str]:
+    """The file suffixes (without the dot) that :func:`save_figure` can write."""
+    return set(Figure().canvas.get_supported_filetypes())
+
+
 def save_figure(fig: Figure, path: str | Path, dpi: int = 120) -> None:
     """Save ``fig`` atomically (temporary file, then rename) and close it."""
     try:

@@ -1,0 +1,106 @@
+"""``rrtpso bench``: benchmark planners; OMPL benchmark logs, a Planner Arena database, a report."""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+from pathlib import Path
+from typing import Any
+
+from ..errors import UsageError
+from .common import (
+    EXIT_OK,
+    EXIT_UNSOLVED,
+    RunProgress,
+    add_run_options,
+    check_output,
+    check_planners,
+    check_positive_seconds,
+    check_run_options,
+    planner_list,
+)
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub: Any) -> None:
+    b = sub.add_parser(
+        "bench",
+        help="benchmark planners: OMPL benchmark logs, a Planner Arena database and a report",
+        description="Run every problem x time budget x planner x run in its own process with the "
+        "same collision checker, then write to --out: runs.jsonl, one OMPL benchmark log per "
+        "problem and budget (*.log), benchmark.db (built by OMPL's converter; open it in Planner "
+        "Arena), report.md, report.csv, ratio.png and success.png (docs/benchmarking.md). Exit "
+        "status 1 when a problem file was bad, 130 when interrupted (continue with --resume).",
+    )
+    b.add_argument("inputs", nargs="+", metavar="FILE|DIR|GLOB", help="problem files")
+    b.add_argument("--planners", required=True, metavar="A,B,...", help="planners to compare")
+    b.add_argument("--runs", type=int, default=10, help="runs per problem, budget and planner")
+    b.add_argument(
+        "--time",
+        default="1",
+        metavar="S[,S2,...]",
+        help="time budget(s) in seconds, comma-separated (default 1)",
+    )
+    b.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    add_run_options(b, "the runs already in DIR/runs.jsonl")
+    b.set_defaults(func=run)
+
+
+def _budgets(text: str) -> list[float]:
+    try:
+        times = [float(t) for t in text.split(",") if t.strip()]
+    except ValueError:
+        raise UsageError(f"--time: expected seconds like 0.25,1,4, got '{text}'") from None
+    if not times:
+        raise UsageError(f"--time: every budget must be a positive number of seconds: {text}")
+    for t in times:
+        check_positive_seconds(t, "--time")
+    return times
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..evaluation import run_bench
+
+    times = _budgets(args.time)
+    args.time = None  # checked above, one budget at a time
+    check_run_options(args)
+    planners = planner_list([args.planners], "")
+    if not planners:
+        raise UsageError("--planners: name at least one planner")
+    params = check_planners(planners, args.param, "--planners")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out: '{args.out}' exists and is not a folder")
+    check_output(str(out / "report.md"), "--out")
+    with RunProgress("bench", "runs") as bar:
+        result = run_bench(
+            args.inputs,
+            planners,
+            out,
+            runs=args.runs,
+            times=times,
+            seed=args.seed,
+            params=params,
+            jobs=args.jobs,
+            executor=args.executor,
+            scheduler=args.scheduler,
+            resume=args.resume,
+            progress=bar.row,
+            on_start=bar.started,
+            command="rrtpso " + shlex.join(args.argv),
+        )
+    from ..plotting import plot_bench, save_figure
+
+    if result.summary:
+        save_figure(plot_bench(result.summary, "ratio"), out / "ratio.png")
+        save_figure(plot_bench(result.summary, "success"), out / "success.png")
+    for e in result.errors:
+        print(f"rrtpso: {e}", file=sys.stderr)
+    print(
+        f"bench: {len(result.rows)} runs, {len(result.logs)} experiments -> {out}/ "
+        f"(benchmark.db, report.md)",
+        file=sys.stderr,
+    )
+    return EXIT_UNSOLVED if result.errors else EXIT_OK

@@ -1,0 +1,49 @@
+"""``rrtpso optimum``: the exact shortest path, the reference of every length ratio."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Any
+
+from .common import EXIT_OK, EXIT_UNSOLVED, check_output
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub: Any) -> None:
+    o = sub.add_parser(
+        "optimum",
+        help="compute the exact shortest path (the reference for path-length ratios)",
+        description="Compute the exact shortest path for the problem's disc robot among its "
+        "circles and polygons: a tangent graph with arcs around the inflated obstacles, searched "
+        "with Dijkstra's algorithm (docs/benchmarking.md). Moving obstacles are ignored. Exit "
+        "status 0 when a path exists, 1 when none does.",
+    )
+    o.add_argument("problem", help="problem file (YAML)")
+    o.add_argument("--json", metavar="OUT", help='write {"length": ..., "path": [...], ...}')
+    o.add_argument("--plot", metavar="OUT.png", help="draw the world and the shortest path")
+    o.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..evaluation import shortest_path
+    from ..model import load_problem
+
+    problem = load_problem(args.problem)
+    check_output(args.json, "--json")
+    check_output(args.plot, "--plot", image=True)
+    result = shortest_path(problem)
+    if args.plot:
+        from ..plotting import plot_optimum, save_figure
+
+        save_figure(plot_optimum(problem, result), args.plot)
+    if args.json:
+        from ..outputs import write_json_atomic
+
+        write_json_atomic(result.to_dict(), args.json)
+    if result.found:
+        print(f"{problem.name}: optimum length={result.length:.6f}", file=sys.stderr)
+        return EXIT_OK
+    print(f"{problem.name}: no path exists", file=sys.stderr)
+    return EXIT_UNSOLVED

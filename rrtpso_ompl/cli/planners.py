@@ -1,0 +1,69 @@
+"""``rrtpso planners``: every registered planner and its declared parameters."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+from .common import EXIT_OK
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub: Any) -> None:
+    q = sub.add_parser(
+        "planners",
+        help="list the planners and their parameters",
+        description="List the registered planners and their parameters.",
+    )
+    q.add_argument("name", nargs="?", help="show only this planner")
+    q.add_argument("--json", action="store_true", help="machine-readable output")
+    q.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..planners import default_registry
+
+    registry = default_registry()
+    entries = [registry.get(args.name)] if args.name else registry.entries()
+    if args.json:
+        print(json.dumps([_entry_dict(e) for e in entries], indent=2))
+        return EXIT_OK
+    for e in entries:
+        aliases = f"  (also: {', '.join(e.aliases)})" if e.aliases else ""
+        print(f"{e.name}{aliases}\n    {e.description}  [{e.source}]")
+        for p in e.params:
+            unit = f" {p.unit}" if p.unit else ""
+            print(
+                f"    {p.name:<28} {p.type.__name__:<5} default {p.default!s:<8}{unit} "
+                f"in {p.range_text()}"
+            )
+            if args.name:
+                print(f"        {p.doc}")
+    return EXIT_OK
+
+
+def _entry_dict(e: Any) -> dict[str, Any]:
+    """A registry entry as JSON: names, capabilities and every declared parameter."""
+    from dataclasses import asdict
+
+    return {
+        "name": e.name,
+        "aliases": list(e.aliases),
+        "description": e.description,
+        "optimizing": e.optimizing,
+        "capabilities": asdict(e.capabilities),
+        "source": e.source,
+        "params": [
+            {
+                "name": p.name,
+                "type": p.type.__name__,
+                "default": p.default,
+                "unit": p.unit,
+                "range": p.range_text(),
+                "doc": p.doc,
+            }
+            for p in e.params
+        ],
+    }

@@ -1,0 +1,142 @@
+"""``rrtpso simulate``: drive among moving obstacles with collision prediction and replanning."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+from ..errors import UsageError
+from .common import (
+    EXIT_OK,
+    EXIT_UNSOLVED,
+    check_output,
+    check_positive_seconds,
+    choose_planner,
+    progress_bar,
+)
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub: Any) -> None:
+    m = sub.add_parser(
+        "simulate",
+        help="drive among moving obstacles with collision prediction and replanning",
+        description="Drive the robot from start to goal among the problem's moving obstacles: it "
+        "senses them within robot.sensor_range, predicts collisions and replans contour detours "
+        "(docs/dynamic.md). Exit status 0 when the goal is reached without a collision, else 1.",
+    )
+    m.add_argument("problem", help="problem file with moving_obstacles")
+    m.add_argument("--json", metavar="OUT", help="write the simulation as JSON")
+    m.add_argument("--gif", metavar="OUT.gif", help="write an animation")
+    m.add_argument("--plot", metavar="OUT.png", help="draw the driven path (paper Fig. 24)")
+    m.add_argument("--seed", type=int, help="random seed (default: the file's planner.seed)")
+    m.add_argument(
+        "--planner",
+        help="planner of the static path and the detours (default: the "
+        "file's planner.type, else RRTstarPSO)",
+    )
+    m.add_argument(
+        "--time",
+        type=float,
+        metavar="SECONDS",
+        help="budget of the initial static path (default: the file's planner.time_limit, else 1.0)",
+    )
+    m.add_argument(
+        "--replan-time",
+        type=float,
+        default=0.5,
+        metavar="SECONDS",
+        help="simulated time one replan takes, split between the two detours (default 0.5)",
+    )
+    m.add_argument(
+        "--strategy",
+        choices=("contour", "global", "none"),
+        default="contour",
+        help="contour: detours up and down around the collision zone (the paper); "
+        "global: replan the whole remaining path; none: never replan "
+        "(default: contour)",
+    )
+    m.add_argument(
+        "--heading-changes",
+        type=float,
+        default=0.0,
+        metavar="RATE",
+        help="random heading changes per obstacle per second (default 0: constant velocity)",
+    )
+    m.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="planner parameter, repeatable",
+    )
+    m.add_argument("-v", "--verbose", action="count", default=0, help="show OMPL's messages")
+    m.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..ompl_setup import set_ompl_log_level
+
+    set_ompl_log_level(args.verbose)
+    choice = choose_planner(args)
+    problem = choice.problem
+    src = args.problem
+    for key in ("speed", "sample_time", "sensor_range"):
+        if getattr(problem.robot, key) is None:
+            raise UsageError(f"{src}: robot.{key}: required for simulate")
+    check_positive_seconds(args.time, "--time", src)
+    check_positive_seconds(args.replan_time, "--replan-time", src)
+    if not (args.heading_changes >= 0 and math.isfinite(args.heading_changes)):
+        raise UsageError(f"{src}: --heading-changes: must be >= 0, got {args.heading_changes}")
+    check_output(args.json, "--json")
+    check_output(args.plot, "--plot", image=True)
+    check_output(args.gif, "--gif")
+    if args.gif and Path(args.gif).suffix.lower() != ".gif":
+        raise UsageError(f"--gif: '{args.gif}' must end in .gif")
+
+    from ..dynamic import DynamicOptions, simulate
+
+    options = DynamicOptions(
+        planner=choice.entry.name,
+        strategy=args.strategy,
+        replan_time=args.replan_time,
+        initial_time=args.time,
+        heading_changes=args.heading_changes,
+        params=choice.params,
+    )
+    seed = args.seed if args.seed is not None else problem.planner.seed
+    with progress_bar("simulating", unit="s") as bar:
+
+        def progress(t: float, t_end: float) -> None:
+            bar.total = round(t_end, 1)
+            bar.n = round(t, 1)
+            bar.refresh()
+
+        sim = simulate(problem, options, seed=seed, progress=progress)
+    _write_outputs(args, problem, sim)
+    verdict = "reached the goal" if sim.reached_goal else f"did not reach the goal ({sim.status})"
+    print(
+        f"{problem.name}: {verdict}, {sim.collisions} collisions, {len(sim.replans)} replans, "
+        f"time {sim.total_time:.1f}s, length {sim.path_length:.1f}",
+        file=sys.stderr,
+    )
+    return EXIT_OK if sim.success else EXIT_UNSOLVED
+
+
+def _write_outputs(args: argparse.Namespace, problem: Any, sim: Any) -> None:
+    if args.plot:
+        from ..plotting import plot_simulation, save_figure
+
+        save_figure(plot_simulation(problem, sim), args.plot)
+    if args.gif and sim.motion is not None:
+        from ..plotting import animate_simulation
+
+        animate_simulation(problem, sim, args.gif)
+    if args.json:
+        from ..outputs import write_json_atomic
+
+        write_json_atomic(sim.to_dict(), args.json)

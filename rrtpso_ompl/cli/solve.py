@@ -1,0 +1,143 @@
+"""``rrtpso solve``: one problem file, one planner; the path as JSON, plots and wheel commands."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Any
+
+from ..errors import UsageError
+from .common import EXIT_OK, EXIT_UNSOLVED, check_output, check_positive_seconds, choose_planner
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub: Any) -> None:
+    p = sub.add_parser(
+        "solve",
+        help="solve one problem file",
+        description="Solve one problem file and report the path.",
+    )
+    p.add_argument("problem", help="problem file (YAML, see docs/problem-format.md)")
+    p.add_argument(
+        "--planner",
+        help="planner name (default: the file's planner.type, else "
+        "RRTstarPSO); see 'rrtpso planners'",
+    )
+    p.add_argument(
+        "--time",
+        type=float,
+        metavar="SECONDS",
+        help="time limit (default: the file's planner.time_limit, else 1.0)",
+    )
+    p.add_argument("--seed", type=int, help="random seed (default: the file's planner.seed)")
+    p.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="planner parameter, repeatable (e.g. --param swarm_size=50)",
+    )
+    p.add_argument("--json", metavar="OUT", help="write the result as JSON")
+    p.add_argument(
+        "--plot", metavar="OUT.png", help="draw the world, the paths and the PSO best-cost curve"
+    )
+    p.add_argument(
+        "--simplify",
+        action="store_true",
+        help="run OMPL's path simplifier on the result within the time limit",
+    )
+    p.add_argument(
+        "--trajectory",
+        metavar="OUT.csv",
+        help="write the wheel commands every robot.sample_time: "
+        "t,x,y,theta,v,omega,v_right,v_left,omega_right,omega_left",
+    )
+    p.add_argument(
+        "--plot-velocities",
+        metavar="OUT.png",
+        help="draw v and omega (paper Fig. 17) and the wheel speeds (Fig. 18)",
+    )
+    p.add_argument(
+        "--profile",
+        choices=("auto", "constant", "limits"),
+        default="auto",
+        help="velocity profile: the paper's constant robot.speed, or within the robot's "
+        "limits from rest to rest (auto: limits when any limit is given)",
+    )
+    p.add_argument(
+        "-v",
+        "--verbose",
+        action="count",
+        default=0,
+        help="show OMPL's Info (-v) and Debug (-vv) messages",
+    )
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..ompl_setup import set_ompl_log_level
+
+    set_ompl_log_level(args.verbose)
+    choice = choose_planner(args)
+    problem = choice.problem
+    check_positive_seconds(args.time, "--time", args.problem)
+    check_output(args.json, "--json")
+    check_output(args.plot, "--plot", image=True)
+    check_output(args.trajectory, "--trajectory")
+    check_output(args.plot_velocities, "--plot-velocities", image=True)
+    wants_motion = bool(args.trajectory or args.plot_velocities)
+    if wants_motion:
+        _check_drive_keys(args, problem)
+
+    from ..planners import solve
+
+    result = solve(
+        problem, choice.entry.name, args.time, args.seed, choice.cli_params, simplify=args.simplify
+    )
+    motion = _drive(problem, result, args.profile) if wants_motion and result.solved else None
+    _write_outputs(args, problem, result, motion)
+    length = f"{result.length:.3f}" if result.length is not None else "-"
+    print(
+        f"{problem.name}: {result.planner} {result.status} length={length} time={result.time:.3f}s",
+        file=sys.stderr,
+    )
+    return EXIT_OK if result.solved else EXIT_UNSOLVED
+
+
+def _check_drive_keys(args: argparse.Namespace, problem: Any) -> None:
+    """Wheel commands need the drive's parameters: refuse before planning when one is missing."""
+    from ..kinematics import REQUIRED_ROBOT_KEYS
+
+    robot = problem.robot
+    flag = "--trajectory" if args.trajectory else "--plot-velocities"
+    for key in REQUIRED_ROBOT_KEYS:
+        if getattr(robot, key) is None:
+            raise UsageError(f"{args.problem}: robot.{key}: required for {flag}")
+
+
+def _drive(problem: Any, result: Any, profile: str) -> Any:
+    from ..kinematics import drive
+    from ..model import World
+
+    return drive(result.path, World.from_problem(problem), problem.robot, profile)
+
+
+def _write_outputs(args: argparse.Namespace, problem: Any, result: Any, motion: Any) -> None:
+    if args.plot:
+        from ..plotting import plot_solution, save_figure
+
+        save_figure(plot_solution(problem, result, motion.curve if motion else None), args.plot)
+    if motion and args.plot_velocities:
+        from ..plotting import plot_velocities, save_figure
+
+        save_figure(plot_velocities(motion.trajectory, problem.units), args.plot_velocities)
+    if motion and args.trajectory:
+        motion.trajectory.write_csv(args.trajectory)
+    if args.json:
+        from ..outputs import write_json_atomic
+
+        data = result.to_dict()
+        if motion:
+            data["kinematics"] = motion.summary()
+        write_json_atomic(data, args.json)
