@@ -5,7 +5,7 @@ Usage::
     python benchmarks/tracking.py                      # seeds 1-8, writes docs/tracking.md
 
 Each seed plans the paper's workspace with RRTstarPSO in its own process (OMPL is seeded once
-per process), then :func:`rrtpso_ompl.kinematics.core.drive` replays the wheel speeds open loop and
+per process), then :func:`rrtpso_ompl.kinematics.drive` replays the wheel speeds open loop and
 follows the reference with Kanayama's controller. Figures are in the problem's unit (cm).
 """
 
@@ -24,12 +24,12 @@ PROBLEM = REPO / "problems" / "static" / "paper_static.yaml"
 
 def run_seed(seed: int, time_limit: float) -> tuple[int, float, float, float]:
     """``(seed, path length, open-loop max error, tracking max error)`` for one seeded plan."""
-    from rrtpso_ompl.ompl_setup.context import seed_ompl
+    from rrtpso_ompl.ompl_setup import seed_ompl
 
     seed_ompl(seed)
     import numpy as np
 
-    from rrtpso_ompl.kinematics.core import drive
+    from rrtpso_ompl.kinematics import drive
     from rrtpso_ompl.model.problem import load_problem
     from rrtpso_ompl.model.world import World
     from rrtpso_ompl.planners.solve import solve

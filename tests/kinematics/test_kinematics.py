@@ -14,7 +14,7 @@ import pytest
 import yaml
 from helpers import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
 
-from rrtpso_ompl.kinematics.core import (
+from rrtpso_ompl.kinematics import (
     CSV_HEADER,
     ReferenceCurve,
     integrate_wheels,

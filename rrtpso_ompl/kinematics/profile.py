@@ -1,0 +1,211 @@
+"""Time along the reference curve: the paper's constant speed or a profile within the robot's
+limits, sampled every ``Ts`` with the body velocities (eqs. 7-8) and wheel speeds (eqs. 9-12).
+
+Eq. 8 as printed has a typo; along a planar curve with time derivatives it is
+``omega = (x' y'' - y' x'') / (x'^2 + y'^2)`` (``docs/kinematics.md``).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..model.problem import Robot
+from .diffdrive import wheel_speeds
+from .reference import ReferenceCurve
+
+__all__ = ["CSV_HEADER", "Trajectory", "time_parametrize"]
+
+CSV_HEADER = (
+    "t", "x", "y", "theta", "v", "omega", "v_right", "v_left", "omega_right", "omega_left",
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """Poses and commands sampled every ``sample_time`` from the start to the goal.
+
+    All arrays have one entry per sample; lengths in problem units, angles in radians, times in
+    seconds, linear speeds in units/s, angular speeds in rad/s. The velocities of a row are the
+    commands to hold until the next row (the mean velocities over that step); the last row is the
+    goal, at rest.
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    theta: np.ndarray
+    v: np.ndarray
+    omega: np.ndarray
+    v_right: np.ndarray
+    v_left: np.ndarray
+    omega_right: np.ndarray
+    omega_left: np.ndarray
+    sample_time: float
+    track_width: float
+    wheel_radius: float
+    profile: str
+
+    def columns(self) -> np.ndarray:
+        """``(n, 10)`` array in the order of :data:`CSV_HEADER`."""
+        return np.column_stack([getattr(self, name) for name in CSV_HEADER])
+
+    def write_csv(self, path: str | Path) -> None:
+        """Write the CSV with exactly the header ``t,x,y,theta,v,omega,...``."""
+        from ..outputs import publish_atomic
+
+        path = Path(path)
+        tmp = path.with_name(f".{path.name}.tmp")
+        with tmp.open("w", newline="") as fh:
+            writer = csv.writer(fh)
+            writer.writerow(CSV_HEADER)
+            writer.writerows([[f"{v:.9g}" for v in row] for row in self.columns()])
+        publish_atomic(tmp, path)
+
+    @property
+    def path_length(self) -> float:
+        """Length of the sampled (x, y) polyline."""
+        return float(np.hypot(np.diff(self.x), np.diff(self.y)).sum())
+
+
+def time_parametrize(curve: ReferenceCurve, robot: Robot, profile: str = "auto") -> Trajectory:
+    """Sample the curve in time every ``robot.sample_time``.
+
+    Parameters
+    ----------
+    curve : ReferenceCurve
+        From :func:`reference_curve`.
+    robot : Robot
+        Needs ``speed``, ``sample_time``, ``track_width`` and ``wheel_radius``; optional limits
+        ``max_speed``, ``max_wheel_speed`` (both units/s) and ``max_accel`` (units/s^2).
+    profile : {"auto", "constant", "limits"}
+        ``"constant"``: the paper's constant speed ``robot.speed`` along the curve (capped where a
+        wheel limit would be exceeded). ``"limits"``: as fast as ``max_speed`` (else ``speed``)
+        allows, slower where a wheel would exceed ``max_wheel_speed`` in a turn, accelerating
+        from rest and braking to rest within ``max_accel``. ``"auto"`` picks ``"limits"`` when any
+        limit is given.
+
+    Returns
+    -------
+    Trajectory
+        Poses at every sample; v and omega (eqs. 7-8) and the wheel speeds (eqs. 9-12) of row k
+        are the mean velocities from row k to row k + 1, i.e. the commands to hold for one sample.
+        Turns in place (the polyline fallback) run at the largest angular speed the wheel limit
+        allows.
+    """
+    for key in ("speed", "sample_time", "track_width", "wheel_radius"):
+        if getattr(robot, key) is None:
+            raise ValueError(f"robot.{key} is required to compute velocities")
+    profile = _resolve_profile(robot, profile)
+    L, ts = robot.track_width, robot.sample_time
+    v, v_top = _speeds(curve, robot, profile)
+    # Time along the curve: exact for constant acceleration between samples.
+    ds = np.diff(curve.s)
+    dv = v[:-1] + v[1:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dt = np.where(dv > 0, 2.0 * ds / dv, 0.0)
+    # Turns in place: as fast as the wheels allow (w = 2 v_wheel / L), else at the speed the
+    # robot would drive.
+    w_turn = 2.0 * (robot.max_wheel_speed or v_top) / L
+    turn_dt = np.abs(curve.turns) / w_turn
+
+    # Event list: (time, s index, in-place turn progress).
+    t_nodes = np.concatenate([[0.0], np.cumsum(turn_dt[:-1] + dt)])
+    t_end = t_nodes[-1] + turn_dt[-1]
+    n = max(1, math.ceil(t_end / ts - 1e-9))
+    t = np.arange(n + 1) * ts
+    out = _states_at(curve, v, dt, turn_dt, t_nodes, w_turn, np.minimum(t, t_end))
+    # The commands of row k are held until row k + 1 (what a controller does with them), so they
+    # are the *mean* velocities over that step (eqs. 7-8 integrated over Ts): the heading then
+    # matches the reference exactly at every sample, and means of limited speeds stay within the
+    # limits. The last row is the goal, at rest.
+    v_out = np.append(np.diff(out["s"]) / ts, 0.0)
+    w_out = np.append(np.diff(out["theta"]) / ts, 0.0)
+    v_r, v_l, w_r, w_l = wheel_speeds(v_out, w_out, L, robot.wheel_radius)
+    return Trajectory(
+        t=t, x=out["x"], y=out["y"], theta=out["theta"], v=v_out, omega=w_out,
+        v_right=v_r, v_left=v_l, omega_right=w_r, omega_left=w_l, sample_time=ts,
+        track_width=L, wheel_radius=robot.wheel_radius, profile=profile,
+    )  # fmt: skip
+
+
+def _resolve_profile(robot: Robot, profile: str) -> str:
+    """``"auto"`` is ``"limits"`` when the robot declares any limit, else ``"constant"``."""
+    if profile == "auto":
+        has_limits = any(
+            getattr(robot, k) is not None for k in ("max_speed", "max_wheel_speed", "max_accel")
+        )
+        profile = "limits" if has_limits else "constant"
+    if profile not in ("constant", "limits"):
+        raise ValueError(f"unknown profile '{profile}' (constant or limits)")
+    return profile
+
+
+def _speeds(curve: ReferenceCurve, robot: Robot, profile: str) -> tuple[np.ndarray, float]:
+    """The speed at each curve sample (units/s) and the top speed of the profile."""
+    L = robot.track_width
+    v_top = robot.max_speed if profile == "limits" and robot.max_speed else robot.speed
+    if robot.max_speed is not None:
+        v_top = min(v_top, robot.max_speed)
+    v = np.full(len(curve.s), float(v_top))
+    if robot.max_wheel_speed is not None:
+        # |v| (1 + L |kappa| / 2) is the faster wheel's speed in a turn of curvature kappa.
+        # Between samples v and kappa are interpolated, so cap each sample by the larger
+        # curvature of the intervals on either side: then the limit holds in between too.
+        k = np.abs(curve.kappa)
+        k_int = np.maximum(k[:-1], k[1:]) if len(k) > 1 else k
+        k_worst = np.maximum(
+            np.concatenate([k_int[:1], k_int]), np.concatenate([k_int, k_int[-1:]])
+        )
+        v = np.minimum(v, robot.max_wheel_speed / (1.0 + 0.5 * L * k_worst))
+    stops = curve.turns != 0.0
+    if profile == "limits":
+        v[0] = v[-1] = 0.0
+        v[stops] = 0.0
+        if robot.max_accel is not None:
+            _limit_acceleration(v, np.diff(curve.s), robot.max_accel)
+    elif stops.any():
+        v[stops] = 0.0  # the polyline fallback must stop to turn, whatever the profile
+    return v, float(v_top)
+
+
+def _limit_acceleration(v: np.ndarray, ds: np.ndarray, a: float) -> None:
+    """Lower ``v`` in place so that no step accelerates or brakes faster than ``a``.
+
+    A forward pass, then a backward one; each step depends on the one before, so these are
+    sequential recurrences (O(n), once per trajectory).
+    """
+    for i in range(1, len(v)):  # forward: accelerate at most a
+        v[i] = min(v[i], math.sqrt(v[i - 1] ** 2 + 2 * a * ds[i - 1]))
+    for i in range(len(v) - 2, -1, -1):  # backward: brake at most a
+        v[i] = min(v[i], math.sqrt(v[i + 1] ** 2 + 2 * a * ds[i]))
+
+
+def _states_at(curve, v, dt, turn_dt, t_nodes, w_turn, tk) -> dict[str, np.ndarray]:
+    """Poses and arc lengths at the times ``tk`` (constant acceleration between curve samples;
+    a turn in place, if any, before leaving sample i)."""
+    last = len(curve.s) - 1
+    i = np.clip(np.searchsorted(t_nodes, tk, side="right") - 1, 0, last)
+    local = tk - t_nodes[i]
+    turning = (turn_dt[i] > 0) & (local < turn_dt[i])
+    th0 = curve.theta[i] + curve.turns[i]
+    # Driving from sample i to i + 1 after the turn: constant acceleration from v[i] to v[i+1].
+    j = np.minimum(i + 1, last)
+    drive_t = np.maximum(local - turn_dt[i], 0.0)
+    dt_i = np.append(dt, 0.0)[i]
+    moving = ~turning & (i < last) & (dt_i > 0)
+    acc = np.where(moving, (v[j] - v[i]) / np.where(dt_i > 0, dt_i, 1.0), 0.0)
+    ds = np.where(moving, v[i] * drive_t + 0.5 * acc * drive_t**2, 0.0)
+    seg = curve.s[j] - curve.s[i]
+    f = np.clip(np.where(seg > 0, ds / np.where(seg > 0, seg, 1.0), 0.0), 0.0, 1.0)
+    turned = curve.theta[i] + np.sign(curve.turns[i]) * w_turn * local
+    return {
+        "x": curve.x[i] + f * (curve.x[j] - curve.x[i]),
+        "y": curve.y[i] + f * (curve.y[j] - curve.y[i]),
+        "theta": np.where(turning, turned, th0 + f * (curve.theta[j] - th0)),
+        "s": curve.s[i] + f * seg,
+    }
