@@ -76,10 +76,10 @@ def run_scenario(seed: int, replan_time: float, initial_time: float) -> list[dic
     """All strategies on scenario ``seed``, in one fresh process; one row per strategy."""
     import dataclasses
 
-    from rrtpso_ompl.dynamic.simulation import DynamicOptions, simulate
+    from rrtpso_ompl.dynamic import DynamicOptions, simulate
     from rrtpso_ompl.model.problem import load_problem
-    from rrtpso_ompl.ompl_setup.context import set_ompl_log_level
-    from rrtpso_ompl.planners.solve import solve
+    from rrtpso_ompl.ompl_setup import set_ompl_log_level
+    from rrtpso_ompl.planners import solve
 
     set_ompl_log_level(0)
     base = load_problem(BASE)

@@ -1,1 +1,31 @@
-"""TODO"""
+"""Moving obstacles (paper section 4.2, eqs. 14-15): prediction, replanning, simulation.
+
+- :mod:`.motion`: timed stop-and-turn motions of the robot and the obstacles' tracks, with the
+  exact closest approach and first entry (piecewise linear in time: quadratics, not sampling);
+- :mod:`.prediction`: predicted collisions (:class:`Threat`) and swept capsules;
+- :mod:`.manager`: the :class:`ReplanningManager` (contour detours up and down, verification,
+  wait and step-aside fallbacks);
+- :mod:`.simulation`: :func:`simulate`, the control loop, and its :class:`SimulationResult`.
+"""
+
+from .manager import Detour, Replan, ReplanningManager
+from .motion import Motion, ObstacleTrack, closest_approach, first_entry
+from .prediction import Threat, capsule, predict_threats
+from .simulation import STRATEGIES, DynamicOptions, SimulationResult, simulate
+
+__all__ = [
+    "STRATEGIES",
+    "Detour",
+    "DynamicOptions",
+    "Motion",
+    "ObstacleTrack",
+    "Replan",
+    "ReplanningManager",
+    "SimulationResult",
+    "Threat",
+    "capsule",
+    "closest_approach",
+    "first_entry",
+    "predict_threats",
+    "simulate",
+]

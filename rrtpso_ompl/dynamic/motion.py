@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.geometry import dedupe, wrap_angle
+
 __all__ = ["Motion", "ObstacleTrack", "closest_approach", "first_entry"]
 
 
@@ -62,14 +64,14 @@ class Motion:
             Drive a segment backwards when that needs the smaller turn (a differential drive can:
             both wheels at ``-v``). Used by evasive manoeuvres; routes are driven forwards.
         """
-        p = _dedupe(np.asarray(path, dtype=float).reshape(-1, 2))
+        p = dedupe(np.asarray(path, dtype=float).reshape(-1, 2))
         heading = np.arctan2(np.diff(p[:, 1]), np.diff(p[:, 0]))
         th = float(theta0) if theta0 is not None else (float(heading[0]) if len(heading) else 0.0)
         ts, xs, ths = [float(t0)], [p[0]], [th]
         for i, h in enumerate(heading):
-            turn = _wrap(h - th)
+            turn = wrap_angle(h - th)
             if allow_reverse and abs(turn) > math.pi / 2:
-                turn = _wrap(h + math.pi - th)
+                turn = wrap_angle(h + math.pi - th)
             if turn != 0.0:
                 th = th + turn
                 dt = abs(turn) / turn_rate if turn_rate else 0.0
@@ -120,7 +122,7 @@ class Motion:
     def waypoints_after(self, t: float) -> np.ndarray:
         """The polyline still to drive after time ``t``: the position at ``t``, then the knots."""
         later = self.xy[self.t > t]
-        return _dedupe(np.vstack([self.position(t)[None], later]))
+        return dedupe(np.vstack([self.position(t)[None], later]))
 
     def until(self, t: float) -> Motion:
         """This motion cut at time ``t`` (a knot is added there)."""
@@ -292,16 +294,3 @@ def first_entry(motion: Motion, obstacle_at, t0: float, t1: float, radius: float
         j += 1
     t_exit = ts[j] + min(hi[j], 1.0) * dt[j]
     return float(t_enter), float(t_exit)
-
-
-def _wrap(a: float) -> float:
-    """Angle in (-pi, pi]."""
-    return math.atan2(math.sin(a), math.cos(a))
-
-
-def _dedupe(p: np.ndarray) -> np.ndarray:
-    """Drop consecutive repeated points."""
-    if len(p) < 2:
-        return p
-    keep = np.concatenate([[True], np.any(np.diff(p, axis=0) != 0.0, axis=1)])
-    return p[keep]

@@ -119,11 +119,22 @@ class World:
     # ------------------------------------------------------------------------------------------
     @classmethod
     def from_problem(cls, problem: Problem) -> World:
-        """Build the static world of a :class:`~rrtpso_ompl.problem.Problem` (moving obstacles
+        """Build the static world of a :class:`~rrtpso_ompl.model.Problem` (moving obstacles
         are not part of it)."""
-        circles = [(*o.center, o.radius) for o in problem.obstacles if isinstance(o, Circle)]
-        polygons = [np.asarray(o.points) for o in problem.obstacles if isinstance(o, Polygon)]
-        return cls(problem.bounds, circles, polygons, problem.robot.radius)
+        return cls.from_obstacles(problem.bounds, problem.obstacles, problem.robot.radius)
+
+    @classmethod
+    def from_obstacles(
+        cls,
+        bounds: tuple[tuple[float, float], tuple[float, float]],
+        obstacles: Sequence[Circle | Polygon],
+        robot_radius: float,
+    ) -> World:
+        """A world of the problem model's obstacles (:class:`~rrtpso_ompl.model.Circle`,
+        :class:`~rrtpso_ompl.model.Polygon`)."""
+        circles = [(*o.center, o.radius) for o in obstacles if isinstance(o, Circle)]
+        polygons = [np.asarray(o.points) for o in obstacles if isinstance(o, Polygon)]
+        return cls(bounds, circles, polygons, robot_radius)
 
     def with_robot_radius(self, robot_radius: float) -> World:
         """The same obstacles for another robot radius."""

@@ -11,11 +11,14 @@ import numpy as np
 import pytest
 from helpers import PROBLEMS, rrtpso_exe
 
-from rrtpso_ompl.dynamic.motion import Motion, ObstacleTrack, closest_approach, first_entry
-from rrtpso_ompl.dynamic.simulation import (
+from rrtpso_ompl.dynamic import (
     DynamicOptions,
+    Motion,
+    ObstacleTrack,
     ReplanningManager,
     capsule,
+    closest_approach,
+    first_entry,
     predict_threats,
     simulate,
 )
