@@ -184,7 +184,7 @@ class ObstacleTrack:
 
     @classmethod
     def from_obstacle(cls, obstacle) -> ObstacleTrack:
-        """Start the track of a :class:`~rrtpso_ompl.problem.MovingObstacle` at t = 0."""
+        """Start the track of a :class:`~rrtpso_ompl.model.MovingObstacle` at t = 0."""
         x, y = obstacle.start
         return cls(
             obstacle.radius, obstacle.speed, math.radians(obstacle.heading_deg), [(0.0, x, y)]

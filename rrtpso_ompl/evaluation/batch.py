@@ -300,8 +300,9 @@ def run_batch(
     on_start : callable, optional
         Called as ``on_start(n_to_run, n_skipped)`` before the first task starts.
     optimum : bool
-        Add ``optimum`` (the exact shortest length, :mod:`rrtpso_ompl.optimum`, computed once per
-        file in this process) and ``ratio`` (``length / optimum``, null unless solved) to every row.
+        Add ``optimum`` (the exact shortest length, :mod:`rrtpso_ompl.evaluation.optimum`,
+        computed once per file in this process) and ``ratio`` (``length / optimum``, null unless
+        solved) to every row.
 
     Returns
     -------

@@ -2,9 +2,10 @@
 
 ``generate("circles", seed=7, n=40)`` returns a problem *dictionary* in the file format of
 ``docs/problem-format.md``: plain ``dict``/``list``/``float``/``str`` values, in the format's key
-order, so it round-trips through :func:`~rrtpso_ompl.problem.problem_from_dict` and
-``yaml.safe_dump``. :func:`write_problem` writes such a dictionary as a problem file and
-:func:`generate_to_file` does both (the ``rrtpso generate`` command is a thin wrapper around it).
+order, so it round-trips through :func:`~rrtpso_ompl.model.problem_from_dict` and
+``yaml.safe_dump``. :func:`~rrtpso_ompl.model.problem_file.write_problem` writes such a
+dictionary as a problem file and :func:`generate_to_file` does both (the ``rrtpso generate``
+command is a thin wrapper around it).
 
 Three kinds:
 
@@ -17,45 +18,26 @@ Every random choice comes from one ``numpy.random.default_rng(seed)`` stream, an
 (no clock, no hash order) enters the output, so the same kind, seed and options give a
 byte-identical file.
 
-**Solvability is certified, not hoped for.** :func:`grid_path` searches a fine grid of the free
-configuration space: grid points are free by the world's exact point clearance
-(:meth:`~rrtpso_ompl.world.World.point_clearance`), neighbouring free points are joined when the
-segment between them is free, and a shortest route is found with Dijkstra's algorithm. A segment
-is accepted either by the exact test :meth:`~rrtpso_ompl.world.World.segments_free` or, when both
-ends are far enough from every obstacle, by the Lipschitz bound (clearance changes by at most the
-distance moved, so a segment of length ``L`` whose ends both have clearance ``c`` keeps at least
-``c - L/2`` everywhere). Every edge of the returned polyline is therefore a genuine collision-free
-motion: a path found is a proof that the problem is solvable, with no OMPL and no randomness.
-(The converse does not hold: a passage narrower than the grid spacing may be missed, in which case
-the generator draws again.)
+**Solvability is certified, not hoped for**: every problem comes with a collision-checked grid
+path (:mod:`rrtpso_ompl.evaluation.certify`); when the certificate fails the obstacles are drawn
+again from the same generator stream.
 """
 
 from __future__ import annotations
 
 import math
-import numbers
-import textwrap
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import dijkstra
 
-from ..model.problem import (
-    _MOVING_KEYS,
-    _OBSTACLE_KEYS,
-    _PLANNER_KEYS,
-    _ROBOT_KEYS,
-    _TOP_KEYS,
-    Problem,
-    ProblemError,
-    problem_from_dict,
-)
-from ..model.world import World
-from ..outputs import write_text_atomic
+from ..errors import GenerationError, ProblemError
+from ..model.geometry import path_length
+from ..model.problem import problem_from_dict
+from ..model.problem_file import default_decimals, round_floats, write_problem
+from ..validation import check_integer, check_number
+from .certify import GRID_POINTS, grid_path, is_solvable
 
 __all__ = [
     "KINDS",
@@ -96,28 +78,7 @@ _OPTION_ORDER = (
 )
 _MAZE_ALGORITHMS = ("dfs", "kruskal")
 
-#: Grid points per side of the solvability check unless ``resolution`` says otherwise: fine enough
-#: for corridors a few percent of the workspace wide, coarse enough to take a fraction of a second.
-_GRID_POINTS = 200
-#: Largest grid of the solvability check (memory: a few hundred bytes per point).
-_MAX_GRID_POINTS = 4_000_000
-#: Segments per vectorised distance call: bounds the (chunk x obstacle edges) arrays.
-_CHUNK = 4096
-#: Grid points per side of a tile of the solvability grid (see _Tiles).
-_TILE = 16
 
-
-class GenerationError(ValueError):
-    """No problem satisfying the options was found within the allowed attempts.
-
-    A ``ValueError``: the options ask for something too dense (too many or too large obstacles,
-    too large a robot) for the workspace.
-    """
-
-
-# ----------------------------------------------------------------------------------------------
-# Public API
-# ----------------------------------------------------------------------------------------------
 def generate(
     kind: str,
     seed: int,
@@ -142,7 +103,7 @@ def generate(
     at ``(0.05 size, 0.05 size)`` and the goal in the opposite corner, and obstacles keep at least
     ``max(2 robot_radius, 0.03 size)`` away from both. For ``"maze"`` they are the centres of the
     bottom-left and top-right cells. Obstacles are drawn, coordinates rounded to ``decimals``,
-    the result validated with :func:`~rrtpso_ompl.problem.problem_from_dict` and certified with
+    the result validated with :func:`~rrtpso_ompl.model.problem_from_dict` and certified with
     :func:`grid_path`; when the certificate fails the obstacles are drawn again from the same
     generator stream (so the outcome still depends on the seed only).
 
@@ -200,50 +161,40 @@ def generate(
         (a ``ValueError``) When obstacles cannot be placed or no certified-solvable problem is
         found within ``max_attempts``.
     """
-    given = {
-        "n": n,
-        "cells": cells,
-        "robot_radius": robot_radius,
-        "radius_range": radius_range,
-        "vertices": vertices,
-        "gap": gap,
-        "wall": wall,
-        "algorithm": algorithm,
-    }
-    kind = _check_kind(kind)
-    for key, value in given.items():
-        if value is not None and key not in _KIND_OPTIONS[kind] and key not in _COMMON_OPTIONS:
-            applies = [k for k, opts in _KIND_OPTIONS.items() if key in opts]
-            raise ValueError(
-                f"option '{key}' does not apply to kind '{kind}' "
-                f"(it applies to: {', '.join(applies)}); options for {kind}: "
-                f"{', '.join(_KIND_OPTIONS[kind] + _COMMON_OPTIONS)}"
-            )
-    seed = _check_int("seed", seed, low=0)
-    size = _check_number("size", size, low=0.0, strict=True)
-    max_attempts = _check_int("max_attempts", max_attempts, low=1)
-    decimals = (
-        default_decimals(size) if decimals is None else _check_int("decimals", decimals, 0, 12)
-    )
+    given = {"n": n, "cells": cells, "robot_radius": robot_radius, "radius_range": radius_range,
+             "vertices": vertices, "gap": gap, "wall": wall, "algorithm": algorithm}  # fmt: skip
+    kind = _check_kind(kind, given)
+    seed = _option("seed", check_integer, seed, low=0)
+    size = _option("size", check_number, size, low=0.0, strict_low=True)
+    max_attempts = _option("max_attempts", check_integer, max_attempts, low=1)
+    if decimals is None:
+        decimals = default_decimals(size)
+    decimals = _option("decimals", check_integer, decimals, low=0, high=12)
     if name is not None and (not isinstance(name, str) or not name.strip()):
-        raise ValueError(f"name must be a non-empty string, got {name!r}")
-    name = name or f"{kind}_{seed}"
+        raise GenerationError(f"name must be a non-empty string, got {name!r}")
     if resolution is not None:
-        resolution = _check_number("resolution", resolution, low=0.0, strict=True)
-
+        resolution = _option("resolution", check_number, resolution, low=0.0, strict_low=True)
     if kind == "maze":
         spec = _MazeSpec.build(size, cells, robot_radius, wall, algorithm, resolution)
     else:
         spec = _FieldSpec.build(kind, size, n, robot_radius, radius_range, vertices, gap)
     resolution = resolution or spec.resolution
     if resolution > size / 2:
-        raise ValueError(f"resolution must be at most size / 2 = {size / 2:g}, got {resolution:g}")
+        raise GenerationError(
+            f"resolution must be at most size / 2 = {size / 2:g}, got {resolution:g}"
+        )
+    return _draw_until_certified(
+        spec, kind, seed, name or f"{kind}_{seed}", decimals, resolution, max_attempts
+    )
 
+
+def _draw_until_certified(spec, kind, seed, name, decimals, resolution, max_attempts):
+    """Draw obstacles from one seeded stream until the rounded problem is valid and certified."""
     rng = np.random.default_rng(seed)
     last_failure = ""
     for attempt in range(1, max_attempts + 1):
         obstacles = spec.draw(rng)
-        data = _round_floats(spec.document(name, obstacles), decimals)
+        data = round_floats(spec.document(name, obstacles), decimals)
         try:
             problem = problem_from_dict(data, source=f"<generate {kind}>")
         except ProblemError as exc:
@@ -254,9 +205,9 @@ def generate(
         if path is None:
             last_failure = f"no collision-free grid path at resolution {resolution:g}"
             continue
-        length = _round_up(float(np.hypot(*np.diff(path, axis=0).T).sum()), 4)
+        length = _round_up(path_length(path), 4)
         data["description"] = (
-            f"{spec.describe()} Generated by rrtpso_ompl.generate (kind {kind}, seed {seed}, "
+            f"{spec.describe()} Generated by rrtpso generate (kind {kind}, seed {seed}, "
             f"attempt {attempt}). A collision-free path of length {length:g} exists "
             f"(certified on a grid of spacing {resolution:.3g}), so the "
             "shortest path is at most that long."
@@ -327,215 +278,9 @@ def generate_to_file(kind: str, seed: int, out: str | Path, **options: Any) -> P
         f"Generated by: {command} --out FILE\n"
         "Every obstacle below was drawn from numpy.random.default_rng(seed); the same command\n"
         "writes the same bytes. Solvability is certified by a collision-free grid path\n"
-        "(rrtpso_ompl.generate.grid_path), see the description."
+        "(rrtpso generate's certificate), see the description."
     )
     return write_problem(data, out, header=header, decimals=options.get("decimals"))
-
-
-def write_problem(
-    data: Mapping[str, Any],
-    path: str | Path,
-    *,
-    header: str | None = None,
-    decimals: int | None = None,
-) -> Path:
-    """Write a problem dictionary as a problem file.
-
-    Keys are written in the format's documented order (top level, ``robot``, ``planner``, each
-    obstacle, each moving obstacle), points and obstacles on one line each in YAML flow style,
-    like the hand-written files in ``problems/``. Every float is rounded to ``decimals`` places
-    first, and the rounded problem is validated again: rounding may move an obstacle onto the
-    start or make a thin polygon degenerate, and such a file is refused rather than written.
-
-    Parameters
-    ----------
-    data : mapping
-        A problem in the file format (as from :func:`generate` or ``yaml.safe_load``).
-    path : str or Path
-        Where to write; the folder is created if needed, the file replaced atomically.
-    header : str, optional
-        Comment lines written first (each line gets a ``# `` prefix).
-    decimals : int, optional
-        Decimal places for floats, 0..12; default :func:`default_decimals` of the bounds.
-
-    Returns
-    -------
-    Path
-        ``path``.
-
-    Raises
-    ------
-    ProblemError
-        When ``data`` is not a valid problem.
-    ValueError
-        When it is no longer valid after rounding (the message says which key and suggests more
-        decimals), or ``decimals`` is out of range.
-    """
-    path = Path(path)
-    problem = problem_from_dict(data, source=str(path))
-    if decimals is None:
-        (xmin, ymin), (xmax, ymax) = problem.bounds
-        decimals = default_decimals(max(xmax - xmin, ymax - ymin))
-    else:
-        decimals = _check_int("decimals", decimals, 0, 12)
-    rounded = _round_floats(data, decimals)
-    try:
-        problem_from_dict(rounded, source=str(path))
-    except ProblemError as exc:
-        raise ValueError(
-            f"{path}: after rounding to {decimals} decimals the problem is no longer valid: "
-            f"{exc.key + ': ' if exc.key else ''}{exc.message}; write more decimals"
-        ) from None
-
-    text = _format_problem(rounded, header)
-    # The text must read back as exactly the validated dictionary: a formatting slip (a string
-    # that YAML would read as a number, say) must not reach the file.
-    if yaml.safe_load(text) != _plain(rounded):
-        raise AssertionError("internal error: the formatted YAML does not read back as written")
-
-    return write_text_atomic(text, path)
-
-
-def default_decimals(size: float) -> int:
-    """Decimal places that keep coordinates to about ``1e-5`` of a workspace of side ``size``.
-
-    3 for a side of 100 to 999, 2 for 1000 to 9999, 4 for 10 to 99, and so on (between 0 and 12).
-    """
-    if not (size > 0 and math.isfinite(size)):
-        raise ValueError(f"size must be a positive finite number, got {size!r}")
-    return int(min(12, max(0, 5 - math.floor(math.log10(size)))))
-
-
-def grid_path(
-    problem: Problem, resolution: float | None = None, *, shortcut: bool = True
-) -> np.ndarray | None:
-    """A certified collision-free path from start to goal through a grid, or None.
-
-    The grid covers the bounds with spacing at most ``resolution`` (edges included). A grid point
-    is a node when the robot disc there is free (exact point clearance); nodes are joined to their
-    8 neighbours when the segment between them is free (exact segment test, or the Lipschitz bound
-    when both ends are far from every obstacle); start and goal are joined to the grid points of
-    the cells around them by exact segment tests. Dijkstra's algorithm then finds the shortest
-    grid route, which ``shortcut`` straightens by skipping waypoints while the straight segment
-    stays free (exact test again).
-
-    Parameters
-    ----------
-    problem : Problem
-        A validated problem (moving obstacles are ignored, as by ``rrtpso solve``).
-    resolution : float, optional
-        Largest grid spacing; default 1/200 of the larger side of the bounds.
-    shortcut : bool
-        Straighten the grid route (default True): a shorter, still certified path.
-
-    Returns
-    -------
-    (m, 2) ndarray or None
-        The polyline, from ``start`` to ``goal`` (or to a grid point within ``goal_tolerance`` of
-        it); every waypoint in bounds and every segment free, so
-        ``World.from_problem(problem).path_valid(path)`` holds. None when the grid has no route,
-        which does *not* prove the problem unsolvable (a passage narrower than the spacing may be
-        missed).
-    """
-    world = World.from_problem(problem)
-    (xmin, ymin), (xmax, ymax) = world.bounds
-    if resolution is None:
-        resolution = max(xmax - xmin, ymax - ymin) / _GRID_POINTS
-    resolution = _check_number("resolution", resolution, low=0.0, strict=True)
-    nx = math.ceil((xmax - xmin) / resolution) + 1
-    ny = math.ceil((ymax - ymin) / resolution) + 1
-    if nx * ny > _MAX_GRID_POINTS:
-        raise ValueError(
-            f"resolution {resolution:g} is too fine for these bounds: {nx} x {ny} grid points "
-            f"(at most {_MAX_GRID_POINTS:,})"
-        )
-    xs = np.linspace(xmin, xmax, nx)
-    ys = np.linspace(ymin, ymax, ny)
-    hx, hy = xs[1] - xs[0], ys[1] - ys[0]
-    gx, gy = np.meshgrid(xs, ys)  # node (j, i) is point (xs[i], ys[j]), index j * nx + i
-    points = np.column_stack([gx.ravel(), gy.ravel()])
-    # Clearance matters only up to what the edge test below can use; beyond `cap` it is clipped.
-    step = math.hypot(hx, hy)  # the longest grid edge
-    cap = world.threshold + 0.5 * step + 2.0 * world.tol
-    tiles = _Tiles(world, xs, ys, reach=cap + step)
-    clearance = tiles.clearance(points, cap)
-    free = clearance >= world.threshold
-
-    # Grid edges to the right, up, up-right and up-left neighbours: each undirected edge once.
-    index = np.arange(nx * ny).reshape(ny, nx)
-    a_parts, b_parts = [], []
-    for dj, di in ((0, 1), (1, 0), (1, 1), (1, -1)):
-        i0, i1 = max(0, -di), nx - max(0, di)
-        a_parts.append(index[: ny - dj, i0:i1].ravel())
-        b_parts.append(index[dj:, i0 + di : i1 + di].ravel())
-    a = np.concatenate(a_parts)
-    b = np.concatenate(b_parts)
-    keep = free[a] & free[b]
-    a, b = a[keep], b[keep]
-    length = np.hypot(*(points[b] - points[a]).T)
-    # Lipschitz bound: clearance drops by at most the distance moved, and every point of a
-    # segment is within L/2 of an end. The margin `tol` keeps the bound safe from round-off.
-    sure = np.minimum(clearance[a], clearance[b]) - 0.5 * length >= world.threshold + world.tol
-    unsure = np.flatnonzero(~sure)
-    ok = sure.copy()
-    if len(unsure):
-        ok[unsure] = tiles.segments_free(points, a[unsure], b[unsure])
-    a, b, length = a[ok], b[ok], length[ok]
-
-    # Start and goal join the grid points of the cells around them (within 1.5 cells).
-    n_grid = nx * ny
-    s_idx, g_idx = n_grid, n_grid + 1
-    extra_a, extra_b, extra_len = [], [], []
-    ends = np.array([problem.start, problem.goal], dtype=float)
-    reach = 1.5 * max(hx, hy)
-    for node, p in ((s_idx, ends[0]), (g_idx, ends[1])):
-        i_lo = max(0, math.floor((p[0] - xmin - reach) / hx))
-        i_hi = min(nx - 1, math.ceil((p[0] - xmin + reach) / hx))
-        j_lo = max(0, math.floor((p[1] - ymin - reach) / hy))
-        j_hi = min(ny - 1, math.ceil((p[1] - ymin + reach) / hy))
-        near = index[j_lo : j_hi + 1, i_lo : i_hi + 1].ravel()
-        near = near[free[near]]
-        near = near[np.hypot(*(points[near] - p).T) <= reach]
-        if len(near):
-            near = near[world.segments_free(np.broadcast_to(p, (len(near), 2)), points[near])]
-        extra_a.append(np.full(len(near), node))
-        extra_b.append(near)
-        extra_len.append(np.hypot(*(points[near] - p).T))
-    # The straight segment itself, when free (then no grid is needed at all).
-    if world.segments_free(ends[:1], ends[1:])[0]:
-        extra_a.append(np.array([s_idx]))
-        extra_b.append(np.array([g_idx]))
-        extra_len.append(np.array([float(np.hypot(*(ends[1] - ends[0])))]))
-
-    all_points = np.vstack([points, ends])
-    rows = np.concatenate([a, *extra_a])
-    cols = np.concatenate([b, *extra_b])
-    # csgraph drops explicit zero weights (no edge): a start on a grid point needs a tiny weight.
-    weight = np.maximum(np.concatenate([length, *extra_len]), 1e-12 * max(hx, hy))
-    graph = coo_matrix((weight, (rows, cols)), shape=(n_grid + 2, n_grid + 2)).tocsr()
-    dist, pred = dijkstra(graph, directed=False, indices=s_idx, return_predecessors=True)
-
-    # The goal, or with a goal tolerance the nearest-by-route grid point within it.
-    targets = [g_idx]
-    if problem.goal_tolerance > 0:
-        within = np.flatnonzero(
-            free & (np.hypot(*(points - ends[1]).T) <= problem.goal_tolerance)
-        ).tolist()
-        targets += within
-    best = min(targets, key=lambda t: dist[t])
-    if not math.isfinite(dist[best]):
-        return None
-    route = [best]
-    while route[-1] != s_idx:
-        route.append(int(pred[route[-1]]))
-    path = all_points[route[::-1]]
-    return _shortcut(world, path) if shortcut else path
-
-
-def is_solvable(problem: Problem, resolution: float | None = None) -> bool:
-    """Whether :func:`grid_path` certifies the problem solvable (see there; False is not a proof
-    of unsolvability)."""
-    return grid_path(problem, resolution, shortcut=False) is not None
 
 
 # ----------------------------------------------------------------------------------------------
@@ -557,37 +302,37 @@ class _FieldSpec:
         self.goal = np.array([size - inset, size - inset])
         # Obstacles keep off start and goal: the robot must be able to turn away from them.
         self.keep_out = max(2.0 * robot_radius, 0.03 * size)
-        self.resolution = size / _GRID_POINTS
+        self.resolution = size / GRID_POINTS
 
     @classmethod
     def build(cls, kind, size, n, robot_radius, radius_range, vertices, gap) -> _FieldSpec:
         default_n = 30 if kind == "circles" else 20
-        n = _check_int("n", default_n if n is None else n, low=1)
+        n = _option("n", check_integer, default_n if n is None else n, low=1)
         default_range = (0.02, 0.06) if kind == "circles" else (0.03, 0.08)
         if radius_range is None:
             radius_range = (default_range[0] * size, default_range[1] * size)
         lo, hi = _check_range("radius_range", radius_range, number=True)
         if lo <= 0:
-            raise ValueError(f"radius_range must be positive, got ({lo:g}, {hi:g})")
+            raise GenerationError(f"radius_range must be positive, got ({lo:g}, {hi:g})")
         if hi >= size / 2:
-            raise ValueError(
+            raise GenerationError(
                 f"radius_range: the largest radius {hi:g} must be less than size / 2 = {size / 2:g}"
             )
         if kind == "polygons":
             v = _check_range("vertices", (3, 8) if vertices is None else vertices, number=False)
             if v[0] < 3:
-                raise ValueError(f"vertices: a polygon needs at least 3, got ({v[0]}, {v[1]})")
+                raise GenerationError(f"vertices: a polygon needs at least 3, got ({v[0]}, {v[1]})")
         else:
             v = None
         if robot_radius is None:
             robot_radius = 0.01 * size
-        robot_radius = _check_number("robot_radius", robot_radius, low=0.0)
+        robot_radius = _option("robot_radius", check_number, robot_radius, low=0.0)
         if robot_radius >= 0.05 * size:
-            raise ValueError(
+            raise GenerationError(
                 f"robot_radius {robot_radius:g} must be less than the start's inset from the "
                 f"corner, 0.05 size = {0.05 * size:g}"
             )
-        gap = _check_number("gap", 0.0 if gap is None else gap, low=0.0)
+        gap = _option("gap", check_number, 0.0 if gap is None else gap, low=0.0)
         return cls(kind, size, n, robot_radius, (lo, hi), v, gap)
 
     def draw(self, rng: np.random.Generator) -> list[dict[str, Any]]:
@@ -681,28 +426,32 @@ class _MazeSpec:
 
     @classmethod
     def build(cls, size, cells, robot_radius, wall, algorithm, resolution) -> _MazeSpec:
-        cells = _check_int("cells", 8 if cells is None else cells, low=2)
+        cells = _option("cells", check_integer, 8 if cells is None else cells, low=2)
         cell = size / cells
-        wall = _check_number("wall", 0.1 * cell if wall is None else wall, low=0.0, strict=True)
+        wall = _option(
+            "wall", check_number, 0.1 * cell if wall is None else wall, low=0.0, strict_low=True
+        )
         if wall >= cell:
-            raise ValueError(f"wall thickness {wall:g} must be less than the cell size {cell:g}")
+            raise GenerationError(
+                f"wall thickness {wall:g} must be less than the cell size {cell:g}"
+            )
         if robot_radius is None:
             robot_radius = 0.2 * cell
-        robot_radius = _check_number("robot_radius", robot_radius, low=0.0)
+        robot_radius = _option("robot_radius", check_number, robot_radius, low=0.0)
         corridor = cell - wall - 2.0 * robot_radius  # free width for the robot's centre
         if corridor <= 0:
-            raise ValueError(
+            raise GenerationError(
                 f"the robot (diameter {2 * robot_radius:g}) does not fit the maze corridors "
                 f"(cell {cell:g} minus wall {wall:g} = {cell - wall:g}); use a smaller "
                 "robot_radius or wall, or fewer cells"
             )
         algorithm = "dfs" if algorithm is None else algorithm
         if algorithm not in _MAZE_ALGORITHMS:
-            raise ValueError(
+            raise GenerationError(
                 f"algorithm must be one of {', '.join(_MAZE_ALGORITHMS)}, got {algorithm!r}"
             )
         # At least four grid points across every corridor, so the certificate cannot miss one.
-        resolution = resolution or min(size / _GRID_POINTS, corridor / 4.0)
+        resolution = resolution or min(size / GRID_POINTS, corridor / 4.0)
         return cls(size, cells, robot_radius, wall, algorithm, resolution)
 
     def draw(self, rng: np.random.Generator) -> list[dict[str, Any]]:
@@ -839,95 +588,6 @@ def _document(
     }
 
 
-# ----------------------------------------------------------------------------------------------
-# Writing
-# ----------------------------------------------------------------------------------------------
-def _format_problem(data: Mapping[str, Any], header: str | None) -> str:
-    lines = [f"# {line}".rstrip() for line in header.splitlines()] if header else []
-    nested = {"robot": _ROBOT_KEYS, "planner": _PLANNER_KEYS}
-    for key in _ordered(data, _TOP_KEYS):
-        value = data[key]
-        if value is None:
-            continue
-        if key in nested and isinstance(value, Mapping):
-            lines.append(f"{key}:")
-            lines += [f"  {k}: {_flow(value[k])}" for k in _ordered(value, nested[key])]
-        elif key in ("obstacles", "moving_obstacles") and isinstance(value, list | tuple):
-            if not value:
-                lines.append(f"{key}: []")
-                continue
-            lines.append(f"{key}:")
-            for item in value:
-                order = (
-                    _OBSTACLE_KEYS.get(item.get("type"), ()) if key == "obstacles" else _MOVING_KEYS
-                )
-                lines.append(f"  - {_flow({k: item[k] for k in _ordered(item, order)})}")
-        elif key == "description" and isinstance(value, str):
-            lines.append(_folded(key, value))
-        else:
-            lines.append(f"{key}: {_flow(value)}")
-    return "\n".join(lines) + "\n"
-
-
-def _folded(key: str, text: str) -> str:
-    """``key: >-`` and the text folded at 100 columns, like the hand-written files.
-
-    Folding is exact only for plain one-line prose (no line breaks, no runs of spaces, no
-    leading or trailing space); anything else is left to PyYAML's own quoting.
-    """
-    if text and text == " ".join(text.split()) and text.isprintable():
-        body = textwrap.wrap(text, width=98, break_long_words=False, break_on_hyphens=False)
-        block = f"{key}: >-\n" + "\n".join(f"  {line}" for line in body)
-        if yaml.safe_load(block) == {key: text}:
-            return block
-    return yaml.safe_dump({key: text}, width=80, sort_keys=False, allow_unicode=True).rstrip("\n")
-
-
-def _ordered(mapping: Mapping[str, Any], order: Sequence[str]) -> list[str]:
-    """Keys of ``mapping`` in the documented ``order`` (any others, which validation has already
-    refused at the top levels, after them in their own order)."""
-    return [k for k in order if k in mapping] + [k for k in mapping if k not in order]
-
-
-def _flow(value: Any) -> str:
-    """One value as single-line YAML flow text (``[1.5, 2.0]``, ``{type: circle, ...}``)."""
-    text = yaml.safe_dump(
-        _plain(value),
-        default_flow_style=True,
-        width=math.inf,
-        sort_keys=False,
-        allow_unicode=True,
-    ).strip()
-    # A lone scalar is dumped as a document with an explicit end marker.
-    if text.endswith("\n..."):
-        text = text[: -len("\n...")].rstrip()
-    return text
-
-
-def _plain(value: Any) -> Any:
-    """Mappings as dicts, sequences as lists, numpy scalars as Python numbers (for PyYAML)."""
-    if isinstance(value, Mapping):
-        return {k: _plain(v) for k, v in value.items()}
-    if isinstance(value, list | tuple | np.ndarray):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
-
-
-def _round_floats(value: Any, decimals: int) -> Any:
-    """A deep copy with every float rounded (ints, bools and strings untouched, -0.0 made 0.0)."""
-    if isinstance(value, Mapping):
-        return {k: _round_floats(v, decimals) for k, v in value.items()}
-    if isinstance(value, list | tuple | np.ndarray):
-        return [_round_floats(v, decimals) for v in value]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and math.isfinite(value):
-        return round(value, decimals) + 0.0
-    return value
-
-
 def _round_up(x: float, digits: int) -> float:
     """``x`` rounded *up* to ``digits`` significant digits (an upper bound stays an upper bound)."""
     if x <= 0 or not math.isfinite(x):
@@ -944,143 +604,34 @@ def _cli_value(value: Any) -> str:
     return str(value)
 
 
-# ----------------------------------------------------------------------------------------------
-# Helpers
-# ----------------------------------------------------------------------------------------------
-def _shortcut(world: World, path: np.ndarray) -> np.ndarray:
-    """Greedy straightening: from each kept waypoint jump to the farthest one in free sight.
-
-    The look-ahead window starts at 64 waypoints and doubles while its far end is in sight (a
-    long winding route need not be tested against every later waypoint). Every new segment passes
-    the exact test, so the result is as certified as the input.
-    """
-    out = [0]
-    i = 0
-    last = len(path) - 1
-    while i < last:
-        window = 64
-        while True:
-            j = np.arange(i + 1, min(last, i + window) + 1)
-            sight = _chunked2(world.segments_free, np.broadcast_to(path[i], (len(j), 2)), path[j])
-            # The next waypoint is always in sight (a certified edge), so there is a last True.
-            best = int(j[np.flatnonzero(sight)[-1]])
-            if best < i + window or best == last:
-                break
-            window *= 2
-        i = best
-        out.append(i)
-    return path[out]
-
-
-class _Tiles:
-    """The grid cut into square tiles, each with a local world of the obstacles near it.
-
-    A tile's local world holds the obstacles whose bounding box comes within ``reach`` of the
-    tile's box. Every point of the tile, and every point of a segment of length at most
-    ``reach - cap`` starting in the tile, is farther than ``cap`` from all other obstacles (it is
-    at least as far from an obstacle as the two boxes are apart). So clearances clipped at ``cap``,
-    and free tests of such segments against a threshold below ``cap``, are the same in the local
-    world as in the whole one: exact, and a maze of 100 walls costs a few walls per point.
-    """
-
-    def __init__(self, world: World, xs: np.ndarray, ys: np.ndarray, reach: float) -> None:
-        self.nx, self.ntx = len(xs), -(-len(xs) // _TILE)
-        poly_box = np.array(
-            [[p[:, 0].min(), p[:, 1].min(), p[:, 0].max(), p[:, 1].max()] for p in world.polygons]
-        ).reshape(-1, 4)
-        circles = world.circles
-        self.worlds: list[World | None] = []
-        for j0 in range(0, len(ys), _TILE):
-            for i0 in range(0, len(xs), _TILE):
-                lo = np.array([xs[i0], ys[j0]])
-                hi = np.array([xs[min(i0 + _TILE, len(xs)) - 1], ys[min(j0 + _TILE, len(ys)) - 1]])
-                # Box-to-box (and box-to-centre) gaps: lower bounds on every point's distance.
-                gap = np.maximum(0.0, np.maximum(poly_box[:, :2] - hi, lo - poly_box[:, 2:]))
-                near_poly = np.flatnonzero(np.hypot(gap[:, 0], gap[:, 1]) < reach)
-                gap = np.maximum(0.0, np.maximum(circles[:, :2] - hi, lo - circles[:, :2]))
-                near_circ = np.flatnonzero(np.hypot(gap[:, 0], gap[:, 1]) - circles[:, 2] < reach)
-                if not len(near_poly) and not len(near_circ):
-                    self.worlds.append(None)
-                    continue
-                self.worlds.append(
-                    World(
-                        world.bounds,
-                        circles[near_circ],
-                        [world.polygons[k] for k in near_poly],
-                        world.robot_radius,
-                    )
-                )
-
-    def tile_of(self, nodes: np.ndarray) -> np.ndarray:
-        """The tile of each grid node (index ``j * nx + i``)."""
-        j, i = np.divmod(nodes, self.nx)
-        return (j // _TILE) * self.ntx + i // _TILE
-
-    def clearance(self, points: np.ndarray, cap: float) -> np.ndarray:
-        """``min(world.point_clearance(p), cap)`` for every grid point (in node order)."""
-        out = np.full(len(points), cap)
-        for t, sel in self._groups(np.arange(len(points))):
-            out[sel] = np.minimum(self.worlds[t].point_clearance(points[sel]), cap)
-        return out
-
-    def segments_free(self, points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """``world.segments_free`` for the grid edges ``a[k] -> b[k]`` (node indices)."""
-        out = np.ones(len(a), dtype=bool)
-        for t, sel in self._groups(a):
-            out[sel] = _chunked2(self.worlds[t].segments_free, points[a[sel]], points[b[sel]])
-        return out
-
-    def _groups(self, nodes: np.ndarray):
-        """(tile, positions in ``nodes``) for every tile that has obstacles near it."""
-        tiles = self.tile_of(nodes)
-        order = np.argsort(tiles, kind="stable")
-        bounds = np.searchsorted(tiles[order], np.arange(len(self.worlds) + 1))
-        for t, local in enumerate(self.worlds):
-            if local is not None and bounds[t] < bounds[t + 1]:
-                yield t, order[bounds[t] : bounds[t + 1]]
-
-
-def _chunked2(fn, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    if len(a) <= _CHUNK:
-        return fn(a, b)
-    return np.concatenate(
-        [fn(a[i : i + _CHUNK], b[i : i + _CHUNK]) for i in range(0, len(a), _CHUNK)]
-    )
-
-
-def _check_kind(kind: Any) -> str:
+def _check_kind(kind: Any, given: dict[str, Any]) -> str:
+    """The kind, with every option given checked to apply to it."""
     if kind not in KINDS:
-        raise ValueError(f"unknown kind {kind!r}; known kinds: {', '.join(KINDS)}")
+        raise GenerationError(f"unknown kind {kind!r}; known kinds: {', '.join(KINDS)}")
+    for key, value in given.items():
+        if value is not None and key not in _KIND_OPTIONS[kind] and key not in _COMMON_OPTIONS:
+            applies = [k for k, opts in _KIND_OPTIONS.items() if key in opts]
+            raise GenerationError(
+                f"option '{key}' does not apply to kind '{kind}' "
+                f"(it applies to: {', '.join(applies)}); options for {kind}: "
+                f"{', '.join(_KIND_OPTIONS[kind] + _COMMON_OPTIONS)}"
+            )
     return kind
 
 
-def _check_int(name: str, value: Any, low: int | None = None, high: int | None = None) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise ValueError(f"{name} must be an integer, got {type(value).__name__} {value!r}")
-    value = int(value)
-    if low is not None and value < low:
-        raise ValueError(f"{name} must be >= {low}, got {value}")
-    if high is not None and value > high:
-        raise ValueError(f"{name} must be <= {high}, got {value}")
-    return value
-
-
-def _check_number(name: str, value: Any, low: float | None = None, strict: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{name} must be a number, got {type(value).__name__} {value!r}")
-    x = float(value)
-    if not math.isfinite(x):
-        raise ValueError(f"{name} must be finite, got {x}")
-    if low is not None and (x <= low if strict else x < low):
-        raise ValueError(f"{name} must be {'>' if strict else '>='} {low:g}, got {x:g}")
-    return x
+def _option(name: str, check: Callable[..., Any], value: Any, **limits: Any) -> Any:
+    """``check(value, **limits)`` with the option's name in a :class:`GenerationError`."""
+    try:
+        return check(value, **limits)
+    except ValueError as exc:
+        raise GenerationError(f"{name} {exc}") from None
 
 
 def _check_range(name: str, value: Any, number: bool) -> tuple[Any, Any]:
     if isinstance(value, str) or not isinstance(value, Sequence) or len(value) != 2:
-        raise ValueError(f"{name} must be a pair (min, max), got {value!r}")
-    check = _check_number if number else _check_int
-    lo, hi = check(f"{name}[0]", value[0]), check(f"{name}[1]", value[1])
+        raise GenerationError(f"{name} must be a pair (min, max), got {value!r}")
+    check = check_number if number else check_integer
+    lo, hi = _option(f"{name}[0]", check, value[0]), _option(f"{name}[1]", check, value[1])
     if lo > hi:
-        raise ValueError(f"{name} needs min <= max, got ({lo}, {hi})")
+        raise GenerationError(f"{name} needs min <= max, got ({lo}, {hi})")
     return lo, hi

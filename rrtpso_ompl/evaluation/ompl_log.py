@@ -103,7 +103,7 @@ STATUS_ENUM: tuple[str, ...] = (
 #: Property types the log format (and Planner Arena) understands.
 PROPERTY_TYPES: tuple[str, ...] = ("BOOLEAN", "INTEGER", "REAL", "ENUM")
 
-#: This project's short status labels (:class:`~rrtpso_ompl.results.SolveResult.status`).
+#: This project's short status labels (:class:`~rrtpso_ompl.planners.SolveResult.status`).
 _SHORT_STATUS = {"exact": 6, "approximate": 5, "none": 4}
 
 #: Planner-name prefixes Planner Arena strips.

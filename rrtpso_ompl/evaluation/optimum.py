@@ -11,7 +11,7 @@ circles and arcs along them (the classic tangent or "reduced visibility" graph; 
    convex polygon vertex (``R``).
 2. **Tangent segments**: for every pair of circles the up to four common tangents (two outer, two
    inner), kept when both tangent points are free and in bounds and the whole segment is free
-   (exact segment distance, :meth:`rrtpso_ompl.world.World.segments_free`).
+   (exact segment distance, :meth:`rrtpso_ompl.model.World.segments_free`).
 3. **Arcs**: on each circle, the tangent points sorted by angle, joined to their neighbours by
    arcs, kept when the arc is free: its exact distance to every circle and polygon edge, its
    extent against the bounds.

@@ -575,7 +575,7 @@ def clearance_threshold(robot_radius: float, tol: float) -> float:
     robot (radius 0) that would let a segment *enter* an obstacle (its distance is then 0, like a
     touch), so the threshold never drops below ``+tol``: still within the round-off tolerance of
     the radius, and every penetration is caught. The loader (free start and goal) and
-    :class:`~rrtpso_ompl.world.World` share this rule, so a start accepted here is never refused
+    :class:`~rrtpso_ompl.model.World` share this rule, so a start accepted here is never refused
     by a planner.
     """
     return max(robot_radius - tol, tol)

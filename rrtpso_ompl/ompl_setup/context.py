@@ -2,7 +2,7 @@
 
 * ``RealVectorStateSpace(2)`` with the problem's bounds (the robot's centre);
 * a state validity checker and an *exact* motion validator over the same
-  :class:`~rrtpso_ompl.world.World` (no discretisation: a segment is valid only when every point of
+  :class:`~rrtpso_ompl.model.World` (no discretisation: a segment is valid only when every point of
   it keeps the robot radius from every obstacle);
 * the path-length objective, the start and the goal (with its tolerance).
 

@@ -7,7 +7,7 @@
   benchmark terms: planning time, simplification, planner-specific run properties and progress.
 * ``solve`` never raises: an exception inside is logged and reported as ``PlannerStatus.CRASH``
   (an exception escaping a Python planner would abort a whole OMPL Benchmark).
-* The collision model: the vectorised :class:`~rrtpso_ompl.world.World` when the space
+* The collision model: the vectorised :class:`~rrtpso_ompl.model.World` when the space
   information's validity checker carries one (as :mod:`rrtpso_ompl.ompl_setup` builds it), else a
   slower adapter over ``si.checkMotion`` so the planner works in any ``SimpleSetup``.
 * A numpy ``Generator`` seeded either by the ``seed`` parameter or from OMPL's own RNG, so that
@@ -95,7 +95,7 @@ class PlannerStats:
 
 
 class SpaceInformationCollisionModel:
-    """The :class:`~rrtpso_ompl.world.World` interface the path optimiser needs, answered one
+    """The :class:`~rrtpso_ompl.model.World` interface the path optimiser needs, answered one
     segment at a time by ``si.checkMotion``.
 
     Used when a planner runs in a ``SimpleSetup`` that was not built by this package. Exact only as

@@ -13,7 +13,7 @@ Cost of a candidate path ``q_0 .. q_n`` (``q_0`` = start and ``q_n`` = goal fixe
 
 where ``alpha_j`` is the turning angle at interior waypoint ``j`` (radians), ``V`` the total
 intrusion of the path's segments into the robot's safety zone (exact, see
-:meth:`rrtpso_ompl.world.World.segment_violation`) and ``J_0`` the cost of the path the swarm was
+:meth:`rrtpso_ompl.model.World.segment_violation`) and ``J_0`` the cost of the path the swarm was
 seeded with. The ``J_0`` offset makes every colliding candidate worse than the seed, so the global
 best is always collision-free (Deb's feasibility rule folded into one number), while ``lambda_v V``
 still tells colliding particles which way is out.

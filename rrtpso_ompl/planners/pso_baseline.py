@@ -85,7 +85,7 @@ class PSOPlanner(PythonPlanner):
     Parameters
     ----------
     si : ompl.base.SpaceInformation
-        A 2-D real vector space (see :class:`~rrtpso_ompl.rrtstar_pso.RRTstarPSO`).
+        A 2-D real vector space (see :class:`~rrtpso_ompl.planners.RRTstarPSO`).
     name : str
         Planner name.
     **params

@@ -3,7 +3,7 @@
 1. OMPL's C++ ``og.RRTstar`` shares this planner's ProblemDefinition and grows its tree for
    ``rrt_time_fraction`` of the time budget (always also stopped by the outer termination
    condition). Its best path's waypoints are the paper's "candidate nodes".
-2. :func:`rrtpso_ompl.path_optimizer.optimize_path` shortens (and optionally smooths) them with the
+2. :func:`rrtpso_ompl.planners.optimize_path` shortens (and optionally smooths) them with the
    PSO of eqs. 4-5, checking every candidate segment exactly.
 3. The result replaces RRT*'s path in the ProblemDefinition (``clearSolutionPaths`` then
    ``addSolutionPath``), so ``ss.getSolutionPath()`` returns it like any planner's path.

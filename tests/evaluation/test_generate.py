@@ -15,10 +15,10 @@ import pytest
 import yaml
 from helpers import PROBLEMS
 
+from rrtpso_ompl.evaluation.certify import _Tiles
 from rrtpso_ompl.evaluation.generate import (
     KINDS,
     GenerationError,
-    _Tiles,
     default_decimals,
     generate,
     generate_to_file,

@@ -15,9 +15,9 @@ from scipy.sparse.csgraph import dijkstra
 
 from rrtpso_ompl.evaluation.generate import generate, grid_path
 from rrtpso_ompl.evaluation.optimum import shortest_path
+from rrtpso_ompl.model.geometry import path_length
 from rrtpso_ompl.model.problem import Circle, Polygon, load_problem, problem_from_dict
 from rrtpso_ompl.model.world import World
-from rrtpso_ompl.model.geometry import path_length
 from rrtpso_ompl.planners.solve import solve
 
 
