@@ -135,8 +135,11 @@ class ParamSpec:
             return "{" + ", ".join(map(str, self.choices)) + "}"
         if self.type is bool:
             return "{false, true}"
-        lo = "-inf" if self.low is None else f"{self.low:g}"
-        hi = "inf" if self.high is None else f"{self.high:g}"
+        def text(x: float) -> str:
+            return str(int(x)) if self.type is int else f"{x:g}"
+
+        lo = "-inf" if self.low is None else text(self.low)
+        hi = "inf" if self.high is None else text(self.high)
         return f"[{lo}, {hi}]"
 
 

@@ -187,28 +187,42 @@ class RRTstarPSO(PythonPlanner):
 
         # --- stage 2: OMPL's simplifier, so the swarm starts from a locally shortened path ------
         if values["simplify"] and not ptc():
-            t1 = time.perf_counter()
-            simplified = og.PathGeometric(raw)  # a copy: RRT*'s own path stays as it was
-            og.PathSimplifier(self.getSpaceInformation()).simplifyMax(simplified)
-            candidate = path_to_array(simplified)
-            if path_length(candidate) < path_length(xy):
-                xy = candidate
-            stats.simplify_time = time.perf_counter() - t1
+            xy = self._simplify(raw, xy, stats)
         stats.simplified_length = path_length(xy)
 
         # --- stage 3: PSO over the candidate nodes --------------------------------------------
-        model = collision_model_for(self.getSpaceInformation())
-        options = PathOptimizerOptions.from_values(values)
-        budget = values["budget"]
+        result = self._swarm(xy, stats, t0, ptc)
+        # Replace RRT*'s entry either way, so the solution is reported under this planner's name.
+        path = array_to_path(self.getSpaceInformation(), result.path)
+        pdef.clearSolutionPaths()
+        pdef.addSolutionPath(path, False, 0.0, self.getName())
+        return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
+
+    def _simplify(self, raw: og.PathGeometric, xy: np.ndarray, stats: RRTstarPSOStats):
+        """OMPL's ``simplifyMax`` on a copy of RRT*'s path; the shorter of the two waypoints."""
+        t1 = time.perf_counter()
+        simplified = og.PathGeometric(raw)  # a copy: RRT*'s own path stays as it was
+        og.PathSimplifier(self.getSpaceInformation()).simplifyMax(simplified)
+        candidate = path_to_array(simplified)
+        stats.simplify_time = time.perf_counter() - t1
+        return candidate if path_length(candidate) < path_length(xy) else xy
+
+    def _swarm(
+        self, xy: np.ndarray, stats: RRTstarPSOStats, t0: float, ptc: ob.PlannerTerminationCondition
+    ):
+        """The path optimiser over the candidate nodes, until the budget's end."""
+        budget = self._values["budget"]
         # With a known budget the PSO stops at its end (and at the outer condition); without one
         # the outer condition has already fired, so the swarm is bounded by its iterations only.
+        terminate = None
         if budget > 0:
             deadline = t0 + budget
 
             def terminate() -> bool:
                 return ptc() or time.perf_counter() >= deadline
-        else:
-            terminate = None
+
+        model = collision_model_for(self.getSpaceInformation())
+        options = PathOptimizerOptions.from_values(self._values)
         result = optimize_path(xy, model, options, self._rng(), terminate)
         stats.pso_time = result.time
         stats.pso_iterations = result.n_iterations
@@ -218,12 +232,7 @@ class RRTstarPSO(PythonPlanner):
         stats.pso_length = result.length
         stats.pso_waypoints = len(result.path)
         stats.pso_improved = result.improved
-
-        # Replace RRT*'s entry either way, so the solution is reported under this planner's name.
-        path = array_to_path(self.getSpaceInformation(), result.path)
-        pdef.clearSolutionPaths()
-        pdef.addSolutionPath(path, False, 0.0, self.getName())
-        return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
+        return result
 
     def _run_rrtstar(
         self, ptc: ob.PlannerTerminationCondition, t0: float, stats: RRTstarPSOStats
