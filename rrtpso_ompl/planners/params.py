@@ -135,6 +135,7 @@ class ParamSpec:
             return "{" + ", ".join(map(str, self.choices)) + "}"
         if self.type is bool:
             return "{false, true}"
+
         def text(x: float) -> str:
             return str(int(x)) if self.type is int else f"{x:g}"
 
