@@ -1,10 +1,26 @@
-"""Publishing results: files appear whole or not at all, and JSON holds only what JSON can."""
+"""Publishing results: files appear whole or not at all, nothing that is not ours is clobbered,
+and JSON holds only what JSON can.
+
+Where a result goes decides how it is written (:func:`publish`):
+
+- a new file, or an existing regular file: written to a temporary file beside it and renamed
+  over it, so a reader never sees half a file; an existing file keeps its permissions;
+- a symbolic link: written through to its target (by the rules for the target), the link stays;
+- a fifo, a character device or ``-`` (standard output): streamed directly, since renaming over
+  them would replace the fifo (its reader would get nothing) or the device node.
+
+Everything that writes a file goes through :func:`atomic_path` (for writers that need a file
+name: matplotlib, SQLite) or :func:`write_text_atomic`.
+"""
 
 from __future__ import annotations
 
 import json
 import math
 import os
+import shutil
+import stat
+import sys
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -14,57 +30,97 @@ from typing import Any
 import numpy as np
 
 __all__ = [
+    "STDOUT",
     "atomic_path",
     "finite",
+    "is_stream",
     "json_line",
-    "publish_atomic",
+    "publish",
     "write_json_atomic",
     "write_text_atomic",
 ]
 
+#: The output name that means standard output.
+STDOUT = "-"
 
-def publish_atomic(tmp: str | Path, path: str | Path) -> None:
-    """Give a finished temporary file the usual permissions and rename it to ``path``.
 
-    ``tempfile.mkstemp`` creates files readable by their owner only; a result file should get the
-    permissions any new file gets (0666 less the umask).
-    """
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)
-    os.replace(tmp, path)
+def is_stream(path: str | Path) -> bool:
+    """Whether ``path`` is written as a stream: ``-``, or an existing fifo or character device
+    (after following links)."""
+    if str(path) == STDOUT:
+        return True
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return False
+    return stat.S_ISFIFO(mode) or stat.S_ISCHR(mode)
+
+
+def _resolved(path: str | Path) -> Path:
+    """``path`` with symbolic links followed (also a dangling link's target)."""
+    return Path(os.path.realpath(path))
+
+
+def publish(tmp: str | Path, path: str | Path) -> None:
+    """Move a finished temporary file to ``path`` by the rules of the module docstring."""
+    if str(path) == STDOUT:
+        with open(tmp, "rb") as src:
+            sys.stdout.flush()
+            shutil.copyfileobj(src, sys.stdout.buffer)
+            sys.stdout.buffer.flush()
+        Path(tmp).unlink(missing_ok=True)
+        return
+    target = _resolved(path)
+    if is_stream(target):
+        with open(tmp, "rb") as src, open(target, "wb") as dst:
+            shutil.copyfileobj(src, dst)
+        Path(tmp).unlink(missing_ok=True)
+        return
+    try:
+        mode = stat.S_IMODE(os.stat(target).st_mode)  # an existing file keeps its permissions
+    except FileNotFoundError:
+        umask = os.umask(0)
+        os.umask(umask)
+        mode = 0o666 & ~umask  # what any new file gets (mkstemp's files are owner-only)
+    os.chmod(tmp, mode)
+    os.replace(tmp, target)
 
 
 @contextmanager
 def atomic_path(path: str | Path, suffix: str | None = None) -> Iterator[str]:
-    """A temporary file name next to ``path`` to write to; renamed to ``path`` when the block ends
-    without an exception, removed otherwise. A reader never sees half a file.
+    """A temporary file name to write to; published to ``path`` (:func:`publish`) when the block
+    ends without an exception, removed otherwise.
 
-    The temporary name ends in ``suffix`` (default: ``path``'s), for writers that choose the
-    format by it (matplotlib, Pillow).
+    The temporary file lies beside the (resolved) target, so the final rename is atomic; for a
+    stream target it lies in the system's temporary folder. Its name ends in ``suffix`` (default:
+    ``path``'s), for writers that choose the format by it (matplotlib, Pillow).
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=suffix or path.suffix or ".tmp",
-                               dir=path.parent)  # fmt: skip
+    name = Path(path)
+    if is_stream(path):
+        folder = None
+    else:
+        folder = _resolved(path).parent
+        folder.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{name.stem or 'out'}.",
+                               suffix=suffix or name.suffix or ".tmp", dir=folder)  # fmt: skip
     os.close(fd)
     try:
         yield tmp
-        publish_atomic(tmp, path)
+        publish(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
 
 
 def write_text_atomic(text: str, path: str | Path) -> Path:
-    """Write ``text`` (UTF-8, ``\\n`` line ends) atomically (see :func:`atomic_path`)."""
+    """Write ``text`` (UTF-8, ``\\n`` line ends) by the rules of :func:`publish`."""
     with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="\n") as fh:
         fh.write(text)
     return Path(path)
 
 
 def write_json_atomic(data: Any, path: str | Path) -> None:
-    """Write JSON through a temporary file and a rename, so a reader never sees half a file."""
+    """Write JSON (NaN and infinities as null) by the rules of :func:`publish`."""
     text = json.dumps(finite(data), indent=2, allow_nan=False, default=_json_default) + "\n"
     write_text_atomic(text, path)
 
@@ -87,7 +143,7 @@ def finite(obj: Any) -> Any:
 
 def _json_default(obj: Any) -> Any:
     if isinstance(obj, np.ndarray):
-        return obj.tolist()
+        return finite(obj.tolist())
     if isinstance(obj, np.generic):
-        return obj.item()
+        return finite(obj.item())
     raise TypeError(f"not JSON serialisable: {type(obj).__name__}")

@@ -12,11 +12,33 @@ import numbers
 import reprlib
 from typing import Any
 
-__all__ = ["SEED_MAX", "check_integer", "check_number", "check_seed", "describe", "short_repr"]
+__all__ = [
+    "MAX_COORDINATE",
+    "MAX_SECONDS",
+    "MIN_EXTENT",
+    "SEED_MAX",
+    "check_integer",
+    "check_number",
+    "check_seconds",
+    "check_seed",
+    "describe",
+    "short_repr",
+]
 
 #: The largest seed: OMPL's ``RNG::setSeed`` takes a 32-bit unsigned integer on every platform
 #: (``std::uint_fast32_t``, which is 32 bits on some), and numpy accepts any non-negative one.
 SEED_MAX = 2**32 - 1
+
+#: Largest coordinate or length, in any unit. Exact checks allow for round-off of 1e-9 of the
+#: workspace's scale (:func:`~rrtpso_ompl.model.problem.touch_tolerance`); beyond 1e9 that
+#: allowance would exceed a unit, and at 1e160 squared distances overflow.
+MAX_COORDINATE = 1e9
+#: Smallest side of the workspace: well above the absolute round-off allowance of 1e-9.
+MIN_EXTENT = 1e-6
+#: Longest time budget, seconds (about 11.6 days). OMPL's timed termination condition holds its
+#: deadline in integer nanoseconds, and a budget near 1e10 s overflows it: the planner then
+#: returns at once with no solution.
+MAX_SECONDS = 1e6
 
 #: Short, bounded reprs: a value may be a huge or self-referencing structure (YAML anchors).
 _REPR = reprlib.Repr()
@@ -25,12 +47,17 @@ _REPR.maxstring = _REPR.maxother = _REPR.maxlong = 40
 _REPR.maxlist = _REPR.maxtuple = _REPR.maxdict = _REPR.maxset = _REPR.maxfrozenset = 4
 
 
+#: Longest repr a message shows, characters.
+_MAX_REPR = 100
+
+
 def short_repr(value: Any) -> str:
-    """A repr of at most a few dozen characters, however large or nested the value."""
+    """A repr of at most :data:`_MAX_REPR` characters, however large or nested the value."""
     try:
-        return _REPR.repr(value)
+        text = _REPR.repr(value)
     except ValueError:  # an int with more digits than Python will convert to text
         return "(too long to show)"
+    return text if len(text) <= _MAX_REPR else text[: _MAX_REPR - 3] + "..."
 
 
 def describe(value: Any) -> str:
@@ -94,6 +121,17 @@ def check_integer(value: Any, *, low: int | None = None, high: int | None = None
     if high is not None and value > high:
         raise ValueError(f"must be <= {high}, got {value}")
     return value
+
+
+def check_seconds(value: Any) -> float:
+    """A time budget: a positive number of seconds, at most :data:`MAX_SECONDS`."""
+    x = check_number(value, low=0.0, strict_low=True)
+    if x > MAX_SECONDS:
+        raise ValueError(
+            f"must be at most {MAX_SECONDS:g} s (about 11.6 days; OMPL's deadline overflows "
+            f"beyond about 1e10 s), got {x:g}"
+        )
+    return x
 
 
 def check_seed(value: Any) -> int:

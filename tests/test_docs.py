@@ -53,3 +53,28 @@ def test_dynamic_guide_quotes_the_dynamic_benchmark():
             f"{float(c[12]):.2f} s median, {float(c[13]):.2f} s max",
         ]
         assert all(e in row for e in expected), (strategy, row, expected)
+
+
+def test_the_published_json_schema_is_the_declared_format_and_accepts_the_library():
+    import json
+
+    import jsonschema
+    import yaml
+
+    from rrtpso_ompl.model.format import schema_text
+
+    text = (DOCS / "problem.schema.json").read_text()
+    assert text == schema_text(), "regenerate with python benchmarks/problem_schema.py"
+    schema = json.loads(text)
+    jsonschema.Draft202012Validator.check_schema(schema)
+    validator = jsonschema.Draft202012Validator(schema)
+    files = sorted((ROOT / "problems").glob("*/*.yaml"))
+    assert files
+    for path in files:
+        errors = [e.message for e in validator.iter_errors(yaml.safe_load(path.read_text()))]
+        assert not errors, (path.name, errors[:2])
+    # and refuses what the loader refuses for the same reasons
+    bad = {"bounds": [[0, 0], [10, 10]], "start": [1, 1], "goal": [2, 2],
+           "robot": {"radius": -1}, "colour": "red"}  # fmt: skip
+    messages = " ".join(e.message for e in validator.iter_errors(bad))
+    assert "colour" in messages and "-1" in messages

@@ -9,20 +9,23 @@ from typing import Any
 from .common import (
     EXIT_OK,
     EXIT_UNSOLVED,
+    Output,
     RunProgress,
     add_run_options,
-    check_output,
+    check_outputs,
     check_planners,
     check_run_options,
+    note,
     planner_list,
 )
 
 __all__ = ["add_parser", "run"]
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     b = sub.add_parser(
         "batch",
+        parents=parents,
         help="solve many problem files in parallel, streaming JSON lines",
         description="Solve every problem file x planner x run in its own process and stream one "
         "JSON row per run to --out as it finishes. A bad file becomes an error row and the batch "
@@ -56,7 +59,10 @@ def run(args: argparse.Namespace) -> int:
     check_run_options(args)
     planners = planner_list(args.planner, "RRTstarPSO")
     params = check_planners(planners, args.param, "--planner")
-    check_output(args.out, "--out")
+    from ..evaluation import expand_inputs
+
+    inputs = [path for path, error in expand_inputs(args.inputs) if error is None]
+    check_outputs([Output("--out", args.out)], inputs)
     tasks = make_tasks(
         args.inputs,
         planners,
@@ -73,6 +79,7 @@ def run(args: argparse.Namespace) -> int:
             args.out,
             jobs=args.jobs,
             resume=args.resume,
+            overwrite=args.overwrite,
             executor=args.executor,
             scheduler=args.scheduler,
             progress=bar.row,
@@ -81,10 +88,9 @@ def run(args: argparse.Namespace) -> int:
     failed = [r for r in rows if not r.get("solved")]
     for r in rows:
         if r.get("error"):
-            print(f"rrtpso: {r['error']}", file=sys.stderr)
-    print(
+            print(f"rrtpso: {r['error']}", file=sys.stderr)  # errors, also with -q
+    note(
         f"batch: {len(rows)} rows, {len(rows) - len(failed)} solved, "
         f"{sum(bool(r.get('error')) for r in rows)} errors -> {args.out}",
-        file=sys.stderr,
     )
     return EXIT_UNSOLVED if failed else EXIT_OK

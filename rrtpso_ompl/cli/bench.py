@@ -12,21 +12,24 @@ from ..errors import UsageError
 from .common import (
     EXIT_OK,
     EXIT_UNSOLVED,
+    Output,
     RunProgress,
     add_run_options,
-    check_output,
+    check_outputs,
     check_planners,
     check_positive_seconds,
     check_run_options,
+    note,
     planner_list,
 )
 
 __all__ = ["add_parser", "run"]
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     b = sub.add_parser(
         "bench",
+        parents=parents,
         help="benchmark planners: OMPL benchmark logs, a Planner Arena database and a report",
         description="Run every problem x time budget x planner x run in its own process with the "
         "same collision checker, then write to --out: runs.jsonl, one OMPL benchmark log per "
@@ -35,7 +38,9 @@ def add_parser(sub: Any) -> None:
         "status 1 when a problem file was bad, 130 when interrupted (continue with --resume).",
     )
     b.add_argument("inputs", nargs="+", metavar="FILE|DIR|GLOB", help="problem files")
-    b.add_argument("--planners", required=True, metavar="A,B,...", help="planners to compare")
+    b.add_argument("--planner", "--planners", dest="planner", action="append", required=True,
+                   metavar="NAME[,NAME...]",
+                   help="planners to compare, repeatable or comma-separated")  # fmt: skip
     b.add_argument("--runs", type=int, default=10, help="runs per problem, budget and planner")
     b.add_argument(
         "--time",
@@ -62,18 +67,21 @@ def _budgets(text: str) -> list[float]:
 
 def run(args: argparse.Namespace) -> int:
     from ..evaluation import run_bench
+    from ..evaluation.bench import OUTPUT_FILES
 
     times = _budgets(args.time)
     args.time = None  # checked above, one budget at a time
     check_run_options(args)
-    planners = planner_list([args.planners], "")
-    if not planners:
-        raise UsageError("--planners: name at least one planner")
-    params = check_planners(planners, args.param, "--planners")
+    planners = planner_list(args.planner, "")
+    params = check_planners(planners, args.param, "--planner")
+    from ..evaluation import expand_inputs
+
     out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"--out: '{args.out}' exists and is not a folder")
-    check_output(str(out / "report.md"), "--out")
+    inputs = [path for path, error in expand_inputs(args.inputs) if error is None]
+    check_outputs([Output("--out", args.out, "folder")], inputs)
+    # No input may be one of the files the bench writes into the folder.
+    written = ["runs.jsonl", *OUTPUT_FILES]
+    check_outputs([Output(f"--out ({name})", str(out / name)) for name in written], inputs)
     with RunProgress("bench", "runs") as bar:
         result = run_bench(
             args.inputs,
@@ -87,6 +95,7 @@ def run(args: argparse.Namespace) -> int:
             executor=args.executor,
             scheduler=args.scheduler,
             resume=args.resume,
+            overwrite=args.overwrite,
             progress=bar.row,
             on_start=bar.started,
             command="rrtpso " + shlex.join(args.argv),
@@ -97,10 +106,9 @@ def run(args: argparse.Namespace) -> int:
         save_figure(plot_bench(result.summary, "ratio"), out / "ratio.png")
         save_figure(plot_bench(result.summary, "success"), out / "success.png")
     for e in result.errors:
-        print(f"rrtpso: {e}", file=sys.stderr)
-    print(
+        print(f"rrtpso: {e}", file=sys.stderr)  # errors, also with -q
+    note(
         f"bench: {len(result.rows)} runs, {len(result.logs)} experiments -> {out}/ "
         f"(benchmark.db, report.md)",
-        file=sys.stderr,
     )
     return EXIT_UNSOLVED if result.errors else EXIT_OK

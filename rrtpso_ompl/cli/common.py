@@ -9,36 +9,66 @@ file and its key, or the flag); :func:`rrtpso_ompl.cli.main` turns it into exit 
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ..errors import ParameterError, UnknownPlannerError, UsageError
 from ..model import Problem, load_problem
+from ..outputs import STDOUT
+from ..validation import check_seconds, check_seed
 
 __all__ = [
     "EXIT_BAD_INPUT",
     "EXIT_INTERRUPTED",
     "EXIT_OK",
     "EXIT_UNSOLVED",
+    "Output",
     "PlannerChoice",
     "RunProgress",
     "add_run_options",
+    "add_shared_flags",
     "check_output",
+    "check_outputs",
     "check_planners",
     "check_positive_seconds",
     "check_run_options",
+    "check_seed_flag",
     "choose_planner",
+    "note",
     "parse_params",
     "planner_list",
     "progress_bar",
+    "set_quiet",
 ]
 
 EXIT_OK, EXIT_UNSOLVED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+
+#: ``-q``: only errors on stderr (no summary lines, no progress bars).
+_quiet = False
+
+
+def set_quiet(quiet: bool) -> None:
+    """Silence (or not) :func:`note` and the progress bars for this command."""
+    global _quiet
+    _quiet = bool(quiet)
+
+
+def note(message: str) -> None:
+    """A line for the user on stderr (the summary of a command), unless ``-q``."""
+    if not _quiet:
+        print(message, file=sys.stderr)
+
+
+def add_shared_flags(parser: argparse.ArgumentParser) -> None:
+    """``-v`` and ``-q``, which every subcommand takes."""
+    parser.add_argument("-v", "--verbose", action="count", default=0,
+                        help="more detail: OMPL's Info (-v) and Debug (-vv) messages")  # fmt: skip
+    parser.add_argument("-q", "--quiet", action="store_true",
+                        help="only errors on stderr: no summary line, no progress bar")  # fmt: skip
 
 
 # ----------------------------------------------------------------------------------------------
@@ -80,6 +110,8 @@ def choose_planner(args: argparse.Namespace) -> PlannerChoice:
     """
     from ..planners import DEFAULT_PLANNER, default_registry
 
+    if args.planner is not None and not args.planner.strip():
+        raise UsageError("--planner: give a planner name (see 'rrtpso planners')")
     problem = load_problem(args.problem)
     src = args.problem
     name = args.planner or problem.planner.type or DEFAULT_PLANNER
@@ -122,37 +154,121 @@ def _check_param(entry: Any, key: str, value: Any, where: str) -> None:
 
 
 def check_positive_seconds(value: float | None, flag: str, src: str = "") -> None:
-    """A time flag must be a positive, finite number of seconds (when given)."""
-    if value is not None and not (value > 0 and math.isfinite(value)):
+    """A time flag must be a positive number of seconds, at most ``MAX_SECONDS`` (when given)."""
+    if value is None:
+        return
+    try:
+        check_seconds(value)
+    except ValueError as exc:
         where = f"{src}: {flag}" if src else flag
-        raise UsageError(f"{where}: must be a positive number of seconds, got {value}")
+        raise UsageError(f"{where}: a time in seconds {exc}") from None
+
+
+def check_seed_flag(value: int | None, flag: str = "--seed", runs: int = 1) -> None:
+    """A seed flag (and the seeds ``value .. value + runs - 1`` of the runs) in OMPL's range."""
+    if value is None:
+        return
+    for seed in (value, value + runs - 1):
+        try:
+            check_seed(seed)
+        except ValueError as exc:
+            what = "the seed of the last run" if seed != value else "the seed"
+            raise UsageError(f"{flag}: {what} {exc}") from None
 
 
 # ----------------------------------------------------------------------------------------------
 # Outputs
 # ----------------------------------------------------------------------------------------------
-def check_output(path: str | None, flag: str, image: bool = False) -> None:
-    """Refuse an output that cannot be written before spending the time budget on planning."""
-    if not path:
+@dataclass(frozen=True)
+class Output:
+    """An output a command was asked to write.
+
+    Attributes
+    ----------
+    flag : str
+        How the command line names it (``--json``).
+    path : str or None
+        Where; None when not asked for. ``-`` is standard output (text outputs only).
+    kind : {"text", "image", "gif", "folder"}
+        What is written there.
+    """
+
+    flag: str
+    path: str | None
+    kind: str = "text"
+
+
+def check_outputs(outputs: Sequence[Output], inputs: Sequence[str | Path] = ()) -> None:
+    """Refuse outputs that cannot be written, before any time is spent planning.
+
+    Refused: an empty name; standard output (``-``) for an image or folder, or for two outputs;
+    a folder where a file goes (or a file where a folder goes); a parent that is a file or not
+    writable; an image suffix matplotlib cannot write; an output that is one of the inputs (it
+    would be destroyed) or the same file as another output (one would be lost).
+    """
+    given = [o for o in outputs if o.path is not None]
+    targets: dict[str, str] = {}
+    for out in given:
+        _check_one(out)
+        key = STDOUT if out.path == STDOUT else os.path.realpath(out.path)
+        if key in targets:
+            where = "standard output" if key == STDOUT else f"the same file '{out.path}'"
+            raise UsageError(f"{targets[key]} and {out.flag} both name {where}; give each its own")
+        targets[key] = out.flag
+    for src in inputs:
+        for out in given:
+            if out.path != STDOUT and _same_file(out.path, src):
+                raise UsageError(
+                    f"{out.flag}: '{out.path}' is an input ({src}); writing it would destroy it"
+                )
+
+
+def _check_one(out: Output) -> None:
+    path, flag = out.path, out.flag
+    if not path or not path.strip():
+        raise UsageError(f"{flag}: give a file name (got an empty one)")
+    if path == STDOUT:
+        if out.kind != "text":
+            raise UsageError(f"{flag}: '-' (standard output) is only for text outputs")
         return
     target = Path(path)
-    if target.is_dir():
+    if out.kind == "folder":
+        if target.exists() and not target.is_dir():
+            raise UsageError(f"{flag}: '{path}' exists and is not a directory")
+    elif target.is_dir():
         raise UsageError(f"{flag}: '{path}' is a directory")
-    parent = target.parent
+    parent = Path(os.path.realpath(target)).parent
     while not parent.exists():
         parent = parent.parent  # missing folders are created when the file is written
+    if not parent.is_dir():
+        raise UsageError(f"{flag}: cannot write '{path}': '{parent}' is a file, not a directory")
     if not os.access(parent, os.W_OK):
         raise UsageError(f"{flag}: cannot write '{path}': '{parent}' is not writable")
-    if image:
+    if out.kind == "image":
         from ..plotting import image_formats
 
         kinds = image_formats()
-        suffix = target.suffix.lower().lstrip(".")
-        if suffix not in kinds:
+        if target.suffix.lower().lstrip(".") not in kinds:
             raise UsageError(
                 f"{flag}: cannot draw '{path}': use one of the suffixes "
                 f"{', '.join('.' + k for k in sorted(kinds))}"
             )
+    if out.kind == "gif" and target.suffix.lower() != ".gif":
+        raise UsageError(f"{flag}: '{path}' must end in .gif")
+
+
+def _same_file(a: str | Path, b: str | Path) -> bool:
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)  # hard links
+    except OSError:
+        return False
+
+
+def check_output(path: str | None, flag: str, image: bool = False) -> None:
+    """:func:`check_outputs` for one output."""
+    check_outputs([Output(flag, path, "image" if image else "text")])
 
 
 # ----------------------------------------------------------------------------------------------
@@ -162,7 +278,8 @@ def progress_bar(desc: str, **kwargs: Any) -> Any:
     """A tqdm bar on stderr, silent when stderr is not a terminal (logs, CI, pipes)."""
     from tqdm import tqdm
 
-    return tqdm(desc=desc, file=sys.stderr, disable=not sys.stderr.isatty(), leave=False, **kwargs)
+    quiet = _quiet or not sys.stderr.isatty()
+    return tqdm(desc=desc, file=sys.stderr, disable=quiet, leave=False, **kwargs)
 
 
 class RunProgress:
@@ -184,7 +301,7 @@ class RunProgress:
         self._bar.total = n
         self._bar.refresh()
         if skipped:
-            print(f"rrtpso: resuming: {skipped} {self.noun} already done", file=sys.stderr)
+            note(f"rrtpso: resuming: {skipped} {self.noun} already done")
 
     def row(self, row: Mapping[str, Any]) -> None:
         kind = "error" if row.get("error") else ("solved" if row["solved"] else "unsolved")
@@ -200,7 +317,13 @@ def add_run_options(p: argparse.ArgumentParser, kept: str) -> None:
     """The options ``batch`` and ``bench`` share: seeds, parallelism, resuming, executors."""
     p.add_argument("--seed", type=int, default=1, help="seed of run 0; run r uses seed + r")
     p.add_argument("--jobs", type=int, default=1, help="parallel worker processes (default 1)")
-    p.add_argument("--resume", action="store_true", help=f"keep {kept}")
+    p.add_argument("--resume", action="store_true", help=f"keep {kept} and run the rest")
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help=f"start afresh although {kept.removeprefix('the ')} exist (without "
+        "--resume or --overwrite an earlier run's results are refused, never replaced)",
+    )
     p.add_argument(
         "--param", action="append", default=[], metavar="NAME=VALUE", help="planner parameter"
     )
@@ -216,6 +339,8 @@ def add_run_options(p: argparse.ArgumentParser, kept: str) -> None:
 def planner_list(values: list[str] | None, default: str) -> list[str]:
     """Planner names from repeated and comma-separated flags, in order, without repeats."""
     names = [n.strip() for v in (values or [default]) for n in v.split(",") if n.strip()]
+    if not names:
+        raise UsageError("--planner: name at least one planner (see 'rrtpso planners')")
     return list(dict.fromkeys(names))
 
 
@@ -225,8 +350,7 @@ def check_run_options(args: argparse.Namespace) -> None:
     for flag in ("runs", "jobs"):
         if getattr(args, flag) < 1:
             raise UsageError(f"--{flag}: must be at least 1, got {getattr(args, flag)}")
-    if args.seed is not None and args.seed < 0:
-        raise UsageError(f"--seed: must be >= 0, got {args.seed}")
+    check_seed_flag(args.seed, runs=args.runs)
     if args.executor == "dask":
         if not args.scheduler:
             raise UsageError("--executor dask: needs --scheduler ADDRESS")

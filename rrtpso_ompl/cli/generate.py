@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import argparse
-import sys
+import os
 from typing import Any
 
 from ..errors import GenerationError, UsageError
-from .common import EXIT_OK, check_output
+from ..outputs import is_stream
+from .common import EXIT_OK, Output, check_outputs, check_seed_flag, note
 
 __all__ = ["add_parser", "run"]
 
@@ -26,9 +27,10 @@ _OPTIONS = (
 )
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     g = sub.add_parser(
         "generate",
+        parents=parents,
         help="write a seeded random problem (circles, polygons or a maze)",
         description="Write a seeded random problem file whose start and goal are free and "
         "connected (certified by a collision-checked grid path). The same seed and options give "
@@ -59,17 +61,22 @@ def add_parser(sub: Any) -> None:
     g.add_argument("--wall", type=float, help="maze wall thickness")
     g.add_argument("--algorithm", choices=("dfs", "kruskal"), help="maze algorithm")
     g.add_argument("--name", help="problem name (default: from kind and seed)")
+    g.add_argument("--overwrite", action="store_true",
+                   help="replace --out when it exists (it is refused otherwise)")  # fmt: skip
     g.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from ..evaluation import generate_to_file
 
+    check_seed_flag(args.seed)
     options = {k: getattr(args, k) for k in _OPTIONS if getattr(args, k) is not None}
-    check_output(args.out, "--out")
+    check_outputs([Output("--out", args.out)])
+    if os.path.lexists(args.out) and not args.overwrite and not is_stream(args.out):
+        raise UsageError(f"--out: '{args.out}' exists; pass --overwrite to replace it")
     try:
         path = generate_to_file(args.kind, args.seed, args.out, **options)
     except (GenerationError, ValueError) as exc:
         raise UsageError(f"generate {args.kind}: {exc}") from None
-    print(f"wrote {path}", file=sys.stderr)
+    note(f"wrote {path}")
     return EXIT_OK

@@ -7,13 +7,15 @@ usage (one message on stderr, no traceback, nothing written), 130 interrupted.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
+import os
 import sys
 from collections.abc import Sequence
 
 from ..errors import RrtpsoError
 from . import batch, bench, generate, optimum, planners, simulate, solve
-from .common import EXIT_BAD_INPUT, EXIT_INTERRUPTED
+from .common import EXIT_BAD_INPUT, EXIT_INTERRUPTED, add_shared_flags, set_quiet
 
 __all__ = ["main"]
 
@@ -28,8 +30,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    shared = argparse.ArgumentParser(add_help=False)
+    add_shared_flags(shared)
     for command in COMMANDS:
-        command.add_parser(sub)
+        command.add_parser(sub, [shared])
     return parser
 
 
@@ -37,6 +41,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     args = build_parser().parse_args(argv)
     args.argv = list(sys.argv[1:] if argv is None else argv)
+    set_quiet(args.quiet)
     logging.basicConfig(
         level=logging.INFO if getattr(args, "verbose", 0) else logging.WARNING,
         format="%(levelname)s: %(name)s: %(message)s",
@@ -44,11 +49,33 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return args.func(args)
     except RrtpsoError as exc:  # bad input of any kind: its message names where it came from
-        print(f"rrtpso: error: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return _fail(f"rrtpso: error: {exc}", EXIT_BAD_INPUT)
     except KeyboardInterrupt:
-        print("rrtpso: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return _fail("rrtpso: interrupted", EXIT_INTERRUPTED)
+    except BrokenPipeError:
+        # The reader went away (`rrtpso planners | head -1`): nothing more can be said to it.
+        _silence_stdout()
+        return _fail("rrtpso: error: the output pipe was closed before everything was written",
+                     EXIT_BAD_INPUT)  # fmt: skip
+    except MemoryError:
+        return _fail(
+            "rrtpso: error: out of memory: the input is too large for this machine (see the "
+            "limits in docs/problem-format.md)",
+            EXIT_BAD_INPUT,
+        )
+
+
+def _fail(message: str, status: int) -> int:
+    with contextlib.suppress(OSError):
+        print(message, file=sys.stderr)
+    return status
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null, so that Python's final flush does not raise again."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    os.close(devnull)
 
 
 def _version() -> str:

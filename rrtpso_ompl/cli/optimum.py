@@ -3,17 +3,17 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from typing import Any
 
-from .common import EXIT_OK, EXIT_UNSOLVED, check_output
+from .common import EXIT_OK, EXIT_UNSOLVED, Output, check_outputs, note
 
 __all__ = ["add_parser", "run"]
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     o = sub.add_parser(
         "optimum",
+        parents=parents,
         help="compute the exact shortest path (the reference for path-length ratios)",
         description="Compute the exact shortest path for the problem's disc robot among its "
         "circles and polygons: a tangent graph with arcs around the inflated obstacles, searched "
@@ -30,20 +30,21 @@ def run(args: argparse.Namespace) -> int:
     from ..evaluation import shortest_path
     from ..model import load_problem
 
+    check_outputs([Output("--json", args.json), Output("--plot", args.plot, "image")],
+                  inputs=[args.problem])  # fmt: skip
     problem = load_problem(args.problem)
-    check_output(args.json, "--json")
-    check_output(args.plot, "--plot", image=True)
     result = shortest_path(problem)
     if args.plot:
         from ..plotting import plot_optimum, save_figure
 
         save_figure(plot_optimum(problem, result), args.plot)
     if args.json:
+        from ..model import World
         from ..outputs import write_json_atomic
 
-        write_json_atomic(result.to_dict(), args.json)
+        write_json_atomic(result.to_dict(World.from_problem(problem)), args.json)
     if result.found:
-        print(f"{problem.name}: optimum length={result.length:.6f}", file=sys.stderr)
+        note(f"{problem.name}: optimum length={result.length:.6f}")
         return EXIT_OK
-    print(f"{problem.name}: no path exists", file=sys.stderr)
+    note(f"{problem.name}: no path exists")
     return EXIT_UNSOLVED

@@ -11,9 +11,10 @@ from .common import EXIT_OK
 __all__ = ["add_parser", "run"]
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     q = sub.add_parser(
         "planners",
+        parents=parents,
         help="list the planners and their parameters",
         description="List the registered planners and their parameters.",
     )

@@ -4,26 +4,28 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
-from pathlib import Path
 from typing import Any
 
 from ..errors import UsageError
 from .common import (
     EXIT_OK,
     EXIT_UNSOLVED,
-    check_output,
+    Output,
+    check_outputs,
     check_positive_seconds,
+    check_seed_flag,
     choose_planner,
+    note,
     progress_bar,
 )
 
 __all__ = ["add_parser", "run"]
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     m = sub.add_parser(
         "simulate",
+        parents=parents,
         help="drive among moving obstacles with collision prediction and replanning",
         description="Drive the robot from start to goal among the problem's moving obstacles: it "
         "senses them within robot.sensor_range, predicts collisions and replans contour detours "
@@ -74,7 +76,6 @@ def add_parser(sub: Any) -> None:
         metavar="NAME=VALUE",
         help="planner parameter, repeatable",
     )
-    m.add_argument("-v", "--verbose", action="count", default=0, help="show OMPL's messages")
     m.set_defaults(func=run)
 
 
@@ -90,13 +91,15 @@ def run(args: argparse.Namespace) -> int:
             raise UsageError(f"{src}: robot.{key}: required for simulate")
     check_positive_seconds(args.time, "--time", src)
     check_positive_seconds(args.replan_time, "--replan-time", src)
+    check_seed_flag(args.seed)
     if not (args.heading_changes >= 0 and math.isfinite(args.heading_changes)):
         raise UsageError(f"{src}: --heading-changes: must be >= 0, got {args.heading_changes}")
-    check_output(args.json, "--json")
-    check_output(args.plot, "--plot", image=True)
-    check_output(args.gif, "--gif")
-    if args.gif and Path(args.gif).suffix.lower() != ".gif":
-        raise UsageError(f"--gif: '{args.gif}' must end in .gif")
+    outputs = [
+        Output("--json", args.json),
+        Output("--plot", args.plot, "image"),
+        Output("--gif", args.gif, "gif"),
+    ]
+    check_outputs(outputs, inputs=[args.problem])
 
     from ..dynamic import DynamicOptions, simulate
 
@@ -119,10 +122,9 @@ def run(args: argparse.Namespace) -> int:
         sim = simulate(problem, options, seed=seed, progress=progress)
     _write_outputs(args, problem, sim)
     verdict = "reached the goal" if sim.reached_goal else f"did not reach the goal ({sim.status})"
-    print(
+    note(
         f"{problem.name}: {verdict}, {sim.collisions} collisions, {len(sim.replans)} replans, "
         f"time {sim.total_time:.1f}s, length {sim.path_length:.1f}",
-        file=sys.stderr,
     )
     return EXIT_OK if sim.success else EXIT_UNSOLVED
 

@@ -3,18 +3,27 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from typing import Any
 
 from ..errors import UsageError
-from .common import EXIT_OK, EXIT_UNSOLVED, check_output, check_positive_seconds, choose_planner
+from .common import (
+    EXIT_OK,
+    EXIT_UNSOLVED,
+    Output,
+    check_outputs,
+    check_positive_seconds,
+    check_seed_flag,
+    choose_planner,
+    note,
+)
 
 __all__ = ["add_parser", "run"]
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     p = sub.add_parser(
         "solve",
+        parents=parents,
         help="solve one problem file",
         description="Solve one problem file and report the path.",
     )
@@ -65,13 +74,6 @@ def add_parser(sub: Any) -> None:
         help="velocity profile: the paper's constant robot.speed, or within the robot's "
         "limits from rest to rest (auto: limits when any limit is given)",
     )
-    p.add_argument(
-        "-v",
-        "--verbose",
-        action="count",
-        default=0,
-        help="show OMPL's Info (-v) and Debug (-vv) messages",
-    )
     p.set_defaults(func=run)
 
 
@@ -82,10 +84,14 @@ def run(args: argparse.Namespace) -> int:
     choice = choose_planner(args)
     problem = choice.problem
     check_positive_seconds(args.time, "--time", args.problem)
-    check_output(args.json, "--json")
-    check_output(args.plot, "--plot", image=True)
-    check_output(args.trajectory, "--trajectory")
-    check_output(args.plot_velocities, "--plot-velocities", image=True)
+    check_seed_flag(args.seed)
+    outputs = [
+        Output("--json", args.json),
+        Output("--plot", args.plot, "image"),
+        Output("--trajectory", args.trajectory),
+        Output("--plot-velocities", args.plot_velocities, "image"),
+    ]
+    check_outputs(outputs, inputs=[args.problem])
     wants_motion = bool(args.trajectory or args.plot_velocities)
     if wants_motion:
         _check_drive_keys(args, problem)
@@ -98,9 +104,8 @@ def run(args: argparse.Namespace) -> int:
     motion = _drive(problem, result, args.profile) if wants_motion and result.solved else None
     _write_outputs(args, problem, result, motion)
     length = f"{result.length:.3f}" if result.length is not None else "-"
-    print(
+    note(
         f"{problem.name}: {result.planner} {result.status} length={length} time={result.time:.3f}s",
-        file=sys.stderr,
     )
     return EXIT_OK if result.solved else EXIT_UNSOLVED
 

@@ -23,13 +23,33 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import RrtpsoError
 from ..model.geometry import path_length
 from ..model.problem import Problem
 from .manager import Replan, ReplanningManager
 from .motion import Motion, ObstacleTrack, closest_approach
 from .prediction import predict_threats
 
-__all__ = ["STRATEGIES", "DynamicOptions", "SimulationResult", "simulate"]
+__all__ = [
+    "MAX_REPLANS",
+    "MAX_STEPS",
+    "STRATEGIES",
+    "DynamicOptions",
+    "SimulationError",
+    "SimulationResult",
+    "simulate",
+]
+
+
+class SimulationError(RrtpsoError):
+    """A simulation that cannot be run as asked (the message says why)."""
+
+
+#: Most control steps one simulation may take (simulated time / sample time).
+MAX_STEPS = 1_000_000
+#: Most reactions (detours and fallbacks) one simulation may make before it gives up: each one
+#: plans or verifies, so this bounds the wall time of a run that can never get through.
+MAX_REPLANS = 500
 
 #: The strategies: the paper's contour detours, replanning the whole remaining path (baseline),
 #: or driving the static path blindly (baseline).
@@ -228,15 +248,45 @@ def simulate(
 
     plan = Motion.from_path(static_path, 0.0, None, robot.speed, robot.turn_rate)
     t_max = options.max_time if options.max_time is not None else 4 * plan.t_end + 60.0
+    _check_steps(t_max, robot.sample_time)
+    blocked = _blocked(problem, tracks, robot)
+    if blocked:
+        return _no_static_path(problem, options, seed, robot, static_path, tracks, blocked)
     manager = ReplanningManager(problem, options, robot.speed, robot.turn_rate, margin, plan_rng)
     plan, t, plans, replans = _drive(
         plan, tracks, robot, manager, options, margin, t_max, world_rng, progress
     )
     reached = plan.t_end <= t_max + 1e-9
     executed = plan if reached else plan.until(min(t, plan.t_end))
-    return _measure(
+    result = _measure(
         problem, options, seed, robot, executed, reached, static_path, tracks, replans, plans
     )
+    if len(replans) >= MAX_REPLANS and not result.reached_goal:
+        result.status = f"gave up after {MAX_REPLANS} replans"
+    return result
+
+
+def _check_steps(t_max: float, sample_time: float) -> None:
+    """Refuse a run that would take more than MAX_STEPS control steps."""
+    steps = t_max / sample_time
+    if steps > MAX_STEPS:
+        raise SimulationError(
+            f"robot.sample_time {sample_time:g} s would take {steps:.3g} control steps to drive "
+            f"the path (simulated time up to {t_max:.3g} s); at most {MAX_STEPS:,}: use a longer "
+            "sample time or a higher speed"
+        )
+
+
+def _blocked(problem: Problem, tracks: list[ObstacleTrack], robot: _Robot) -> str:
+    """Why the robot cannot set off: an obstacle on its start at t = 0, or one that never moves
+    on its goal (empty when neither)."""
+    for j, tr in enumerate(tracks):
+        contact = robot.radius + tr.radius
+        if math.dist(tr.position(0.0), problem.start) < contact:
+            return f"start blocked: moving_obstacles[{j}] overlaps the robot at t = 0"
+        if tr.speed == 0 and math.dist(tr.position(0.0), problem.goal) < contact:
+            return f"goal blocked: moving_obstacles[{j}] stands still on the goal"
+    return ""
 
 
 def _static_path(problem: Problem, options: DynamicOptions, seed: int | None) -> np.ndarray:
@@ -256,7 +306,7 @@ def _drive(plan, tracks, robot, manager, options, margin, t_max, world_rng, prog
     change_p = options.heading_changes * robot.sample_time
     t = 0.0
     k = 0
-    while t < plan.t_end - 1e-9 and t <= t_max:
+    while t < plan.t_end - 1e-9 and t <= t_max and len(replans) < MAX_REPLANS:
         obs = _sense(plan.position(t), tracks, t, robot.sensor_range)
         if obs and options.strategy != "none":
             threats = predict_threats(plan, t, obs, robot.radius, 0.5 * margin)
@@ -336,8 +386,9 @@ def _measure(problem, options, seed, robot, executed, reached, static_path, trac
     )
 
 
-def _no_static_path(problem, options, seed, robot, static_path, tracks) -> SimulationResult:
-    """The result when no static path was found: the robot never moves."""
+def _no_static_path(problem, options, seed, robot, static_path, tracks,
+                    status: str = "no static path") -> SimulationResult:  # fmt: skip
+    """The result when the robot cannot set off (no static path, a blocked start or goal)."""
     n = len(tracks)
     return SimulationResult(
         problem=problem.name,
@@ -358,5 +409,5 @@ def _no_static_path(problem, options, seed, robot, static_path, tracks) -> Simul
         tracks=tracks,
         replans=[],
         plans=[],
-        status="no static path",
+        status=status,
     )

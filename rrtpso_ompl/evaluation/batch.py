@@ -1,27 +1,26 @@
 """Batch solving: many problem files x planners x runs, in parallel, streamed to JSON lines.
 
-Every task runs in a fresh process (spawn start method): OMPL's random generator can be seeded only
-once per process, so this is what makes each row reproducible from its seed, whichever worker ran
-it. The local executor is :class:`concurrent.futures.ProcessPoolExecutor` with one task per child;
-``executor="dask"`` sends the same tasks to a Dask cluster, where each task again spawns its own
-process. Rows are written by the parent as they finish, one whole line per write, so an interrupted
-batch leaves a valid JSON-lines file that ``resume=True`` continues.
+Every run gets an OMPL of its own, seeded before any of its random generators exists (OMPL takes
+its seed once per process): the local executor's warm workers fork one child per run
+(:mod:`rrtpso_ompl.evaluation.workers`), after loading the run's problem once per worker; the
+Dask executor starts a process per run. So each row is reproducible from its seed, whichever
+worker ran it, and a run that crashes is an error row, not the end of the batch. Rows are written
+by the parent as they finish, one whole line per write, to a locked results file
+(:mod:`rrtpso_ompl.evaluation.results_file`), so an interrupted batch leaves a valid file that
+``resume=True`` continues.
 """
 
 from __future__ import annotations
 
 import glob
-import json
-import multiprocessing as mp
 import time
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..errors import RrtpsoError
-from ..outputs import json_line, write_text_atomic
+from ..errors import ProblemError, RrtpsoError
+from .results_file import ResultsFile, latest_rows, read_rows, row_key
 
 __all__ = [
     "Task",
@@ -138,8 +137,28 @@ def make_tasks(
 
 
 # ----------------------------------------------------------------------------------------------
-# One task (runs in a worker process)
+# One task (runs in a forked child of a warm worker)
 # ----------------------------------------------------------------------------------------------
+#: Problems a warm worker has loaded: file -> (problem, world) or the error loading it gave.
+#: Filled in the worker before it forks (:func:`prepare_task`), so each run's child finds its
+#: problem and world built, and loads nothing.
+_LOADED: dict[str, Any] = {}
+
+
+def prepare_task(task: Task) -> None:
+    """Load the task's problem and build its world, once per file and worker (no OMPL here: the
+    worker must not create any OMPL object before it forks)."""
+    if task.error or task.file in _LOADED:
+        return
+    from ..model import World, load_problem
+
+    try:
+        problem = load_problem(task.file)
+        _LOADED[task.file] = (problem, World.from_problem(problem))
+    except RrtpsoError as exc:
+        _LOADED[task.file] = exc
+
+
 def run_task(task: Task) -> dict[str, Any]:
     """Solve one task and return its row. Never raises for a bad problem: that is the row.
 
@@ -148,40 +167,28 @@ def run_task(task: Task) -> dict[str, Any]:
     ``error`` (None, or the message for a bad file or planner), and ``budget``, the time limit
     the task asked for (None: the file's).
     """
-    from ..model.problem import ProblemError, load_problem
     from ..ompl_setup import set_ompl_log_level
     from ..planners.solve import solve
 
     set_ompl_log_level(0)
-    base = {
-        "file": task.file,
-        "planner": task.planner,
-        "seed": task.seed,
-        "run": task.run,
-        "budget": task.time_limit,
-    }
+    base = _base_row(task)
     t0 = time.perf_counter()
     if task.error:
-        return _error_row(base, f"{task.file}: {task.error}")
+        return error_row(task, f"{task.file}: {task.error}")
+    prepare_task(task)
+    loaded = _LOADED[task.file]
+    if isinstance(loaded, RrtpsoError):
+        return error_row(task, str(loaded) if isinstance(loaded, ProblemError) else
+                         f"{task.file}: {loaded}")  # fmt: skip
+    problem, world = loaded
     try:
-        problem = load_problem(task.file)
-        result = solve(
-            problem,
-            task.planner,
-            task.time_limit,
-            task.seed,
-            dict(task.params),
-            simplify=task.simplify,
-            progress=task.progress,
-        )
+        result = solve(problem, task.planner, task.time_limit, task.seed, dict(task.params),
+                       simplify=task.simplify, progress=task.progress, world=world)  # fmt: skip
     except ProblemError as exc:  # it names the file already
-        return _error_row(base, str(exc))
+        return error_row(task, str(exc))
     except RrtpsoError as exc:  # unknown planner, bad parameter
-        return _error_row(base, f"{task.file}: {exc}")
-    row = {**base, **result.to_dict()}
-    row["file"] = task.file
-    row["run"] = task.run
-    row["budget"] = task.time_limit
+        return error_row(task, f"{task.file}: {exc}")
+    row = {**base, **result.to_dict(), **base}
     if not task.keep_path:
         row.pop("path", None)
     row["wall"] = time.perf_counter() - t0
@@ -189,9 +196,15 @@ def run_task(task: Task) -> dict[str, Any]:
     return row
 
 
-def _error_row(base: dict[str, Any], message: str) -> dict[str, Any]:
+def _base_row(task: Task) -> dict[str, Any]:
+    return {"file": task.file, "planner": task.planner, "seed": task.seed, "run": task.run,
+            "budget": task.time_limit}  # fmt: skip
+
+
+def error_row(task: Task, message: str) -> dict[str, Any]:
+    """The row of a task that produced no result: ``status`` "error" and the reason."""
     return {
-        **base,
+        **_base_row(task),
         "problem": None,
         "status": "error",
         "solved": False,
@@ -202,52 +215,52 @@ def _error_row(base: dict[str, Any], message: str) -> dict[str, Any]:
     }
 
 
-def _run_isolated(task: Task) -> dict[str, Any]:
-    """``run_task`` in a fresh spawned process (used inside long-lived Dask workers)."""
-    ctx = mp.get_context("spawn")
-    with ProcessPoolExecutor(1, mp_context=ctx) as pool:
-        return pool.submit(run_task, task).result()
+def _timeout(task: Task) -> float:
+    """How long a run may take before its process is stopped: its budget plus a grace period
+    (the file's own budget is not known here, so the largest allowed one counts)."""
+    from ..validation import MAX_SECONDS
+    from .workers import GRACE
+
+    budget = task.time_limit if task.time_limit is not None else MAX_SECONDS
+    return 2.0 * budget + GRACE
 
 
-# ----------------------------------------------------------------------------------------------
-# Results files
-# ----------------------------------------------------------------------------------------------
-def read_rows(path: str | Path) -> list[dict[str, Any]]:
-    """The complete rows of a JSON-lines results file (a torn last line is ignored)."""
-    rows = []
-    p = Path(path)
-    if not p.exists():
-        return rows
-    with p.open() as fh:
-        for line in fh:
-            try:
-                row = json.loads(line)
-            except json.JSONDecodeError:
-                continue  # an interrupted write; the task runs again
-            if isinstance(row, dict):
-                rows.append(row)
-    return rows
+def _warm() -> None:
+    """Imports a worker does once, so that its forked children start planning at once."""
+    import numpy  # noqa: F401
+    import scipy.sparse.csgraph  # noqa: F401
+    import shapely  # noqa: F401
+
+    from ..planners import default_registry
+
+    default_registry()  # imports OMPL's modules and every plugin, creates no OMPL object
 
 
-def _row_key(row: Mapping[str, Any]) -> tuple[str, str, int, float | None]:
-    return (row.get("file"), row.get("planner"), row.get("seed"), row.get("budget"))
+def _row_of(task: Task, result: Any) -> dict[str, Any]:
+    from .workers import ChildFailure
+
+    if isinstance(result, ChildFailure):
+        return error_row(task, f"{task.file}: {result.message}")
+    return result
 
 
 # ----------------------------------------------------------------------------------------------
 # Executors
 # ----------------------------------------------------------------------------------------------
 def _local_results(tasks: list[Task], jobs: int) -> Iterator[dict[str, Any]]:
-    ctx = mp.get_context("spawn")
-    # One task per child: a fresh process, so OMPL takes each task's seed.
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, max_tasks_per_child=1)
-    try:
-        pending: set[Future] = {pool.submit(run_task, t) for t in tasks}
-        while pending:
-            done, pending = wait(pending, return_when=FIRST_COMPLETED)
-            for fut in done:
-                yield fut.result()
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+    from .workers import run_local
+
+    for task, result in run_local(tasks, run_task, jobs, warm=_warm, prepare=prepare_task,
+                                  timeout_of=_timeout):  # fmt: skip
+        yield _row_of(task, result)
+
+
+def _run_isolated(task: Task) -> dict[str, Any]:
+    """``run_task`` in a process of its own (inside a long-lived Dask worker, which may run
+    threads, so it is spawned rather than forked)."""
+    from .workers import run_spawned
+
+    return _row_of(task, run_spawned(run_task, task, _timeout(task)))
 
 
 def _dask_results(tasks: list[Task], scheduler: str | Any) -> Iterator[dict[str, Any]]:
@@ -276,6 +289,7 @@ def run_batch(
     *,
     jobs: int = 1,
     resume: bool = False,
+    overwrite: bool = False,
     executor: str = "local",
     scheduler: Any = None,
     progress: Callable[[dict[str, Any]], None] | None = None,
@@ -288,10 +302,15 @@ def run_batch(
     ----------
     tasks : iterable of Task
     out : path
-        The results file. Without ``resume`` it is started afresh; with ``resume`` the rows it
-        already holds are kept and their tasks skipped (error rows are retried).
+        The results file (:class:`~rrtpso_ompl.evaluation.results_file.ResultsFile`: locked while
+        the batch runs, appended to, never replaced).
     jobs : int
         Worker processes of the local executor.
+    resume : bool
+        Keep the rows ``out`` holds and skip their tasks (error rows are retried).
+    overwrite : bool
+        Start afresh when ``out`` holds rows of an earlier run (without ``resume`` or this, such
+        a file is refused).
     executor : {"local", "dask"}
     scheduler : str or distributed.Client
         Dask scheduler address (or a client) for ``executor="dask"``.
@@ -307,40 +326,42 @@ def run_batch(
     Returns
     -------
     list of dict
-        All rows of the file: the kept ones and the new ones.
+        One row per run (the kept ones and the new ones).
+
+    Raises
+    ------
+    UsageError
+        When ``out`` is being written by another batch, holds rows and neither ``resume`` nor
+        ``overwrite`` is given, or is not a results file of this package.
     """
     tasks = list(tasks)
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    kept: list[dict[str, Any]] = []
-    if resume:
-        kept = [r for r in read_rows(out) if not r.get("error")]
-    done = {_row_key(r) for r in kept}
-    todo = [t for t in tasks if t.key not in done]
-    if on_start is not None:
-        on_start(len(todo), len(tasks) - len(todo))
-    # Rewrite the kept rows first: this drops a torn last line and retried error rows.
-    write_text_atomic("".join(json_line(r) for r in kept), out)
-    rows = list(kept)
-    if executor == "local":
-        results = _local_results(todo, max(1, jobs))
-    elif executor == "dask":
-        if scheduler is None:
-            raise ValueError("the dask executor needs a scheduler address")
-        results = _dask_results(todo, scheduler)
-    else:
+    if executor not in ("local", "dask"):
         raise ValueError(f"unknown executor {executor!r} (local or dask)")
-    optima = _Optima() if optimum else None
-    with out.open("a", buffering=1) as fh:
-        for row in results:
-            if optima is not None:
-                optima.annotate(row)
-            fh.write(json_line(row))  # one whole line per write: never a torn row mid-file
-            fh.flush()
-            rows.append(row)
-            if progress is not None:
-                progress(row)
-    return rows
+    if executor == "dask" and scheduler is None:
+        raise ValueError("the dask executor needs a scheduler address")
+    with ResultsFile(out, resume=resume, overwrite=overwrite) as results:
+        kept = [r for r in results.kept if not r.get("error")]
+        done = {row_key(r) for r in kept}
+        todo = [t for t in tasks if t.key not in done]
+        if on_start is not None:
+            on_start(len(todo), len(tasks) - len(todo))
+        rows = list(kept)
+        if executor == "local":
+            stream = _local_results(todo, max(1, jobs))
+        else:
+            stream = _dask_results(todo, scheduler)
+        optima = _Optima() if optimum else None
+        try:
+            for row in stream:
+                if optima is not None:
+                    optima.annotate(row)
+                results.append(row)
+                rows.append(row)
+                if progress is not None:
+                    progress(row)
+        finally:
+            stream.close()  # on Ctrl-C: stop the workers before the file is released
+    return latest_rows(rows)
 
 
 class _Optima:
@@ -351,12 +372,12 @@ class _Optima:
 
     def length(self, file: str) -> float | None:
         if file not in self._cache:
-            from ..model.problem import ProblemError, load_problem
+            from ..model.problem import load_problem
             from .optimum import shortest_path
 
             try:
                 self._cache[file] = shortest_path(load_problem(file)).length
-            except (ProblemError, OSError):
+            except (RrtpsoError, OSError, MemoryError):
                 self._cache[file] = None  # the row already says why
         return self._cache[file]
 

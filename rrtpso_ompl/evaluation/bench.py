@@ -42,6 +42,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..errors import UsageError
 from ..outputs import atomic_path, write_text_atomic
 from ..planners.result import BenchmarkRun
 from .batch import Task, make_tasks, run_batch
@@ -162,6 +163,7 @@ def run_bench(
     on_start: Callable[[int, int], None] | None = None,
     command: str | None = None,
     simplify: bool | None = None,
+    overwrite: bool = False,
 ) -> BenchResult:
     """Run a benchmark and write its results to ``out_dir`` (see the module docstring).
 
@@ -185,26 +187,79 @@ def run_bench(
     simplify : bool, optional
         Follow every planner with OMPL's simplifier (True), none (False, e.g. the paper's
         Table 3 of raw paths), or as its registry entry says (None).
+    overwrite : bool
+        Start afresh in a folder that holds an earlier bench (without it, or ``resume``, such a
+        folder is refused).
 
     Returns
     -------
     BenchResult
+
+    Raises
+    ------
+    UsageError
+        When the folder holds files of this bench's names that no bench wrote, another bench is
+        writing it, or it holds an earlier bench and neither ``resume`` nor ``overwrite`` is given.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    _check_out_dir(out)
     tasks = bench_tasks(items, planners, runs, times, seed, params, simplify)
-    rows = run_batch(tasks, out / "runs.jsonl", jobs=jobs, resume=resume, executor=executor,
-                     scheduler=scheduler, progress=progress, on_start=on_start)  # fmt: skip
+    rows = run_batch(tasks, out / "runs.jsonl", jobs=jobs, resume=resume, overwrite=overwrite,
+                     executor=executor, scheduler=scheduler, progress=progress,
+                     on_start=on_start)  # fmt: skip
     errors = sorted({r["error"] for r in rows if r.get("error")})
     good = [r for r in rows if not r.get("error")]
     experiments = to_experiments(good, planners, runs, seed)
-    for stale in out.glob("*.log"):  # from an earlier bench into the same folder
+    for stale in _our_logs(out):  # from an earlier bench into the same folder
         stale.unlink()
-    logs = [write_log(e, out / f"{e.name}.log") for e in experiments]
+    logs = [write_log(e, _free_log_name(out, e.name)) for e in experiments]
     database = build_database(logs, out / "benchmark.db") if logs else None
     summary = summarise(good, planners)
     write_report(summary, out, errors=errors, command=command)
     return BenchResult(rows, summary, out, logs, database, errors)
+
+
+#: The files a bench writes into its folder besides runs.jsonl and the logs.
+OUTPUT_FILES = ("benchmark.db", "report.md", "report.csv", "ratio.png", "success.png")
+#: The line of a log's setup block that says this harness wrote it.
+_HARNESS = "harness: rrtpso bench (one process per run, exact collision checks)"
+
+
+def _check_out_dir(out: Path) -> None:
+    """Refuse a folder whose output files were not written by a bench (no runs.jsonl)."""
+    if (out / "runs.jsonl").exists():
+        return  # an earlier bench: run_batch decides (resume, overwrite, or refuse)
+    foreign = [name for name in OUTPUT_FILES if (out / name).exists()]
+    if foreign:
+        raise UsageError(
+            f"--out {out}: the folder holds {', '.join(foreign)} but no runs.jsonl, so no rrtpso "
+            "bench wrote them; they are left as they are: choose an empty or new folder"
+        )
+
+
+def _is_our_log(path: Path) -> bool:
+    try:
+        with path.open(encoding="utf-8", errors="replace") as fh:
+            head = fh.read(4096)
+    except OSError:
+        return False
+    return head.startswith("rrtpso-ompl version") and _HARNESS in head
+
+
+def _our_logs(out: Path) -> list[Path]:
+    """The OMPL logs an earlier bench wrote into ``out`` (any other ``.log`` is left alone)."""
+    return [p for p in out.glob("*.log") if p.is_file() and _is_our_log(p)]
+
+
+def _free_log_name(out: Path, name: str) -> Path:
+    """``out/<name>.log``, or ``<name>_2.log`` ... when a file not written by a bench has it."""
+    path = out / f"{name}.log"
+    k = 2
+    while path.exists() and not _is_our_log(path):
+        path = out / f"{name}_{k}.log"
+        k += 1
+    return path
 
 
 # ----------------------------------------------------------------------------------------------
@@ -304,8 +359,7 @@ def to_experiments(
                 seed=seed,
                 total_time=sum(r.get("wall") or 0.0 for r in group),
                 host=host,
-                setup=f"problem file: {file}\nplanners: {', '.join(planners)}\n"
-                "harness: rrtpso bench (one process per run, exact collision checks)",
+                setup=f"problem file: {file}\nplanners: {', '.join(planners)}\n{_HARNESS}",
                 properties=props,
             )
         )

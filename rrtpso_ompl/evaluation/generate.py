@@ -50,6 +50,12 @@ __all__ = [
     "write_problem",
 ]
 
+#: Most obstacles of a circle or polygon field, and most cells per side of a maze: the bounds of
+#: every loop and allocation the generator makes (a maze of 200 x 200 cells has about 80,000
+#: walls).
+MAX_OBSTACLES = 100_000
+MAX_CELLS = 200
+
 #: The kinds of problem :func:`generate` can make.
 KINDS = ("circles", "polygons", "maze")
 
@@ -307,7 +313,7 @@ class _FieldSpec:
     @classmethod
     def build(cls, kind, size, n, robot_radius, radius_range, vertices, gap) -> _FieldSpec:
         default_n = 30 if kind == "circles" else 20
-        n = _option("n", check_integer, default_n if n is None else n, low=1)
+        n = _option("n", check_integer, default_n if n is None else n, low=1, high=MAX_OBSTACLES)
         default_range = (0.02, 0.06) if kind == "circles" else (0.03, 0.08)
         if radius_range is None:
             radius_range = (default_range[0] * size, default_range[1] * size)
@@ -426,7 +432,9 @@ class _MazeSpec:
 
     @classmethod
     def build(cls, size, cells, robot_radius, wall, algorithm, resolution) -> _MazeSpec:
-        cells = _option("cells", check_integer, 8 if cells is None else cells, low=2)
+        cells = _option(
+            "cells", check_integer, 8 if cells is None else cells, low=2, high=MAX_CELLS
+        )
         cell = size / cells
         wall = _option(
             "wall", check_number, 0.1 * cell if wall is None else wall, low=0.0, strict_low=True

@@ -55,16 +55,14 @@ class Trajectory:
         return np.column_stack([getattr(self, name) for name in CSV_HEADER])
 
     def write_csv(self, path: str | Path) -> None:
-        """Write the CSV with exactly the header ``t,x,y,theta,v,omega,...``."""
-        from ..outputs import publish_atomic
+        """Write the CSV with exactly the header ``t,x,y,theta,v,omega,...`` (published whole, see
+        :func:`rrtpso_ompl.outputs.publish`)."""
+        from ..outputs import atomic_path
 
-        path = Path(path)
-        tmp = path.with_name(f".{path.name}.tmp")
-        with tmp.open("w", newline="") as fh:
+        with atomic_path(path) as tmp, open(tmp, "w", newline="") as fh:
             writer = csv.writer(fh)
             writer.writerow(CSV_HEADER)
             writer.writerows([[f"{v:.9g}" for v in row] for row in self.columns()])
-        publish_atomic(tmp, path)
 
     @property
     def path_length(self) -> float:

@@ -21,10 +21,21 @@ from typing import Any
 
 import numpy as np
 import shapely
-import yaml
 
 from ..errors import ProblemError
-from ..validation import check_number, check_seed, describe, short_repr
+from ..validation import (
+    MAX_COORDINATE,
+    MIN_EXTENT,
+    check_number,
+    check_seconds,
+    check_seed,
+    describe,
+)
+from .format import MOVING, OBSTACLES, PLANNER, ROBOT, TOP
+from .yamlfile import read_yaml_file
+
+#: Why coordinates and lengths are bounded (for messages).
+_SCALE = "exact checks allow for round-off of 1e-9 of the workspace's scale"
 
 __all__ = [
     "Circle",
@@ -170,22 +181,8 @@ def load_problem(path: str | Path) -> Problem:
         robot disc overlapping an obstacle, non-positive time limit.
     """
     path = Path(path)
-    source = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ProblemError(source, "", "no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ProblemError(source, "", f"cannot read the file: {exc}") from None
-    try:
-        data = _load_yaml(text)
-    except yaml.YAMLError as exc:
-        raise ProblemError(source, "", f"malformed YAML{_yaml_message(exc)}") from None
-    except RecursionError:
-        raise ProblemError(
-            source, "", "malformed YAML: lists or mappings nested too deeply"
-        ) from None
-    return problem_from_dict(data, source=source, name=path.stem)
+    data = read_yaml_file(path)
+    return problem_from_dict(data, source=str(path), name=path.stem)
 
 
 def problem_from_dict(data: Any, source: str = "<dict>", name: str | None = None) -> Problem:
@@ -214,7 +211,7 @@ def problem_from_dict(data: Any, source: str = "<dict>", name: str | None = None
     v = _Validator(source)
     if data is None:
         raise v.error("", "the file is empty; a problem needs at least bounds, start, goal, robot")
-    doc = v.mapping(data, "", _TOP_KEYS, required=("bounds", "start", "goal", "robot"))
+    doc = v.mapping(data, "", _TOP_KEYS, required=_REQUIRED)
     bounds = v.bounds(doc["bounds"], "bounds")
     robot = v.robot(doc["robot"], "robot")
     obstacles = tuple(
@@ -246,37 +243,14 @@ def problem_from_dict(data: Any, source: str = "<dict>", name: str | None = None
 # ----------------------------------------------------------------------------------------------
 # Validation helpers: each takes the key path it is checking, so every error can name it.
 # ----------------------------------------------------------------------------------------------
-_TOP_KEYS = (
-    "name",
-    "description",
-    "units",
-    "bounds",
-    "start",
-    "goal",
-    "goal_tolerance",
-    "robot",
-    "obstacles",
-    "moving_obstacles",
-    "planner",
-)
-_ROBOT_KEYS = (
-    "radius",
-    "wheel_radius",
-    "track_width",
-    "speed",
-    "sample_time",
-    "sensor_range",
-    "max_speed",
-    "max_wheel_speed",
-    "max_accel",
-)
-_PLANNER_KEYS = ("type", "time_limit", "seed", "params")
-_OBSTACLE_KEYS = {
-    "circle": ("type", "center", "radius"),
-    "rectangle": ("type", "min", "max"),
-    "polygon": ("type", "points"),
-}
-_MOVING_KEYS = ("radius", "start", "speed", "heading_deg")
+# The key tables come from the format's declarations (:mod:`rrtpso_ompl.model.format`), which
+# also make the JSON Schema: one list of keys for both.
+_TOP_KEYS = TOP.names()
+_ROBOT_KEYS = ROBOT.names()
+_PLANNER_KEYS = PLANNER.names()
+_OBSTACLE_KEYS = {kind: section.names() for kind, section in OBSTACLES.items()}
+_MOVING_KEYS = MOVING.names()
+_REQUIRED = TOP.required()
 
 
 class _Validator:
@@ -337,7 +311,21 @@ class _Validator:
     def point(self, value: Any, key: str) -> Point:
         if not isinstance(value, list | tuple) or len(value) != 2:
             raise self.error(key, f"must be a point [x, y], got {describe(value)}")
-        return (self.number(value[0], f"{key}[0]"), self.number(value[1], f"{key}[1]"))
+        return (self.coordinate(value[0], f"{key}[0]"), self.coordinate(value[1], f"{key}[1]"))
+
+    def coordinate(self, value: Any, key: str) -> float:
+        """A coordinate: a number of magnitude at most :data:`MAX_COORDINATE`."""
+        x = self.number(value, key)
+        if abs(x) > MAX_COORDINATE:
+            raise self.error(key, f"must be within +-{MAX_COORDINATE:g} ({_SCALE}), got {x:g}")
+        return x
+
+    def length(self, value: Any, key: str, strict: bool = False) -> float:
+        """A length or speed: a number >= 0 (> 0 with ``strict``), at most ``MAX_COORDINATE``."""
+        x = self.number(value, key, low=0.0, strict=strict)
+        if x > MAX_COORDINATE:
+            raise self.error(key, f"must be at most {MAX_COORDINATE:g} ({_SCALE}), got {x:g}")
+        return x
 
     # -- sections ----------------------------------------------------------------------------------
     def bounds(self, value: Any, key: str) -> tuple[Point, Point]:
@@ -346,17 +334,20 @@ class _Validator:
         lo, hi = self.point(value[0], f"{key}[0]"), self.point(value[1], f"{key}[1]")
         if not (lo[0] < hi[0] and lo[1] < hi[1]):
             raise self.error(key, f"needs xmin < xmax and ymin < ymax, got {lo} and {hi}")
-        # The touching tolerance is relative to the workspace size, which must itself be finite.
-        if not math.isfinite(max(hi[0] - lo[0], hi[1] - lo[1])):
-            raise self.error(key, "the workspace is too large for floating-point arithmetic")
+        if min(hi[0] - lo[0], hi[1] - lo[1]) < MIN_EXTENT:
+            raise self.error(
+                key,
+                f"the workspace is too small to plan in: sides {hi[0] - lo[0]:g} x "
+                f"{hi[1] - lo[1]:g}, each must be at least {MIN_EXTENT:g}",
+            )
         return lo, hi
 
     def robot(self, value: Any, key: str) -> Robot:
-        doc = self.mapping(value, key, _ROBOT_KEYS, required=("radius",))
+        doc = self.mapping(value, key, _ROBOT_KEYS, required=ROBOT.required())
         # Radius 0 is a point robot, which is a legitimate (classic) planning problem.
-        radius = self.number(doc["radius"], f"{key}.radius", low=0.0)
+        radius = self.length(doc["radius"], f"{key}.radius")
         optional = {
-            k: self.number(doc[k], f"{key}.{k}", low=0.0, strict=True)
+            k: self.length(doc[k], f"{key}.{k}", strict=True)
             for k in _ROBOT_KEYS[1:]
             if doc.get(k) is not None
         }
@@ -370,7 +361,10 @@ class _Validator:
             ptype = self.string(ptype, f"{key}.type")
         limit = doc.get("time_limit")
         if limit is not None:
-            limit = self.number(limit, f"{key}.time_limit", low=0.0, strict=True)
+            try:
+                limit = check_seconds(self.number(limit, f"{key}.time_limit"))
+            except ValueError as exc:
+                raise self.error(f"{key}.time_limit", str(exc)) from None
         seed = doc.get("seed")
         if seed is not None:
             if not isinstance(seed, numbers.Integral):  # 1.0 is a typo here, not a seed
@@ -403,7 +397,7 @@ class _Validator:
         doc = self.mapping(value, key, allowed, required=allowed, what=f" for a {kind}")
         if kind == "circle":
             center = self.point(doc["center"], f"{key}.center")
-            radius = self.number(doc["radius"], f"{key}.radius", low=0.0, strict=True)
+            radius = self.length(doc["radius"], f"{key}.radius", strict=True)
             return Circle(center, radius)
         if kind == "rectangle":
             lo = self.point(doc["min"], f"{key}.min")
@@ -446,9 +440,9 @@ class _Validator:
         doc = self.mapping(value, key, _MOVING_KEYS, required=_MOVING_KEYS)
         # No bounds check: a moving obstacle may well enter the workspace from outside.
         return MovingObstacle(
-            radius=self.number(doc["radius"], f"{key}.radius", low=0.0, strict=True),
+            radius=self.length(doc["radius"], f"{key}.radius", strict=True),
             start=self.point(doc["start"], f"{key}.start"),
-            speed=self.number(doc["speed"], f"{key}.speed", low=0.0),
+            speed=self.length(doc["speed"], f"{key}.speed"),
             heading_deg=self.number(doc["heading_deg"], f"{key}.heading_deg"),
         )
 
@@ -464,7 +458,8 @@ class _Validator:
                 f"[{xmin:g}, {xmax:g}] x [{ymin:g}, {ymax:g}]",
             )
         r = problem.robot.radius
-        need = clearance_threshold(r, touch_tolerance(max(xmax - xmin, ymax - ymin)))
+        tol = touch_tolerance(problem.bounds)
+        need = clearance_threshold(r, tol)
         for i, obs in enumerate(problem.obstacles):
             d = _clearance(obs, x, y)
             if d >= need:
@@ -472,6 +467,13 @@ class _Validator:
             if r == 0.0:
                 raise self.error(
                     key, f"the point ({x:g}, {y:g}) lies in or on obstacles[{i}] ({obs.kind})"
+                )
+            if d >= r:  # only within the round-off allowance: say so, not "overlaps"
+                raise self.error(
+                    key,
+                    f"the robot disc (radius {r:g}) at ({x:g}, {y:g}) touches obstacles[{i}] "
+                    f"({obs.kind}) within the round-off allowance {tol:.3g} of this workspace: "
+                    f"clearance {d:.6g}",
                 )
             raise self.error(
                 key,
@@ -483,89 +485,16 @@ class _Validator:
 # ----------------------------------------------------------------------------------------------
 # Small pure helpers.
 # ----------------------------------------------------------------------------------------------
-class _SafeLoader(yaml.SafeLoader):
-    """``yaml.SafeLoader`` whose value errors carry the line and column of the value.
+def touch_tolerance(bounds: tuple[Point, Point]) -> float:
+    """Round-off allowance for "touching is allowed" comparisons in a workspace.
 
-    PyYAML's constructors raise plain ``ValueError``, ``KeyError`` and others for values such as
-    ``2020-13-45`` or ``!!int abc``. Converting them here, where the node (and so its position in
-    the file) is known, turns them into ordinary YAML errors with a location.
+    ``1e-9`` of the workspace's scale: the larger of its sides and of its coordinates' magnitudes
+    (float spacing grows with both), at least ``1e-9``. Far below any physical clearance, well
+    above float round-off in the distance formulas.
     """
-
-    def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:
-        try:
-            return super().construct_object(node, deep=deep)
-        except (yaml.YAMLError, RecursionError):
-            raise
-        except Exception as exc:
-            raise yaml.constructor.ConstructorError(
-                None,
-                None,
-                f"cannot read the value {short_repr(node.value)}: {exc}",
-                node.start_mark,
-            ) from None
-
-
-def _load_yaml(text: str) -> Any:
-    """``yaml.safe_load`` that also refuses duplicate keys.
-
-    PyYAML silently keeps the last of two equal keys, so a second ``radius:`` would quietly win;
-    the YAML spec requires keys to be unique. The check runs on the composed node graph, before
-    construction, where merge keys (``<<``) are still distinguishable from written keys.
-    """
-    loader = _SafeLoader(text)
-    try:
-        node = loader.get_single_node()
-        if node is None:
-            return None
-        _refuse_duplicate_keys(node)
-        return loader.construct_document(node)
-    finally:
-        loader.dispose()
-
-
-def _refuse_duplicate_keys(root: yaml.Node) -> None:
-    # Iterative, and each node once: aliases may share or even contain their own nodes.
-    seen_nodes: set[int] = set()
-    stack = [root]
-    while stack:
-        node = stack.pop()
-        if id(node) in seen_nodes:
-            continue
-        seen_nodes.add(id(node))
-        if isinstance(node, yaml.MappingNode):
-            first: dict[tuple[str, str], yaml.Node] = {}
-            for key, value in node.value:
-                if isinstance(key, yaml.ScalarNode) and key.tag != "tag:yaml.org,2002:merge":
-                    other = first.setdefault((key.tag, key.value), key)
-                    if other is not key:
-                        raise yaml.constructor.ConstructorError(
-                            None,
-                            None,
-                            f"duplicate key {short_repr(key.value)} "
-                            f"(first written at line {other.start_mark.line + 1})",
-                            key.start_mark,
-                        )
-                stack.extend((key, value))
-        elif isinstance(node, yaml.SequenceNode):
-            stack.extend(node.value)
-
-
-def _yaml_message(exc: yaml.YAMLError) -> str:
-    """`` at line L, column C: what`` (1-based, as editors count) from a PyYAML error."""
-    mark = getattr(exc, "problem_mark", None)
-    where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-    lines = str(exc).strip().splitlines()
-    what = getattr(exc, "problem", None) or (lines[0] if lines else type(exc).__name__)
-    return f"{where}: {what}"
-
-
-def touch_tolerance(size: float) -> float:
-    """Round-off allowance for "touching is allowed" comparisons in a workspace of ``size``.
-
-    ``1e-9`` of the workspace's larger side (at least ``1e-9``): far below any physical clearance,
-    well above float round-off in the distance formulas.
-    """
-    return 1e-9 * max(size, 1.0)
+    (xmin, ymin), (xmax, ymax) = bounds
+    scale = max(xmax - xmin, ymax - ymin, abs(xmin), abs(ymin), abs(xmax), abs(ymax), 1.0)
+    return 1e-9 * scale
 
 
 def clearance_threshold(robot_radius: float, tol: float) -> float:

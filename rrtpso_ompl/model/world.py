@@ -72,7 +72,7 @@ class World:
         self.bounds = ((float(xmin), float(ymin)), (float(xmax), float(ymax)))
         self.robot_radius = float(robot_radius)
         #: Absolute tolerance for "touching is allowed" comparisons (floating-point round-off).
-        self.tol = touch_tolerance(max(xmax - xmin, ymax - ymin))
+        self.tol = touch_tolerance(self.bounds)
 
         circ = np.asarray(circles, dtype=float).reshape(-1, 3)
         self.circles = circ

@@ -25,6 +25,7 @@ from ompl import base as ob
 from ompl import util as ou
 
 from ..model.problem import touch_tolerance
+from ..validation import MAX_SECONDS, SEED_MAX
 from .params import ParamSpec, ParamTable
 from .result import BenchmarkRun
 
@@ -50,6 +51,7 @@ BUDGET = ParamSpec(
     "termination condition and bounds its later stages by their iterations only.",
     unit="s",
     low=0.0,
+    high=MAX_SECONDS,
 )
 #: The seed of a planner's own numpy Generator.
 SEED = ParamSpec(
@@ -59,7 +61,7 @@ SEED = ParamSpec(
     "Seed of the planner's numpy Generator; -1 draws it from OMPL's RNG "
     "(so ompl.util.RNG.setSeed makes the whole run reproducible).",
     low=-1,
-    high=2**32 - 1,
+    high=SEED_MAX,
 )
 
 
@@ -107,9 +109,7 @@ class SpaceInformationCollisionModel:
         self.si = si
         bounds = si.getStateSpace().getBounds()
         self.bounds = ((bounds.low[0], bounds.low[1]), (bounds.high[0], bounds.high[1]))
-        self.tol = touch_tolerance(
-            max(bounds.high[0] - bounds.low[0], bounds.high[1] - bounds.low[1])
-        )
+        self.tol = touch_tolerance(self.bounds)
         self.robot_radius = 0.0
         self._a = si.allocState()
         self._b = si.allocState()

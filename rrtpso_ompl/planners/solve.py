@@ -21,7 +21,7 @@ from ..model.geometry import path_length
 from ..model.problem import Problem
 from ..model.world import World
 from ..ompl_setup import PlanningContext, make_context, path_to_array, seed_ompl
-from ..validation import check_number
+from ..validation import check_seconds, check_seed
 from .registry import PlannerEntry, PlannerRegistry, default_registry
 from .result import BenchmarkRun, SolveResult
 
@@ -91,10 +91,15 @@ def resolve_request(
     entry = registry.get(planner or cfg.type or DEFAULT_PLANNER)
     limit = time_limit if time_limit is not None else (cfg.time_limit or DEFAULT_TIME_LIMIT)
     try:
-        limit = check_number(limit, low=0.0, strict_low=True)
+        limit = check_seconds(limit)
     except ValueError as exc:
         raise ParameterError(f"time limit {exc}", "time_limit") from None
     seed = seed if seed is not None else cfg.seed
+    if seed is not None:
+        try:
+            seed = check_seed(seed)
+        except ValueError as exc:
+            raise ParameterError(f"seed {exc}", "seed") from None
     values: dict[str, Any] = {**cfg.params, **(params or {})}
     # Planners that split their time (RRTstarPSO) need to know it: OMPL's termination condition
     # does not say how much is left.

@@ -283,3 +283,17 @@ def test_cli_bad_file_exit_2(tmp_path):
     assert proc.returncode == 2
     assert str(bad) in proc.stderr and "goal" in proc.stderr and "Traceback" not in proc.stderr
     assert not out.exists()
+
+
+@pytest.mark.parametrize("path", sorted((PROBLEMS / "static").glob("*.yaml")), ids=lambda p: p.stem)
+def test_the_json_path_is_a_valid_path_of_nearly_the_exact_length(path):
+    """Arcs become circumscribed polygons, not chords: the exact checker accepts the path."""
+    problem = load_problem(path)
+    world = World.from_problem(problem)
+    result = shortest_path(problem, world)
+    polyline = np.asarray(result.to_dict(world)["path"])
+    assert world.path_valid(polyline)
+    assert result.length <= path_length(polyline) <= result.length * (1 + 2e-4)
+    # The old chords were not valid wherever the path wraps an obstacle.
+    chords = np.vstack([p.points()[[0, -1]] for p in result.pieces])
+    assert path_length(chords) <= path_length(polyline)

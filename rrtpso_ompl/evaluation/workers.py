@@ -1,0 +1,258 @@
+"""Running tasks in parallel, each with a fresh OMPL, without paying for a fresh Python each time.
+
+OMPL takes its seed once per process, before any of its random generators exists, and a process
+forked after OMPL was used repeats its parent's random numbers. So every run needs an OMPL of its
+own. Starting a whole Python for it costs about half a second (numpy, scipy, shapely and OMPL
+imports). Instead:
+
+- a **warm worker** is a spawned process that has imported everything and loaded the problems it
+  was given, but has never created an OMPL object;
+- for each run it **forks a child**, which seeds OMPL first, solves, sends its row back through
+  a pipe and exits; a fork of a warm worker costs milliseconds;
+- a child that dies (a crash in OMPL, the kernel's out-of-memory killer) or overruns its time
+  becomes an error row; the worker goes on with the next task. A worker that dies itself is
+  replaced, and its task becomes an error row.
+
+Where ``os.fork`` does not exist the worker starts a spawned process per run instead (correct,
+slower). Workers and their children ignore Ctrl-C: the parent handles it, stops them and leaves
+its results file valid.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import faulthandler
+import multiprocessing as mp
+import os
+import pickle
+import select
+import signal
+import time
+import traceback
+from collections.abc import Callable, Iterable, Iterator
+from multiprocessing.connection import Connection, wait
+from typing import Any
+
+__all__ = ["GRACE", "ChildFailure", "run_local", "run_once_in_child", "run_spawned"]
+
+#: Seconds a run may take beyond its budget before its child is killed (imports are done, so
+#: this covers building the world, the optimum, and a slow machine).
+GRACE = 120.0
+
+
+def run_once_in_child(fn: Callable[[Any], dict[str, Any]], task: Any, timeout: float) -> Any:
+    """``fn(task)`` in a forked child (a spawned process without ``os.fork``); its return value,
+    or an :class:`ChildFailure` describing how the child ended."""
+    if not hasattr(os, "fork"):
+        return run_spawned(fn, task, timeout)
+    r, w = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: never returns
+        os.close(r)
+        faulthandler.disable()  # a crash is reported as the task's error row, not as a dump
+        code = 0
+        try:
+            payload = pickle.dumps(("ok", fn(task)))
+        except BaseException as exc:
+            payload = pickle.dumps(("raised", f"{type(exc).__name__}: {exc}",
+                                    traceback.format_exc(limit=5)))  # fmt: skip
+            code = 1
+        try:
+            view = memoryview(payload)
+            while view:
+                view = view[os.write(w, view) :]
+        finally:
+            os._exit(code)  # no atexit handlers, no nanobind leak reports, no flushing twice
+    os.close(w)
+    data = _read_all(r, timeout)
+    status = _reap(pid, killed=data is None)
+    if data:
+        try:
+            kind, *rest = pickle.loads(data)
+        except Exception:  # a torn message: the child died while writing
+            kind, rest = "torn", []
+        if kind == "ok":
+            return rest[0]
+        if kind == "raised":
+            return ChildFailure(f"the run raised {rest[0]}", detail=rest[1])
+    if data is None:
+        return ChildFailure(f"the run took longer than {timeout:.0f} s and was stopped")
+    return ChildFailure(f"the run's process died ({status})")
+
+
+class ChildFailure:
+    """How a child run failed (it becomes the task's error row)."""
+
+    def __init__(self, message: str, detail: str = "") -> None:
+        self.message = message
+        self.detail = detail
+
+    def __repr__(self) -> str:
+        return f"ChildFailure({self.message!r})"
+
+
+def _read_all(fd: int, timeout: float) -> bytes | None:
+    """Everything written to the pipe until the writer closes it; None on timeout."""
+    chunks = []
+    deadline = time.monotonic() + timeout
+    try:
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return None
+            ready, _, _ = select.select([fd], [], [], left)
+            if not ready:
+                return None
+            chunk = os.read(fd, 1 << 20)
+            if not chunk:
+                return b"".join(chunks)
+            chunks.append(chunk)
+    finally:
+        os.close(fd)
+
+
+def _reap(pid: int, killed: bool) -> str:
+    """Wait for the child (killing it first when it overran); how it ended, in words."""
+    if killed:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGKILL)
+    _, status = os.waitpid(pid, 0)
+    if os.WIFSIGNALED(status):
+        sig = os.WTERMSIG(status)
+        try:
+            name = signal.Signals(sig).name
+        except ValueError:
+            name = str(sig)
+        return f"killed by signal {name}"
+    return f"exit status {os.WEXITSTATUS(status)}"
+
+
+def run_spawned(fn: Callable[[Any], Any], task: Any, timeout: float) -> Any:
+    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
+
+    with ProcessPoolExecutor(1, mp_context=mp.get_context("spawn")) as pool:
+        try:
+            return pool.submit(fn, task).result(timeout=timeout)
+        except BrokenProcessPool:
+            return ChildFailure("the run's process died")
+        except Exception as exc:
+            return ChildFailure(f"the run raised {type(exc).__name__}: {exc}")
+
+
+# ----------------------------------------------------------------------------------------------
+# The local pool of warm workers
+# ----------------------------------------------------------------------------------------------
+def _worker_main(conn: Connection, fn: Callable[[Any], Any], warm: Callable[[], None] | None,
+                 prepare: Callable[[Any], None] | None,
+                 timeout_of: Callable[[Any], float]) -> None:  # fmt: skip
+    """A warm worker: imports once, then runs each task it receives in a forked child, after
+    ``prepare(task)`` (loading its problem, which the following runs of it share)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
+    if hasattr(os, "setpgrp"):
+        os.setpgrp()  # the worker and its children: one group the parent can stop at once
+    if warm is not None:
+        warm()
+    while True:
+        try:
+            message = conn.recv()
+        except (EOFError, OSError):
+            return
+        if message is None:
+            return
+        index, task = message
+        if prepare is not None:
+            with contextlib.suppress(Exception):
+                prepare(task)
+        conn.send((index, run_once_in_child(fn, task, timeout_of(task))))
+
+
+class _Worker:
+    def __init__(self, ctx: Any, fn, warm, prepare, timeout_of) -> None:
+        self.conn, child = ctx.Pipe()
+        self.process = ctx.Process(target=_worker_main,
+                                   args=(child, fn, warm, prepare, timeout_of),
+                                   daemon=True)  # fmt: skip
+        self.process.start()
+        child.close()
+        self.busy: tuple[int, Any] | None = None
+
+    def give(self, index: int, task: Any) -> None:
+        self.busy = (index, task)
+        self.conn.send((index, task))
+
+    def stop(self, force: bool) -> None:
+        if force:
+            self._kill()
+        else:
+            with contextlib.suppress(OSError):
+                self.conn.send(None)
+        self.process.join(timeout=5)
+        if self.process.is_alive():
+            self._kill()
+        self.process.join()
+
+    def _kill(self) -> None:
+        """Kill the worker and the child it may be running (its process group)."""
+        try:
+            os.killpg(self.process.pid, signal.SIGKILL)
+        except (AttributeError, ProcessLookupError, PermissionError):
+            self.process.kill()
+
+
+def run_local(
+    tasks: Iterable[Any],
+    fn: Callable[[Any], Any],
+    jobs: int,
+    *,
+    warm: Callable[[], None] | None = None,
+    prepare: Callable[[Any], None] | None = None,
+    timeout_of: Callable[[Any], float],
+) -> Iterator[tuple[Any, Any]]:
+    """Run ``fn(task)`` for every task on ``jobs`` warm workers; yields ``(task, result)`` as they
+    finish, where ``result`` is ``fn``'s value or a :class:`ChildFailure`.
+
+    ``warm()`` runs once in each worker (imports), ``prepare(task)`` in the worker before each
+    fork (what the runs of a task can share); ``timeout_of(task)`` bounds each run. Closing
+    the iterator early (or Ctrl-C in the parent) stops the workers and their children.
+    """
+    ctx = mp.get_context("spawn")
+    queue = list(enumerate(tasks))[::-1]
+    workers = [
+        _Worker(ctx, fn, warm, prepare, timeout_of) for _ in range(max(1, min(jobs, len(queue))))
+    ]
+    clean = False
+    try:
+        for w in workers:
+            if queue:
+                w.give(*queue.pop())
+        while any(w.busy is not None for w in workers):
+            ready = wait([w.conn for w in workers if w.busy] +
+                         [w.process.sentinel for w in workers if w.busy])  # fmt: skip
+            for i, w in enumerate(workers):
+                if w.busy is None:
+                    continue
+                _, task = w.busy
+                result = None
+                if w.conn in ready:
+                    try:
+                        _, result = w.conn.recv()
+                        w.busy = None
+                    except (EOFError, OSError):
+                        pass  # the worker died: its pipe closed (the sentinel follows)
+                if w.busy is not None and (w.conn in ready or w.process.sentinel in ready):
+                    # The worker itself died: its task is lost; replace the worker.
+                    w.process.join(timeout=5)
+                    result = ChildFailure(f"the worker process died (exit code "
+                                          f"{w.process.exitcode})")  # fmt: skip
+                    w.conn.close()
+                    workers[i] = w = _Worker(ctx, fn, warm, prepare, timeout_of)
+                elif result is None and w.busy is not None:
+                    continue
+                if queue:
+                    w.give(*queue.pop())
+                yield task, result
+        clean = True
+    finally:
+        for w in workers:
+            w.stop(force=not clean)

@@ -1,0 +1,318 @@
+"""Hostile input and output through the real command line, as a careless user would try it.
+
+Every case runs ``rrtpso`` in a child process with an address-space limit, in a temporary folder
+(never with system paths as targets), and checks: no traceback, the documented exit status,
+inputs and foreign files unchanged, results files valid line by line.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from helpers import PROBLEMS, rrtpso_exe
+
+#: Address space of every child (bytes): a run that tries to expand a bomb hits it.
+MEMORY_LIMIT = 2 << 30
+CIRCLE = (PROBLEMS / "static" / "single_circle.yaml").read_text()
+DYNAMIC = (PROBLEMS / "dynamic" / "head_on.yaml").read_text()
+
+
+def _limit() -> None:
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
+
+
+def run(*args, cwd: Path, timeout: float = 120, **kwargs) -> subprocess.CompletedProcess:
+    proc = subprocess.run([*rrtpso_exe(), *map(str, args)], cwd=cwd, capture_output=True,
+                          text=True, timeout=timeout, preexec_fn=_limit, **kwargs)  # fmt: skip
+    assert "Traceback" not in proc.stderr, proc.stderr
+    return proc
+
+
+def rows_of(path: Path) -> list[dict]:
+    """Every line of a results file is one JSON row (no torn or foreign lines)."""
+    text = path.read_text()
+    assert text == "" or text.endswith("\n")
+    rows = [json.loads(line) for line in text.splitlines()]
+    assert all({"file", "planner", "seed", "run", "status"} <= set(r) for r in rows)
+    return rows
+
+
+@pytest.fixture
+def folder(tmp_path: Path) -> Path:
+    (tmp_path / "p.yaml").write_text(CIRCLE)
+    (tmp_path / "d.yaml").write_text(DYNAMIC)
+    return tmp_path
+
+
+# ----------------------------------------------------------------------------------------------
+# Data loss and overwriting
+# ----------------------------------------------------------------------------------------------
+def test_a_second_batch_on_the_same_file_is_refused_and_the_first_keeps_its_rows(folder):
+    args = ["batch", "p.yaml", "--planner", "RRTstar", "--runs", "4", "--time", "0.5",
+            "--out", "r.jsonl"]  # fmt: skip
+    first = subprocess.Popen([*rrtpso_exe(), *args], cwd=folder, stderr=subprocess.PIPE,
+                             text=True, preexec_fn=_limit)  # fmt: skip
+    deadline = time.time() + 30
+    while not (folder / "r.jsonl").exists() and time.time() < deadline:
+        time.sleep(0.05)
+    second = run(*args, "--overwrite", cwd=folder)
+    assert second.returncode == 2 and "another rrtpso batch or bench is writing" in second.stderr
+    _, err = first.communicate(timeout=120)
+    assert first.returncode == 0 and "Traceback" not in err
+    assert len(rows_of(folder / "r.jsonl")) == 4
+
+
+def test_outputs_that_are_inputs_or_each_other_are_refused(folder):
+    before = (folder / "p.yaml").read_text()
+    for args, words in [
+        (["solve", "p.yaml", "--json", "p.yaml"], "is an input"),
+        (["batch", "p.yaml", "--out", "p.yaml"], "is an input"),
+        (["solve", "p.yaml", "--json", "x", "--trajectory", "x"], "both name the same file"),
+        (["solve", "p.yaml", "--json", "-", "--trajectory", "-"], "standard output"),
+        (["solve", "p.yaml", "--json", ""], "give a file name"),
+        (["solve", "p.yaml", "--planner", ""], "give a planner name"),
+        (["solve", "p.yaml", "--plot", "-"], "only for text outputs"),
+        (["optimum", "p.yaml", "--json", "p.yaml"], "is an input"),
+    ]:
+        proc = run(*args, cwd=folder)
+        assert proc.returncode == 2 and words in proc.stderr, (args, proc.stderr)
+    assert (folder / "p.yaml").read_text() == before
+    assert not (folder / "x").exists()
+
+
+def test_only_our_results_files_are_resumed_or_replaced(folder):
+    (folder / "notes.txt").write_text("my notes\n")
+    (folder / "keep.jsonl").write_text('{"keep": 1}\n')
+    for target in ("notes.txt", "keep.jsonl"):
+        for flag in ("--resume", "--overwrite", None):
+            extra = [flag] if flag else []
+            proc = run("batch", "p.yaml", "--time", "0.1", "--out", target, *extra, cwd=folder)
+            assert proc.returncode == 2, proc.stderr
+    assert (folder / "notes.txt").read_text() == "my notes\n"
+    assert (folder / "keep.jsonl").read_text() == '{"keep": 1}\n'
+    # An earlier run's results: refused without a flag, continued or replaced with one.
+    assert run("batch", "p.yaml", "--time", "0.1", "--out", "r.jsonl", cwd=folder).returncode == 0
+    proc = run("batch", "p.yaml", "--time", "0.1", "--out", "r.jsonl", cwd=folder)
+    assert proc.returncode == 2 and "--resume" in proc.stderr and "--overwrite" in proc.stderr
+    assert len(rows_of(folder / "r.jsonl")) == 1
+    proc = run("batch", "p.yaml", "--time", "0.1", "--runs", "2", "--out", "r.jsonl", "--resume",
+               cwd=folder)  # fmt: skip
+    assert proc.returncode == 0 and len(rows_of(folder / "r.jsonl")) == 2
+    assert run("batch", "p.yaml", "--time", "0.1", "--out", "r.jsonl", "--overwrite",
+               cwd=folder).returncode == 0  # fmt: skip
+    assert len(rows_of(folder / "r.jsonl")) == 1
+
+
+def test_links_fifos_modes_and_stdout_are_written_as_what_they_are(folder):
+    (folder / "target.json").write_text("old")
+    (folder / "link.json").symlink_to("target.json")
+    (folder / "private.json").write_text("old")
+    (folder / "private.json").chmod(0o600)
+    for out in ("link.json", "private.json"):
+        assert run("solve", "p.yaml", "--time", "0.1", "--json", out, cwd=folder).returncode == 0
+    assert (folder / "link.json").is_symlink()
+    assert json.loads((folder / "target.json").read_text())["solved"]
+    assert (folder / "private.json").stat().st_mode & 0o777 == 0o600
+    os.mkfifo(folder / "fifo")
+    reader = subprocess.Popen(["cat", str(folder / "fifo")], stdout=subprocess.PIPE, text=True)
+    assert run("solve", "p.yaml", "--time", "0.1", "--json", "fifo", cwd=folder).returncode == 0
+    assert json.loads(reader.communicate(timeout=30)[0])["solved"]
+    assert (folder / "fifo").is_fifo()
+    proc = run("solve", "p.yaml", "--time", "0.1", "--json", "-", cwd=folder)
+    assert proc.returncode == 0 and json.loads(proc.stdout)["planner"] == "RRTstarPSO"
+
+
+# ----------------------------------------------------------------------------------------------
+# Crashes, tracebacks, hangs
+# ----------------------------------------------------------------------------------------------
+SEEDS = [
+    (["solve", "p.yaml", "--seed", "-1"], "--seed"),
+    (["solve", "p.yaml", "--seed", str(2**64)], "--seed"),
+    (["solve", "p.yaml", "--param", f"seed={2**32}"], "seed"),
+    (["simulate", "d.yaml", "--seed=-1"], "--seed"),
+    (["batch", "p.yaml", "--seed", str(2**32 - 1), "--runs", "2", "--out", "o.jsonl"], "last run"),
+    (["generate", "circles", "--seed", "-3", "--out", "g.yaml"], "--seed"),
+]
+
+
+@pytest.mark.parametrize(("args", "words"), SEEDS, ids=lambda a: " ".join(a)[:40])
+def test_one_seed_range_everywhere(folder, args, words):
+    proc = run(*args, cwd=folder)
+    assert proc.returncode == 2 and words in proc.stderr
+    assert "2**32 - 1" in proc.stderr or "4294967295" in proc.stderr
+
+
+def _problem(folder: Path, name: str, text: str) -> str:
+    (folder / name).write_text(text)
+    return name
+
+
+BAD_VALUES = [
+    ("planner:\n  params: {swarm_size: .inf}\n", "planner.params.swarm_size"),
+    ("planner:\n  seed: 18446744073709551615\n", "planner.seed"),
+    ("planner:\n  time_limit: 1.0e+308\n", "planner.time_limit"),
+]
+
+
+@pytest.mark.parametrize(("extra", "key"), BAD_VALUES, ids=["swarm", "seed", "time"])
+def test_values_that_cannot_be_honoured_in_a_file(folder, extra, key):
+    name = _problem(folder, "bad.yaml", CIRCLE.split("planner:")[0] + extra)
+    proc = run("solve", name, "--json", "out.json", cwd=folder)
+    assert proc.returncode == 2 and f"bad.yaml: {key}" in proc.stderr
+    assert not (folder / "out.json").exists()
+
+
+@pytest.mark.parametrize(
+    ("text", "words"),
+    [
+        ("bounds: [[0, 0], [1.0e-15, 1.0e-15]]\nstart: [0, 0]\ngoal: [1.0e-15, 1.0e-15]\n"
+         "robot: {radius: 0}\n", "too small"),
+        ("bounds: [[0, 0], [30, 40]]\nstart: [1, 1]\ngoal: [20, 20]\nrobot: {radius: 1}\n"
+         "obstacles:\n  - {type: rectangle, min: [5, 5], max: [30, 1.0e+160]}\n", "within +-1e+09"),
+        ("bounds: [[0, 0], [1.0e+12, 1.0e+12]]\nstart: [1, 1]\ngoal: [20, 20]\n"
+         "robot: {radius: 1}\n", "within +-1e+09"),
+    ],
+    ids=["tiny-bounds", "huge-rectangle", "huge-bounds"],
+)  # fmt: skip
+def test_geometry_that_cannot_be_checked_exactly(folder, text, words):
+    name = _problem(folder, "g.yaml", text)
+    for command in ("solve", "optimum"):
+        proc = run(command, name, cwd=folder)
+        assert proc.returncode == 2 and words in proc.stderr, proc.stderr
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["--time", "1e10"], "at most 1e+06 s"),
+        (["--time", "nan"], "finite"),
+        (["--param", "budget=1e300"], "budget"),
+        (["--trajectory", "afile/t.csv"], "is a file, not a directory"),
+    ],
+)
+def test_flags_that_cannot_be_honoured(folder, args, words):
+    (folder / "afile").write_text("a file")
+    proc = run("solve", "p.yaml", *args, cwd=folder)
+    assert proc.returncode == 2 and words in proc.stderr, proc.stderr
+
+
+def test_missing_output_folders_are_created(folder):
+    proc = run("solve", "p.yaml", "--time", "0.2", "--trajectory", "new/dir/t.csv", "--json",
+               "new/r.json", cwd=folder)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert (folder / "new/dir/t.csv").read_text().startswith("t,x,y,theta")
+
+
+def test_a_closed_pipe_is_not_a_traceback(folder):
+    proc = subprocess.run(f"{' '.join(rrtpso_exe())} planners | head -1", shell=True,
+                          capture_output=True, text=True, timeout=60)  # fmt: skip
+    assert proc.stdout.strip() and "Traceback" not in proc.stderr
+
+
+def test_ctrl_c_in_a_batch_leaves_a_valid_file_and_no_tracebacks(folder):
+    proc = subprocess.Popen(
+        [*rrtpso_exe(), "batch", "p.yaml", "--planner", "RRTstar", "--runs", "20", "--time", "0.5",
+         "--jobs", "2", "--out", "r.jsonl"],
+        cwd=folder, stderr=subprocess.PIPE, text=True, preexec_fn=_limit,
+    )  # fmt: skip
+    deadline = time.time() + 60
+    while time.time() < deadline:
+        path = folder / "r.jsonl"
+        if path.exists() and path.read_text().count("\n") >= 2:
+            break
+        time.sleep(0.1)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "Traceback" not in err, err
+    rows = rows_of(folder / "r.jsonl")
+    assert 2 <= len(rows) < 20
+    # and it continues
+    proc = run("batch", "p.yaml", "--planner", "RRTstar", "--runs", "20", "--time", "0.05",
+               "--jobs", "2", "--out", "r.jsonl", "--resume", cwd=folder)  # fmt: skip
+    assert proc.returncode == 0 and len(rows_of(folder / "r.jsonl")) >= 20
+
+
+def test_inputs_too_large_for_the_machine_end_cleanly(folder):
+    circles = "\n".join(f"  - {{type: circle, center: [{10 + (i % 60) * 16}, "
+                        f"{10 + (i // 60) * 16}], radius: 2}}" for i in range(2100))  # fmt: skip
+    head = "bounds: [[0, 0], [1000, 1000]]\nstart: [1, 1]\ngoal: [999, 999]\n"
+    name = _problem(folder, "many.yaml", f"{head}robot: {{radius: 0.5}}\nobstacles:\n{circles}\n")
+    proc = run("optimum", name, cwd=folder)
+    assert proc.returncode == 2 and "at most 2,000" in proc.stderr
+    proc = run("generate", "circles", "--seed", "1", "--n", "100000000", "--out", "g.yaml",
+               cwd=folder)  # fmt: skip
+    assert proc.returncode == 2 and "n must be <= 100000" in proc.stderr
+
+
+@pytest.mark.parametrize(
+    ("edit", "status", "words"),
+    [
+        (("speed: 15, heading_deg: 180", "speed: 0, heading_deg: 180"), 1, "goal blocked"),
+        (("start: [470, 250], speed: 15", "start: [30, 250], speed: 0"), 1, "start blocked"),
+        (("sample_time: 0.15", "sample_time: 1.0e-9"), 2, "control steps"),
+        (("  speed: 20", "  speed: 1.0e-9"), 2, "control steps"),
+    ],
+    ids=["still-on-goal", "still-on-start", "tiny-sample-time", "tiny-speed"],
+)
+def test_simulations_that_cannot_end_stop_with_a_status(folder, edit, status, words):
+    name = _problem(folder, "s.yaml", DYNAMIC.replace(*edit))
+    proc = run("simulate", name, "--json", "s.json", cwd=folder, timeout=60)
+    assert proc.returncode == status and words in proc.stderr, proc.stderr
+
+
+# ----------------------------------------------------------------------------------------------
+# Memory
+# ----------------------------------------------------------------------------------------------
+def test_an_alias_bomb_is_refused_within_the_memory_limit(folder):
+    lines = ["bounds: [[0, 0], [100, 100]]", "start: [1, 1]", "goal: [99, 99]",
+             "robot: {radius: 1}", "x0: &a0 [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]"]  # fmt: skip
+    lines += [f"x{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 10)}]" for i in range(1, 10)]
+    lines.append("planner: {params: {swarm_size: *a9}}")
+    name = _problem(folder, "bomb.yaml", "\n".join(lines) + "\n")
+    proc = run("solve", name, cwd=folder)
+    assert proc.returncode == 2 and "aliases expand" in proc.stderr
+    assert len(proc.stderr) < 500
+    name = _problem(folder, "loop.yaml", CIRCLE + "x: &a [1, *a]\n")
+    proc = run("solve", name, cwd=folder)
+    assert proc.returncode == 2 and "recursive alias" in proc.stderr
+
+
+def test_a_long_value_is_echoed_short(folder):
+    name = _problem(folder, "long.yaml", CIRCLE.split("planner:")[0] +
+                    f"planner:\n  params: {{swarm_size: {'9' * 5000}}}\n")  # fmt: skip
+    proc = run("solve", name, cwd=folder)
+    assert proc.returncode == 2 and len(proc.stderr) < 400
+
+
+# ----------------------------------------------------------------------------------------------
+# Command-line conventions
+# ----------------------------------------------------------------------------------------------
+def test_conventions(folder):
+    proc = run("solve", "p.yaml", "--planner", "rrtstar", cwd=folder)
+    assert proc.returncode == 2 and "did you mean 'RRTstar'" in proc.stderr
+    proc = subprocess.run([sys.executable, "-m", "rrtpso_ompl", "--version"],
+                          capture_output=True, text=True, timeout=60)  # fmt: skip
+    assert proc.returncode == 0 and proc.stdout.startswith("rrtpso ")
+    proc = run("solve", "p.yaml", "--time", "0.1", "-q", cwd=folder)
+    assert proc.returncode == 0 and proc.stderr == ""
+    proc = run("bench", "p.yaml", "--planner", "RRTConnect", "--runs", "1", "--time", "0.1",
+               "--out", "b", "-q", cwd=folder)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert (folder / "b" / "benchmark.db").exists()
+
+
+def test_generate_never_replaces_a_file_unasked(folder):
+    before = (folder / "p.yaml").read_text()
+    proc = run("generate", "circles", "--seed", "1", "--out", "p.yaml", cwd=folder)
+    assert proc.returncode == 2 and "--overwrite" in proc.stderr
+    assert (folder / "p.yaml").read_text() == before
+    proc = run("generate", "circles", "--seed", "1", "--out", "p.yaml", "--overwrite", cwd=folder)
+    assert proc.returncode == 0 and (folder / "p.yaml").read_text() != before
