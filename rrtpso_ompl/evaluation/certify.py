@@ -33,10 +33,6 @@ __all__ = ["GRID_POINTS", "grid_path", "is_solvable"]
 GRID_POINTS = 200
 #: Largest grid of the solvability check (memory: a few hundred bytes per point).
 _MAX_GRID_POINTS = 4_000_000
-#: Segments per vectorised distance call: bounds the (chunk x obstacle edges) arrays.
-_CHUNK = 4096
-#: Grid points per side of a tile of the solvability grid (see _Tiles).
-_TILE = 16
 
 
 def grid_path(
@@ -115,8 +111,8 @@ class _Grid:
         # Clearance matters only up to what the edge test can use; beyond `cap` it is clipped.
         self.step = math.hypot(self.hx, self.hy)  # the longest grid edge
         cap = world.threshold + 0.5 * self.step + 2.0 * world.tol
-        self.tiles = _Tiles(world, xs, ys, reach=cap + self.step)
-        self.clearance = self.tiles.clearance(self.points, cap)
+        # Clearances up to `cap` through the world's index (exact; larger ones are clipped).
+        self.clearance = np.minimum(world.point_clearance(self.points, cap=cap), cap)
         self.free = self.clearance >= world.threshold
 
     @classmethod
@@ -160,7 +156,7 @@ def _grid_edges(grid: _Grid, world: World) -> tuple[np.ndarray, np.ndarray, np.n
     unsure = np.flatnonzero(~sure)
     ok = sure.copy()
     if len(unsure):
-        ok[unsure] = grid.tiles.segments_free(grid.points, a[unsure], b[unsure])
+        ok[unsure] = world.segments_free(grid.points[a[unsure]], grid.points[b[unsure]])
     return a[ok], b[ok], length[ok]
 
 
@@ -193,79 +189,3 @@ def is_solvable(problem: Problem, resolution: float | None = None) -> bool:
     """Whether :func:`grid_path` certifies the problem solvable (see there; False is not a proof
     of unsolvability)."""
     return grid_path(problem, resolution, shortcut=False) is not None
-
-
-def _chunked2(fn, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    if len(a) <= _CHUNK:
-        return fn(a, b)
-    return np.concatenate(
-        [fn(a[i : i + _CHUNK], b[i : i + _CHUNK]) for i in range(0, len(a), _CHUNK)]
-    )
-
-
-class _Tiles:
-    """The grid cut into square tiles, each with a local world of the obstacles near it.
-
-    A tile's local world holds the obstacles whose bounding box comes within ``reach`` of the
-    tile's box. Every point of the tile, and every point of a segment of length at most
-    ``reach - cap`` starting in the tile, is farther than ``cap`` from all other obstacles (it is
-    at least as far from an obstacle as the two boxes are apart). So clearances clipped at ``cap``,
-    and free tests of such segments against a threshold below ``cap``, are the same in the local
-    world as in the whole one: exact, and a maze of 100 walls costs a few walls per point.
-    """
-
-    def __init__(self, world: World, xs: np.ndarray, ys: np.ndarray, reach: float) -> None:
-        self.nx, self.ntx = len(xs), -(-len(xs) // _TILE)
-        poly_box = np.array(
-            [[p[:, 0].min(), p[:, 1].min(), p[:, 0].max(), p[:, 1].max()] for p in world.polygons]
-        ).reshape(-1, 4)
-        circles = world.circles
-        self.worlds: list[World | None] = []
-        for j0 in range(0, len(ys), _TILE):
-            for i0 in range(0, len(xs), _TILE):
-                lo = np.array([xs[i0], ys[j0]])
-                hi = np.array([xs[min(i0 + _TILE, len(xs)) - 1], ys[min(j0 + _TILE, len(ys)) - 1]])
-                # Box-to-box (and box-to-centre) gaps: lower bounds on every point's distance.
-                gap = np.maximum(0.0, np.maximum(poly_box[:, :2] - hi, lo - poly_box[:, 2:]))
-                near_poly = np.flatnonzero(np.hypot(gap[:, 0], gap[:, 1]) < reach)
-                gap = np.maximum(0.0, np.maximum(circles[:, :2] - hi, lo - circles[:, :2]))
-                near_circ = np.flatnonzero(np.hypot(gap[:, 0], gap[:, 1]) - circles[:, 2] < reach)
-                if not len(near_poly) and not len(near_circ):
-                    self.worlds.append(None)
-                    continue
-                self.worlds.append(
-                    World(
-                        world.bounds,
-                        circles[near_circ],
-                        [world.polygons[k] for k in near_poly],
-                        world.robot_radius,
-                    )
-                )
-
-    def tile_of(self, nodes: np.ndarray) -> np.ndarray:
-        """The tile of each grid node (index ``j * nx + i``)."""
-        j, i = np.divmod(nodes, self.nx)
-        return (j // _TILE) * self.ntx + i // _TILE
-
-    def clearance(self, points: np.ndarray, cap: float) -> np.ndarray:
-        """``min(world.point_clearance(p), cap)`` for every grid point (in node order)."""
-        out = np.full(len(points), cap)
-        for t, sel in self._groups(np.arange(len(points))):
-            out[sel] = np.minimum(self.worlds[t].point_clearance(points[sel]), cap)
-        return out
-
-    def segments_free(self, points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """``world.segments_free`` for the grid edges ``a[k] -> b[k]`` (node indices)."""
-        out = np.ones(len(a), dtype=bool)
-        for t, sel in self._groups(a):
-            out[sel] = _chunked2(self.worlds[t].segments_free, points[a[sel]], points[b[sel]])
-        return out
-
-    def _groups(self, nodes: np.ndarray):
-        """(tile, positions in ``nodes``) for every tile that has obstacles near it."""
-        tiles = self.tile_of(nodes)
-        order = np.argsort(tiles, kind="stable")
-        bounds = np.searchsorted(tiles[order], np.arange(len(self.worlds) + 1))
-        for t, local in enumerate(self.worlds):
-            if local is not None and bounds[t] < bounds[t + 1]:
-                yield t, order[bounds[t] : bounds[t + 1]]

@@ -5,45 +5,51 @@ any static obstacle, i.e. its distance to every obstacle is at least ``R``. A st
 free when *every* point of the segment is free. Both tests are computed exactly, with no sampling:
 
 * circle (centre ``c``, radius ``r``): distance from the segment to ``c`` minus ``r``;
+* axis-aligned box (rectangles, the blocked cells of a map): zero when the segment meets the box,
+  else the smallest of the distances from the segment's end points to the box and from the box's
+  corners to the segment;
 * polygon: zero when the segment crosses an edge or lies inside, else the smallest of the
   point-to-segment distances between the segment's end points and the edges and between the
   polygon's vertices and the segment (the distance between two non-crossing segments is attained
   at an end point of one of them).
 
-Two implementations of the same formulas serve two callers:
+A spatial index (:class:`~rrtpso_ompl.model.spatial.Grid`) hands every check only the obstacles
+that can be within ``R`` of it, so a check costs about the same among 10 obstacles as among
+10,000. Two implementations of the same formulas serve two callers:
 
 * :meth:`World.motion_free` / :meth:`World.point_free` are scalar pure Python: OMPL asks for one
-  segment at a time, and for a handful of obstacles a Python loop with bounding-box rejection is
-  about 20x faster than building numpy arrays per call.
-* :meth:`World.segment_distance` and friends are vectorised numpy over many segments at once: the
-  PSO evaluates whole swarms of paths per iteration.
+  segment at a time, and for a few candidates plain floats beat building numpy arrays.
+* :meth:`World.segments_free`, :meth:`World.segment_violation` and friends are vectorised numpy
+  over many segments at once: the PSO evaluates whole swarms of paths per iteration.
 
-Touching at exactly the robot radius is allowed, up to a tolerance of ``1e-9`` times the size of
+Touching at exactly the robot radius is allowed, up to a tolerance of ``1e-9`` times the scale of
 the workspace (floating-point round-off).
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 import shapely
 
 from .geometry import point_segment_distance, point_segment_distance_xy, segments_cross
 from .problem import Circle, Polygon, Problem, clearance_threshold, touch_tolerance
+from .spatial import Grid
 
 __all__ = ["World", "clearance_threshold"]  # the rule lives in problem (the loader shares it)
 
+Bounds = tuple[tuple[float, float], tuple[float, float]]
 
-@dataclass(frozen=True, eq=False)
-class _PolygonData:
-    """Prepared per-polygon data for the scalar checks."""
-
-    xs: tuple[float, ...]
-    ys: tuple[float, ...]
-    bbox: tuple[float, float, float, float]  # xmin, ymin, xmax, ymax
+#: Worlds with at most this many obstacles are checked without the index: for a handful of
+#: obstacles a loop with bounding-box rejection beats walking grid cells.
+SMALL_WORLD = 24
+#: Most (segment, obstacle) pairs one vectorised step evaluates at once (memory bound).
+_PAIR_CHUNK = 1_000_000
+#: Obstacle kinds, in the order of their ids: circles, then boxes, then polygons.
+_CIRCLE, _BOX, _POLYGON = 0, 1, 2
 
 
 class World:
@@ -59,103 +65,156 @@ class World:
         Simple polygons, each a ring of vertices without the closing repeat.
     robot_radius : float
         Radius ``R`` of the robot disc (its safety zone), in the same unit.
+    boxes : sequence of (xmin, ymin, xmax, ymax)
+        Axis-aligned rectangles (a map's blocked cells, merged; rectangles of a problem file).
     """
 
     def __init__(
         self,
-        bounds: tuple[tuple[float, float], tuple[float, float]],
+        bounds: Bounds,
         circles: Sequence[Sequence[float]] = (),
         polygons: Sequence[np.ndarray | Sequence[Sequence[float]]] = (),
         robot_radius: float = 0.0,
+        boxes: Sequence[Sequence[float]] = (),
     ) -> None:
         (xmin, ymin), (xmax, ymax) = bounds
         self.bounds = ((float(xmin), float(ymin)), (float(xmax), float(ymax)))
         self.robot_radius = float(robot_radius)
         #: Absolute tolerance for "touching is allowed" comparisons (floating-point round-off).
         self.tol = touch_tolerance(self.bounds)
-
-        circ = np.asarray(circles, dtype=float).reshape(-1, 3)
-        self.circles = circ
-        self.polygons = [np.asarray(p, dtype=float).reshape(-1, 2) for p in polygons]
-
-        # --- vectorised data -------------------------------------------------------------------
-        # Every polygon edge a->b as one row; the PSO checks (segments x edges) in one broadcast.
-        if self.polygons:
-            a = np.concatenate(self.polygons)
-            b = np.concatenate([np.roll(p, -1, axis=0) for p in self.polygons])
-            self._edges = np.hstack([a, b])
-            self._vertices = a
-            self._poly_union = shapely.union_all([shapely.Polygon(p) for p in self.polygons])
-            shapely.prepare(self._poly_union)
-        else:
-            self._edges = np.empty((0, 4))
-            self._vertices = np.empty((0, 2))
-            self._poly_union = None
-
         #: Distance to every obstacle that a free configuration or segment needs.
         self.threshold = clearance_threshold(self.robot_radius, self.tol)
 
-        # --- scalar data (plain Python floats: no numpy scalars in the hot loop) -----------------
-        r_need = self.threshold
-        self._circles_py = [
-            (float(cx), float(cy), float(r) + r_need, (float(r) + r_need) ** 2)
-            for cx, cy, r in circ
-        ]
-        self._polys_py = []
-        for p in self.polygons:
-            self._polys_py.append(
-                _PolygonData(
-                    xs=tuple(float(v) for v in p[:, 0]),
-                    ys=tuple(float(v) for v in p[:, 1]),
-                    bbox=(
-                        float(p[:, 0].min()) - r_need,
-                        float(p[:, 1].min()) - r_need,
-                        float(p[:, 0].max()) + r_need,
-                        float(p[:, 1].max()) + r_need,
-                    ),
-                )
-            )
+        self.circles = np.asarray(circles, dtype=float).reshape(-1, 3)
+        self.boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
+        self.polygons = [np.asarray(p, dtype=float).reshape(-1, 2) for p in polygons]
+        self._n_circles = len(self.circles)
+        self._n_boxes = len(self.boxes)
+        self._prepare_polygons()
+        self._prepare_scalar()
+        self._prepare_index()
 
     # ------------------------------------------------------------------------------------------
     @classmethod
     def from_problem(cls, problem: Problem) -> World:
         """Build the static world of a :class:`~rrtpso_ompl.model.Problem` (moving obstacles
-        are not part of it)."""
-        return cls.from_obstacles(problem.bounds, problem.obstacles, problem.robot.radius)
+        are not part of it; a map's blocked cells are boxes)."""
+        extra = getattr(problem, "map_boxes", None)
+        return cls.from_obstacles(problem.bounds, problem.obstacles, problem.robot.radius, extra)
 
     @classmethod
     def from_obstacles(
         cls,
-        bounds: tuple[tuple[float, float], tuple[float, float]],
+        bounds: Bounds,
         obstacles: Sequence[Circle | Polygon],
         robot_radius: float,
+        boxes: np.ndarray | None = None,
     ) -> World:
         """A world of the problem model's obstacles (:class:`~rrtpso_ompl.model.Circle`,
-        :class:`~rrtpso_ompl.model.Polygon`)."""
+        :class:`~rrtpso_ompl.model.Polygon`; axis-aligned rectangles become boxes) and extra
+        ``boxes``."""
         circles = [(*o.center, o.radius) for o in obstacles if isinstance(o, Circle)]
-        polygons = [np.asarray(o.points) for o in obstacles if isinstance(o, Polygon)]
-        return cls(bounds, circles, polygons, robot_radius)
+        polys = [o for o in obstacles if isinstance(o, Polygon)]
+        rects = [_box_of(o) for o in polys if _is_box(o)]
+        polygons = [np.asarray(o.points) for o in polys if not _is_box(o)]
+        extra = np.asarray(boxes if boxes is not None else (), dtype=float).reshape(-1, 4)
+        all_boxes = np.vstack([np.asarray(rects, dtype=float).reshape(-1, 4), extra])
+        return cls(bounds, circles, polygons, robot_radius, all_boxes)
 
     def with_robot_radius(self, robot_radius: float) -> World:
         """The same obstacles for another robot radius."""
-        return World(self.bounds, self.circles, self.polygons, robot_radius)
-
-    @property
-    def polygon_edges(self) -> np.ndarray:
-        """Every polygon edge as a row ``(ax, ay, bx, by)``: shape ``(n_edges, 4)``."""
-        return self._edges
-
-    def in_polygons(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """Whether each point ``(x[i], y[i])`` lies in (or on) a polygon (circles not counted)."""
-        x = np.asarray(x, dtype=float)
-        if self._poly_union is None:
-            return np.zeros(x.shape, dtype=bool)
-        return shapely.intersects_xy(self._poly_union, x, np.asarray(y, dtype=float))
+        return World(self.bounds, self.circles, self.polygons, robot_radius, self.boxes)
 
     @property
     def n_obstacles(self) -> int:
-        """Number of static obstacles."""
-        return len(self.circles) + len(self.polygons)
+        """Number of static obstacles (circles, boxes and polygons)."""
+        return self._n_circles + self._n_boxes + len(self.polygons)
+
+    @property
+    def polygon_edges(self) -> np.ndarray:
+        """Every edge of the polygons and boxes as a row ``(ax, ay, bx, by)``: ``(n_edges, 4)``."""
+        return self._all_edges
+
+    def in_polygons(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Whether each point ``(x[i], y[i])`` lies in (or on) a polygon or a box (circles are
+        not counted)."""
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        p = np.column_stack([x.ravel(), y.ravel()])
+        out = np.zeros(len(p), dtype=bool)
+        if self._poly_union is not None:
+            out |= shapely.intersects_xy(self._poly_union, p[:, 0], p[:, 1])
+        if self._n_boxes:
+            q, ids = self._pairs_near_points(p, 0.0, kinds=(_BOX,))
+            b = self.boxes[ids - self._n_circles]
+            inside = (p[q, 0] >= b[:, 0]) & (p[q, 0] <= b[:, 2])
+            inside &= (p[q, 1] >= b[:, 1]) & (p[q, 1] <= b[:, 3])
+            out[q[inside]] = True
+        return out.reshape(x.shape)
+
+    # ------------------------------------------------------------------------------------------
+    # Preparation
+    # ------------------------------------------------------------------------------------------
+    def _prepare_polygons(self) -> None:
+        """Polygon edges (with their polygon's id), shapes for inside tests."""
+        if self.polygons:
+            a = np.concatenate(self.polygons)
+            b = np.concatenate([np.roll(p, -1, axis=0) for p in self.polygons])
+            self._edges = np.hstack([a, b])
+            sizes = np.array([len(p) for p in self.polygons])
+            self._edge_start = np.concatenate([[0], np.cumsum(sizes)])
+            self._shapes = shapely.polygons([shapely.linearrings(p) for p in self.polygons])
+            self._poly_union = shapely.union_all(self._shapes)
+            shapely.prepare(self._poly_union)
+        else:
+            self._edges = np.empty((0, 4))
+            self._edge_start = np.zeros(1, dtype=np.intp)
+            self._shapes = np.empty(0, dtype=object)
+            self._poly_union = None
+        x0, y0, x1, y1 = self.boxes.T if self._n_boxes else (np.empty(0),) * 4
+        box_edges = np.concatenate([
+            np.column_stack([x0, y0, x1, y0]), np.column_stack([x1, y0, x1, y1]),
+            np.column_stack([x1, y1, x0, y1]), np.column_stack([x0, y1, x0, y0]),
+        ]) if self._n_boxes else np.empty((0, 4))  # fmt: skip
+        self._all_edges = np.vstack([self._edges, box_edges])
+
+    def _item_boxes(self) -> np.ndarray:
+        """Bounding box of every obstacle, in id order: circles, boxes, polygons."""
+        c = self.circles
+        circ = np.column_stack([c[:, 0] - c[:, 2], c[:, 1] - c[:, 2],
+                                c[:, 0] + c[:, 2], c[:, 1] + c[:, 2]])  # fmt: skip
+        poly = np.array([[p[:, 0].min(), p[:, 1].min(), p[:, 0].max(), p[:, 1].max()]
+                         for p in self.polygons]).reshape(-1, 4)  # fmt: skip
+        return np.vstack([circ.reshape(-1, 4), self.boxes, poly])
+
+    def _prepare_scalar(self) -> None:
+        """Plain Python data for the scalar checks (no numpy scalars in the hot loop)."""
+        r = self.threshold
+        self._py: list[tuple] = []
+        for cx, cy, rad in self.circles.tolist():
+            self._py.append((_CIRCLE, cx, cy, rad + r, (rad + r) ** 2))
+        for x0, y0, x1, y1 in self.boxes.tolist():
+            self._py.append((_BOX, x0, y0, x1, y1))
+        for p in self.polygons:
+            xs, ys = tuple(p[:, 0].tolist()), tuple(p[:, 1].tolist())
+            bbox = (min(xs) - r, min(ys) - r, max(xs) + r, max(ys) + r)
+            self._py.append((_POLYGON, xs, ys, bbox))
+
+    def _prepare_index(self) -> None:
+        """The grid over every obstacle grown by its reach (the threshold and a margin)."""
+        n = self.n_obstacles
+        self._all_ids = tuple(range(n))
+        self._reach = self.threshold + 4.0 * self.tol  # a margin: grazing is never missed
+        boxes = self._item_boxes()
+        boxes[:, :2] -= self._reach
+        boxes[:, 2:] += self._reach
+        (xmin, ymin), (xmax, ymax) = self.bounds
+        lo = np.array([xmin, ymin]) - self._reach
+        hi = np.array([xmax, ymax]) + self._reach
+        if n:
+            lo = np.minimum(lo, boxes[:, :2].min(axis=0))
+            hi = np.maximum(hi, boxes[:, 2:].max(axis=0))
+        self._grid = Grid(lo, hi, boxes)
+        self._indexed = n > SMALL_WORLD
 
     # ------------------------------------------------------------------------------------------
     # Scalar checks (OMPL callbacks)
@@ -168,59 +227,89 @@ class World:
 
     def point_free(self, x: float, y: float) -> bool:
         """Whether the robot disc centred at ``(x, y)`` overlaps no obstacle (bounds unchecked)."""
-        for cx, cy, _, rr2 in self._circles_py:
-            dx, dy = x - cx, y - cy
-            if dx * dx + dy * dy < rr2:
+        ids = self._grid.items(self._grid.cell_of(x, y)) if self._indexed else self._all_ids
+        r = self.threshold
+        py = self._py
+        for k in ids:
+            item = py[k]
+            kind = item[0]
+            if kind == _CIRCLE:
+                dx, dy = x - item[1], y - item[2]
+                if dx * dx + dy * dy < item[4]:
+                    return False
+            elif kind == _BOX:
+                ex = max(item[1] - x, 0.0, x - item[3])
+                ey = max(item[2] - y, 0.0, y - item[4])
+                if ex * ex + ey * ey < r * r:
+                    return False
+            elif not _point_polygon_free(x, y, item, r):
                 return False
-        if self._polys_py:
-            r_need = self.threshold
-            for poly in self._polys_py:
-                x0, y0, x1, y1 = poly.bbox
-                if x < x0 or x > x1 or y < y0 or y > y1:
-                    continue
-                if _point_in_polygon(x, y, poly.xs, poly.ys):
-                    return False
-                if _point_polygon_boundary_distance(x, y, poly.xs, poly.ys) < r_need:
-                    return False
         return True
 
     def motion_free(self, ax: float, ay: float, bx: float, by: float) -> bool:
         """Whether every point of the segment ``(ax, ay)-(bx, by)`` is free (exact)."""
+        if not self._indexed:
+            return self._segment_clear(self._all_ids, ax, ay, bx, by)
+        grid = self._grid
+        first = grid.cell_of(ax, ay)
+        if first == grid.cell_of(bx, by):
+            return self._segment_clear(grid.items(first), ax, ay, bx, by)
+        seen: set[int] = set()
+        for cell in grid.cells_on_segment(ax, ay, bx, by):
+            ids = [k for k in grid.items(cell) if k not in seen]
+            if ids:
+                if not self._segment_clear(ids, ax, ay, bx, by):
+                    return False
+                seen.update(ids)
+        return True
+
+    def _segment_clear(self, ids, ax: float, ay: float, bx: float, by: float) -> bool:
+        """Whether the segment keeps the threshold from each obstacle of ``ids``."""
         dx, dy = bx - ax, by - ay
         len2 = dx * dx + dy * dy
         sx0, sx1 = (ax, bx) if ax <= bx else (bx, ax)
         sy0, sy1 = (ay, by) if ay <= by else (by, ay)
-        for cx, cy, rr, rr2 in self._circles_py:
-            # Bounding-box rejection first: most obstacles are far from a short RRT* edge.
-            if cx + rr < sx0 or cx - rr > sx1 or cy + rr < sy0 or cy - rr > sy1:
-                continue
-            if len2 > 0.0:
-                t = ((cx - ax) * dx + (cy - ay) * dy) / len2
+        r = self.threshold
+        py = self._py
+        for k in ids:
+            item = py[k]
+            kind = item[0]
+            if kind == _CIRCLE:
+                _, cx, cy, rr, rr2 = item
+                # Bounding-box rejection first: most candidates are far from a short edge.
+                if cx + rr < sx0 or cx - rr > sx1 or cy + rr < sy0 or cy - rr > sy1:
+                    continue
+                t = ((cx - ax) * dx + (cy - ay) * dy) / len2 if len2 > 0.0 else 0.0
                 t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
+                ex, ey = ax + t * dx - cx, ay + t * dy - cy
+                if ex * ex + ey * ey < rr2:
+                    return False
+            elif kind == _BOX:
+                _, x0, y0, x1, y1 = item
+                if sx1 < x0 - r or sx0 > x1 + r or sy1 < y0 - r or sy0 > y1 + r:
+                    continue
+                if _segment_box_distance(ax, ay, bx, by, x0, y0, x1, y1) < r:
+                    return False
             else:
-                t = 0.0
-            ex, ey = ax + t * dx - cx, ay + t * dy - cy
-            if ex * ex + ey * ey < rr2:
-                return False
-        if self._polys_py:
-            r_need = self.threshold
-            for poly in self._polys_py:
-                x0, y0, x1, y1 = poly.bbox
+                _, xs, ys, (x0, y0, x1, y1) = item
                 if sx1 < x0 or sx0 > x1 or sy1 < y0 or sy0 > y1:
                     continue
-                if _segment_polygon_distance(ax, ay, bx, by, poly.xs, poly.ys) < r_need:
+                if _segment_polygon_distance(ax, ay, bx, by, xs, ys) < r:
                     return False
         return True
 
     # ------------------------------------------------------------------------------------------
     # Vectorised checks (PSO, validation of whole paths)
     # ------------------------------------------------------------------------------------------
-    def point_clearance(self, points: np.ndarray) -> np.ndarray:
+    def point_clearance(self, points: np.ndarray, cap: float | None = None) -> np.ndarray:
         """Distance from each point to the nearest static obstacle (0 inside one).
 
         Parameters
         ----------
         points : (n, 2) array_like
+        cap : float, optional
+            Only distances up to ``cap`` matter: larger ones may be returned as ``inf`` (through
+            the index, much faster among many obstacles).
 
         Returns
         -------
@@ -228,58 +317,60 @@ class World:
             ``inf`` when the world has no obstacles.
         """
         p = np.asarray(points, dtype=float).reshape(-1, 2)
-        return self.segment_distance(p, p)
+        return self.segment_distance(p, p, cap)
 
-    def segment_distance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    def segment_distance(
+        self, a: np.ndarray, b: np.ndarray, cap: float | None = None
+    ) -> np.ndarray:
         """Exact distance from each segment ``a[i]-b[i]`` to the nearest static obstacle.
 
         Parameters
         ----------
         a, b : (..., 2) array_like
             End points; any leading shape, broadcast together.
+        cap : float, optional
+            Only distances up to ``cap`` matter: larger ones may come back as ``inf``. With a cap
+            the obstacles come from the index; without one every obstacle is measured.
 
         Returns
         -------
         ndarray of shape ``(...)``
             0 where a segment touches or enters an obstacle; ``inf`` with no obstacles.
         """
-        a = np.asarray(a, dtype=float)
-        b = np.asarray(b, dtype=float)
-        a, b = np.broadcast_arrays(a, b)
-        shape = a.shape[:-1]
-        a = a.reshape(-1, 2)
-        b = b.reshape(-1, 2)
-        d = np.full(a.shape[0], np.inf)
-        if len(self.circles):
-            d = np.minimum(d, self._segment_circle_distance(a, b).min(axis=1))
-        if len(self.polygons):
-            d = np.minimum(d, self._segment_polygon_distance(a, b))
+        a, b, shape = _flat_pair(a, b)
+        d = np.full(len(a), np.inf)
+        if cap is None or not self._indexed:
+            for seg, ids in self._all_pairs(len(a)):
+                np.minimum.at(d, seg, self._pair_distance(seg, ids, a, b))
+        else:
+            extra = max(cap - self.threshold, 0.0)
+            for seg, ids in self._index_pairs(a, b, extra):
+                np.minimum.at(d, seg, self._pair_distance(seg, ids, a, b))
         return d.reshape(shape)
 
     def segment_violation(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """How far each segment intrudes into the robot's safety zone, summed over obstacles.
 
-        ``sum_k max(0, R - d_k)`` for circles (so that a path crossing two obstacles is worse than
-        one crossing one) plus ``max(0, R - d)`` for the union of polygons. Zero exactly when the
-        segment is free (up to the tolerance). Shape as :meth:`segment_distance`.
+        ``sum_k max(0, R - d_k)`` over the circles and boxes (so that a path crossing two
+        obstacles is worse than one crossing one) plus ``max(0, R - d)`` for the union of
+        polygons. Zero exactly when the segment is free (up to the tolerance). Shape as
+        :meth:`segment_distance`.
         """
-        a = np.asarray(a, dtype=float)
-        b = np.asarray(b, dtype=float)
-        a, b = np.broadcast_arrays(a, b)
-        shape = a.shape[:-1]
-        a = a.reshape(-1, 2)
-        b = b.reshape(-1, 2)
-        r_need = self.threshold
-        v = np.zeros(a.shape[0])
-        if len(self.circles):
-            v += np.maximum(0.0, r_need - self._segment_circle_distance(a, b)).sum(axis=1)
-        if len(self.polygons):
-            v += np.maximum(0.0, r_need - self._segment_polygon_distance(a, b))
+        a, b, shape = _flat_pair(a, b)
+        v = np.zeros(len(a))
+        poly_d = np.full(len(a), np.inf)
+        pairs = self._index_pairs(a, b, 0.0) if self._indexed else self._all_pairs(len(a))
+        for seg, ids in pairs:
+            d = self._pair_distance(seg, ids, a, b)
+            is_poly = ids >= self._n_circles + self._n_boxes
+            np.add.at(v, seg[~is_poly], np.maximum(0.0, self.threshold - d[~is_poly]))
+            np.minimum.at(poly_d, seg[is_poly], d[is_poly])
+        v += np.maximum(0.0, self.threshold - poly_d)
         return v.reshape(shape)
 
     def segments_free(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Boolean array: whether each segment ``a[i]-b[i]`` is free (bounds not checked)."""
-        return self.segment_distance(a, b) >= self.threshold
+        return self.segment_distance(a, b, cap=self.threshold) >= self.threshold
 
     def points_in_bounds(self, points: np.ndarray) -> np.ndarray:
         """Boolean array: whether each point lies in the bounds (inclusive, with tolerance)."""
@@ -324,30 +415,88 @@ class World:
         return LocalViolation(self, np.asarray(seg_lo, float), np.asarray(seg_hi, float))
 
     # ------------------------------------------------------------------------------------------
-    def _segment_circle_distance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """(n, m) distance from n segments to the boundaries of m circles (0 when inside)."""
-        c = self.circles[:, :2]
-        return np.maximum(
-            0.0,
-            point_segment_distance(c[None, :, :], a[:, None, :], b[:, None, :])
-            - self.circles[None, :, 2],
-        )
+    # Pairs of (segment, obstacle) and their distances
+    # ------------------------------------------------------------------------------------------
+    def _all_pairs(self, n_segments: int):
+        """Every (segment, obstacle) pair, in chunks of bounded size."""
+        n = self.n_obstacles
+        if not n or not n_segments:
+            return
+        step = max(1, _PAIR_CHUNK // n)
+        ids = np.arange(n)
+        for s0 in range(0, n_segments, step):
+            seg = np.repeat(np.arange(s0, min(s0 + step, n_segments)), n)
+            yield seg, np.tile(ids, len(seg) // n)
 
-    def _segment_polygon_distance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """(n,) distance from n segments to the union of the polygons (0 when touching/inside)."""
-        e0 = self._edges[None, :, :2]
-        e1 = self._edges[None, :, 2:]
-        A = a[:, None, :]
-        B = b[:, None, :]
+    def _index_pairs(self, a: np.ndarray, b: np.ndarray, extra: float):
+        """The (segment, obstacle) pairs the index finds within the reach (plus ``extra``) of
+        each segment, in chunks of bounded size."""
+        if not self.n_obstacles or not len(a):
+            return
+        length = np.hypot(*(b - a).T)
+        cells = np.ceil(length / self._grid.h) + 1.0
+        # Short chunks: the number of sampled cells, and so of pairs, stays bounded.
+        bounds = np.searchsorted(np.cumsum(cells), np.arange(0, cells.sum(), 20_000.0))
+        starts = np.unique(np.concatenate([bounds, [len(a)]]))
+        for s0, s1 in itertools.pairwise(starts):
+            if extra > 0.0:
+                lo = np.minimum(a[s0:s1], b[s0:s1]) - extra
+                hi = np.maximum(a[s0:s1], b[s0:s1]) + extra
+                seg, ids = self._grid.pairs_in_boxes(lo, hi)
+            else:
+                seg, ids = self._grid.pairs_on_segments(a[s0:s1], b[s0:s1])
+            yield seg + s0, ids
+
+    def _pairs_near_points(self, p: np.ndarray, extra: float, kinds=(_CIRCLE, _BOX, _POLYGON)):
+        seg, ids = self._grid.pairs_in_boxes(p - extra, p + extra)
+        kind = self._kind_of(ids)
+        keep = np.isin(kind, kinds)
+        return seg[keep], ids[keep]
+
+    def _kind_of(self, ids: np.ndarray) -> np.ndarray:
+        boxes_end = self._n_circles + self._n_boxes
+        return np.where(ids < self._n_circles, _CIRCLE, np.where(ids < boxes_end, _BOX, _POLYGON))
+
+    def _pair_distance(self, seg: np.ndarray, ids: np.ndarray, a: np.ndarray, b: np.ndarray):
+        """Exact distance of segment ``seg[k]`` to obstacle ``ids[k]``, for every pair."""
+        d = np.empty(len(seg))
+        kind = self._kind_of(ids)
+        c = kind == _CIRCLE
+        if c.any():
+            circ = self.circles[ids[c]]
+            dc = point_segment_distance(circ[:, :2], a[seg[c]], b[seg[c]]) - circ[:, 2]
+            d[c] = np.maximum(dc, 0.0)
+        x = kind == _BOX
+        if x.any():
+            d[x] = _segment_box_distance_v(a[seg[x]], b[seg[x]],
+                                           self.boxes[ids[x] - self._n_circles])  # fmt: skip
+        p = kind == _POLYGON
+        if p.any():
+            d[p] = self._segment_polygon_distance_v(
+                a[seg[p]], b[seg[p]], ids[p] - self._n_circles - self._n_boxes
+            )
+        return d
+
+    def _segment_polygon_distance_v(self, a: np.ndarray, b: np.ndarray, poly: np.ndarray):
+        """Distance from segment ``a[k]-b[k]`` to polygon ``poly[k]`` (0 when touching/inside)."""
+        start = self._edge_start[poly]
+        count = self._edge_start[poly + 1] - start
+        pair = np.repeat(np.arange(len(poly)), count)
+        edge = np.repeat(start, count) + np.arange(count.sum()) - np.repeat(
+            np.cumsum(count) - count, count)  # fmt: skip
+        e = self._edges[edge]
+        A, B = a[pair], b[pair]
+        e0, e1 = e[:, :2], e[:, 2:]
         # Distance between two non-crossing segments is attained at one of the four end points.
-        d = np.minimum(
+        de = np.minimum(
             np.minimum(point_segment_distance(A, e0, e1), point_segment_distance(B, e0, e1)),
             np.minimum(point_segment_distance(e0, A, B), point_segment_distance(e1, A, B)),
         )
-        d[segments_cross(A, B, e0, e1)] = 0.0
-        d = d.min(axis=1)
-        # A segment with no edge crossing is either wholly inside or wholly outside a polygon.
-        inside = shapely.intersects_xy(self._poly_union, a[:, 0], a[:, 1])
+        de[segments_cross(A, B, e0, e1)] = 0.0
+        d = np.full(len(poly), np.inf)
+        np.minimum.at(d, pair, de)
+        # A segment that crosses no edge lies wholly inside or wholly outside the polygon.
+        inside = shapely.intersects_xy(self._shapes[poly], a[:, 0], a[:, 1])
         d[inside] = 0.0
         return d
 
@@ -355,48 +504,29 @@ class World:
 class LocalViolation:
     """:meth:`World.segment_violation` for a fixed number of segments confined to boxes.
 
-    Candidate obstacles per segment are gathered once (padded with an obstacle that is never
+    Candidate obstacles per segment come from the index once (padded with an obstacle that is never
     near, so the per-call work is one dense broadcast over ``(paths, segments, candidates)``).
     """
 
     def __init__(self, world: World, seg_lo: np.ndarray, seg_hi: np.ndarray) -> None:
         self.world = world
-        r_need = world.threshold
         n_seg = len(seg_lo)
         far = 1e6 * max(1.0, *(abs(v) for b in world.bounds for v in b))
-
-        # Circles: box-to-centre distance below r + R.
-        circ = world.circles
-        if len(circ):
-            c = circ[:, :2][None, :, :]
-            gap = np.maximum(0.0, np.maximum(seg_lo[:, None, :] - c, c - seg_hi[:, None, :]))
-            near = np.hypot(gap[..., 0], gap[..., 1]) < circ[None, :, 2] + r_need
-            self.circles = _gather(near, circ, np.array([far, far, 0.0]))
+        if world.n_obstacles:
+            seg, ids = world._grid.pairs_in_boxes(seg_lo, seg_hi)
         else:
-            self.circles = np.zeros((n_seg, 0, 3))
-
-        # Polygon edges: edge bounding box overlapping the segment box grown by R.
-        edges = world._edges
-        if len(edges):
-            e_lo = np.minimum(edges[:, :2], edges[:, 2:])
-            e_hi = np.maximum(edges[:, :2], edges[:, 2:])
-            near = np.all(
-                (e_lo[None] <= seg_hi[:, None] + r_need) & (e_hi[None] >= seg_lo[:, None] - r_need),
-                axis=-1,
-            )
-            self.edges = _gather(near, edges, np.array([far, far, far, far]))
-            self.edge_segments = np.flatnonzero(near.any(axis=1))
-            # A box with no polygon edge within R of it lies wholly inside or wholly outside the
-            # polygons; one point (its centre) tells which, and inside means full violation.
-            lone = np.flatnonzero(~near.any(axis=1))
-            mid = 0.5 * (seg_lo[lone] + seg_hi[lone])
-            self.buried_segments = lone[
-                shapely.intersects_xy(world._poly_union, mid[:, 0], mid[:, 1])
-            ]
-        else:
-            self.edges = np.zeros((n_seg, 0, 4))
-            self.edge_segments = np.zeros(0, dtype=int)
-            self.buried_segments = np.zeros(0, dtype=int)
+            seg, ids = np.empty(0, dtype=np.intp), np.empty(0, dtype=np.intp)
+        kind = world._kind_of(ids)
+        c = kind == _CIRCLE
+        self.circles = _gather(seg[c], world.circles[ids[c]], n_seg, np.array([far, far, 0.0]))
+        x = kind == _BOX
+        self.boxes = _gather(seg[x], world.boxes[ids[x] - world._n_circles], n_seg,
+                             np.array([far, far, far, far]))  # fmt: skip
+        # Polygons: their edges, and the segments whose box lies wholly inside one.
+        p = kind == _POLYGON
+        self.polygon_segments = np.unique(seg[p])
+        poly_ids = ids[p] - world._n_circles - world._n_boxes
+        self._polys = [poly_ids[seg[p] == s] for s in range(n_seg)]
 
     def violation(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Same as :meth:`World.segment_violation` for ``a, b`` of shape ``(P, S, 2)``."""
@@ -409,38 +539,135 @@ class LocalViolation:
             c = self.circles[None, :, :, :2]
             d = point_segment_distance(c, A, B) - self.circles[None, :, :, 2]
             v += np.maximum(0.0, r_need - np.maximum(d, 0.0)).sum(axis=2)
-        if len(self.edge_segments):
-            # Only the segments that have candidate edges at all.
-            idx = self.edge_segments
-            A, B = A[:, idx], B[:, idx]
-            e0 = self.edges[None, idx, :, :2]
-            e1 = self.edges[None, idx, :, 2:]
-            d = np.minimum(
-                np.minimum(point_segment_distance(A, e0, e1), point_segment_distance(B, e0, e1)),
-                np.minimum(point_segment_distance(e0, A, B), point_segment_distance(e1, A, B)),
-            )
-            d = np.where(segments_cross(A, B, e0, e1), 0.0, d).min(axis=2)
-            start = a[:, idx]
-            inside = shapely.intersects_xy(world._poly_union, start[..., 0], start[..., 1])
-            v[:, idx] += np.maximum(0.0, r_need - np.where(inside, 0.0, d))
-        if len(self.buried_segments):
-            v[:, self.buried_segments] += r_need
+        if self.boxes.shape[1]:
+            shape = (a.shape[0], a.shape[1], self.boxes.shape[1])
+            d = _segment_box_distance_v(
+                np.broadcast_to(A, (*shape, 2)).reshape(-1, 2),
+                np.broadcast_to(B, (*shape, 2)).reshape(-1, 2),
+                np.broadcast_to(self.boxes[None], (*shape, 4)).reshape(-1, 4),
+            ).reshape(shape)
+            v += np.maximum(0.0, r_need - d).sum(axis=2)
+        for s in self.polygon_segments:
+            polys = self._polys[s]
+            n = a.shape[0]
+            seg = np.repeat(np.arange(n), len(polys))
+            d = world._segment_polygon_distance_v(a[seg, s], b[seg, s], np.tile(polys, n))
+            best = np.full(n, np.inf)
+            np.minimum.at(best, seg, d)
+            v[:, s] += np.maximum(0.0, r_need - best)
         return v
 
 
-def _gather(near: np.ndarray, rows: np.ndarray, pad: np.ndarray) -> np.ndarray:
-    """(S, K, m) array of the rows flagged in each line of ``near`` (S, N), padded with ``pad``."""
-    k = max(1, int(near.sum(axis=1).max()) if near.size else 1)
-    out = np.broadcast_to(pad, (near.shape[0], k, len(pad))).copy()
-    for s, idx in enumerate(near):
-        sel = rows[idx]
-        out[s, : len(sel)] = sel
+def _gather(seg: np.ndarray, rows: np.ndarray, n_seg: int, pad: np.ndarray) -> np.ndarray:
+    """(S, K, m) array of the rows of each segment (``seg[k]`` owns ``rows[k]``), padded."""
+    counts = np.bincount(seg, minlength=n_seg) if len(seg) else np.zeros(n_seg, dtype=np.intp)
+    k = max(1, int(counts.max()) if n_seg else 1)
+    out = np.broadcast_to(pad, (n_seg, k, len(pad))).copy()
+    if len(seg):
+        order = np.argsort(seg, kind="stable")
+        s = seg[order]
+        slot = np.arange(len(s)) - np.repeat(np.cumsum(counts) - counts, counts)
+        out[s, slot] = rows[order]
     return out
+
+
+def _flat_pair(a, b) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
+    a, b = np.broadcast_arrays(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
+    return a.reshape(-1, 2), b.reshape(-1, 2), a.shape[:-1]
+
+
+def _is_box(polygon: Polygon) -> bool:
+    """Whether a polygon is an axis-aligned rectangle (checked exactly by the box formulas)."""
+    if len(polygon.points) != 4:
+        return False
+    xs = sorted({p[0] for p in polygon.points})
+    ys = sorted({p[1] for p in polygon.points})
+    corners = {(x, y) for x in xs for y in ys}
+    return len(xs) == 2 and len(ys) == 2 and set(polygon.points) == corners
+
+
+def _box_of(polygon: Polygon) -> tuple[float, float, float, float]:
+    xs = [p[0] for p in polygon.points]
+    ys = [p[1] for p in polygon.points]
+    return min(xs), min(ys), max(xs), max(ys)
+
+
+# ----------------------------------------------------------------------------------------------
+# Box distances
+# ----------------------------------------------------------------------------------------------
+def _segment_box_distance(ax, ay, bx, by, x0, y0, x1, y1) -> float:
+    """Exact distance from segment a-b to the closed box [x0, x1] x [y0, y1] (0 when they meet)."""
+    # Liang-Barsky: does the segment meet the box?
+    dx, dy = bx - ax, by - ay
+    t0, t1 = 0.0, 1.0
+    hit = True
+    for p, q in ((-dx, ax - x0), (dx, x1 - ax), (-dy, ay - y0), (dy, y1 - ay)):
+        if p == 0.0:
+            if q < 0.0:
+                hit = False
+                break
+        else:
+            t = q / p
+            if p < 0.0:
+                t0 = t if t > t0 else t0
+            else:
+                t1 = t if t < t1 else t1
+            if t0 > t1:
+                hit = False
+                break
+    if hit:
+        return 0.0
+    # Otherwise the distance is attained at an end point of the segment or a corner of the box.
+    ex = max(x0 - ax, 0.0, ax - x1)
+    ey = max(y0 - ay, 0.0, ay - y1)
+    fx = max(x0 - bx, 0.0, bx - x1)
+    fy = max(y0 - by, 0.0, by - y1)
+    d = min(math.sqrt(ex * ex + ey * ey), math.sqrt(fx * fx + fy * fy))
+    for cx, cy in ((x0, y0), (x1, y0), (x1, y1), (x0, y1)):
+        d = min(d, point_segment_distance_xy(cx, cy, ax, ay, bx, by))
+    return d
+
+
+def _segment_box_distance_v(a: np.ndarray, b: np.ndarray, box: np.ndarray) -> np.ndarray:
+    """:func:`_segment_box_distance` for arrays: ``a, b`` (k, 2), ``box`` (k, 4)."""
+    d = b - a
+    t0 = np.zeros(len(a))
+    t1 = np.ones(len(a))
+    ok = np.ones(len(a), dtype=bool)
+    for p, q in ((-d[:, 0], a[:, 0] - box[:, 0]), (d[:, 0], box[:, 2] - a[:, 0]),
+                 (-d[:, 1], a[:, 1] - box[:, 1]), (d[:, 1], box[:, 3] - a[:, 1])):  # fmt: skip
+        zero = p == 0.0
+        ok &= ~(zero & (q < 0.0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.where(zero, 0.0, q / np.where(zero, 1.0, p))
+        t0 = np.where(~zero & (p < 0.0), np.maximum(t0, t), t0)
+        t1 = np.where(~zero & (p > 0.0), np.minimum(t1, t), t1)
+    hit = ok & (t0 <= t1)
+
+    def to_box(pt: np.ndarray) -> np.ndarray:
+        ex = np.maximum(np.maximum(box[:, 0] - pt[:, 0], 0.0), pt[:, 0] - box[:, 2])
+        ey = np.maximum(np.maximum(box[:, 1] - pt[:, 1], 0.0), pt[:, 1] - box[:, 3])
+        return np.hypot(ex, ey)
+
+    out = np.minimum(to_box(a), to_box(b))
+    for ix, iy in ((0, 1), (2, 1), (2, 3), (0, 3)):
+        corner = np.column_stack([box[:, ix], box[:, iy]])
+        out = np.minimum(out, point_segment_distance(corner, a, b))
+    return np.where(hit, 0.0, out)
 
 
 # ----------------------------------------------------------------------------------------------
 # Scalar polygon primitives (pure Python floats)
 # ----------------------------------------------------------------------------------------------
+def _point_polygon_free(x: float, y: float, item: tuple, r: float) -> bool:
+    _, xs, ys, (x0, y0, x1, y1) = item
+    if x < x0 or x > x1 or y < y0 or y > y1:
+        return True
+    if _point_in_polygon(x, y, xs, ys):
+        return False
+    return _point_polygon_boundary_distance(x, y, xs, ys) >= r
+
+
 def _point_in_polygon(x: float, y: float, xs: tuple[float, ...], ys: tuple[float, ...]) -> bool:
     """Even-odd ray casting (boundary points may go either way; callers also test distance)."""
     inside = False

@@ -15,7 +15,6 @@ import pytest
 import yaml
 from helpers import PROBLEMS
 
-from rrtpso_ompl.evaluation.certify import _Tiles
 from rrtpso_ompl.evaluation.generate import (
     KINDS,
     GenerationError,
@@ -133,35 +132,6 @@ def test_grid_path_straight_line_when_free():
         {"bounds": [[0, 0], [10, 10]], "start": [1, 1], "goal": [9, 2], "robot": {"radius": 0}}
     )
     np.testing.assert_array_equal(grid_path(problem), [[1, 1], [9, 2]])
-
-
-def test_tiles_give_the_whole_worlds_clipped_clearance_and_free_segments():
-    # The tiling is an exact shortcut: same answers as the whole world, obstacle by obstacle.
-    problem = problem_from_dict(generate("maze", 4, cells=6))
-    world = World.from_problem(problem)
-    xs = np.linspace(0, 100, 161)
-    ys = np.linspace(0, 100, 151)
-    step = float(np.hypot(xs[1] - xs[0], ys[1] - ys[0]))
-    cap = world.threshold + 0.5 * step + 2 * world.tol
-    tiles = _Tiles(world, xs, ys, reach=cap + step)
-    gx, gy = np.meshgrid(xs, ys)
-    points = np.column_stack([gx.ravel(), gy.ravel()])
-    np.testing.assert_allclose(
-        tiles.clearance(points, cap),
-        np.minimum(world.point_clearance(points), cap),
-        rtol=0,
-        atol=1e-12,
-    )
-    rng = np.random.default_rng(0)
-    a = rng.integers(0, len(points), 3000)
-    # Neighbours one step right/up/diagonally, kept inside the grid.
-    j, i = np.divmod(a, len(xs))
-    b = np.minimum(j + rng.integers(0, 2, len(a)), len(ys) - 1) * len(xs) + np.minimum(
-        i + rng.integers(0, 2, len(a)), len(xs) - 1
-    )
-    np.testing.assert_array_equal(
-        tiles.segments_free(points, a, b), world.segments_free(points[a], points[b])
-    )
 
 
 # ----------------------------------------------------------------------------------------------

@@ -450,3 +450,85 @@ def test_local_model_box_wholly_inside_a_polygon():
     assert float(model.violation(a, b)[0, 0]) == pytest.approx(
         float(world.segment_violation(a, b)[0, 0])
     )
+
+
+# ----------------------------------------------------------------------------------------------
+# The spatial index: the same answers as measuring every obstacle
+# ----------------------------------------------------------------------------------------------
+def _crowded_world(seed: int, radius: float) -> World:
+    """Many circles, boxes (map-like: some share edges) and a few polygons."""
+    rng = np.random.default_rng(seed)
+    circles = np.column_stack([rng.uniform(0, 100, (60, 2)), rng.uniform(0.2, 3, 60)])
+    x = rng.integers(0, 40, 80) * 2.5
+    y = rng.integers(0, 40, 80) * 2.5
+    boxes = np.column_stack([x, y, x + 2.5 * rng.integers(1, 4, 80), y + 2.5])
+    polygons = [c + rng.uniform(1, 4) * np.array([[0, 0], [1, 0], [0.5, 0.9]]) for c in
+                rng.uniform(5, 95, (6, 2))]  # fmt: skip
+    return World(BOUNDS, circles, polygons, radius, boxes)
+
+
+def _brute(world: World) -> World:
+    twin = World(world.bounds, world.circles, world.polygons, world.robot_radius, world.boxes)
+    twin._indexed = False
+    return twin
+
+
+@pytest.mark.parametrize("radius", [0.0, 0.7, 3.0])
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_the_index_gives_the_same_answers_as_brute_force(seed, radius):
+    world = _crowded_world(seed, radius)
+    brute = _brute(world)
+    assert world._indexed and world.n_obstacles > 100
+    rng = np.random.default_rng(seed + 10)
+    a = rng.uniform(-2, 102, (3000, 2))
+    # Short, long and zero-length segments, and some along the box grid lines.
+    b = a + rng.normal(0, 1, (3000, 2)) * rng.choice([0.0, 1.0, 8.0, 60.0], (3000, 1))
+    b[:200, 1] = a[:200, 1] = np.round(a[:200, 1] / 2.5) * 2.5
+    free = world.segments_free(a, b)
+    np.testing.assert_array_equal(free, brute.segments_free(a, b))
+    d = brute.segment_distance(a, b)
+    np.testing.assert_array_equal(free, d >= world.threshold)
+    scalar = [world.motion_free(*p, *q) for p, q in zip(a, b, strict=True)]
+    np.testing.assert_array_equal(scalar, free)
+    np.testing.assert_allclose(world.segment_violation(a, b), brute.segment_violation(a, b),
+                               rtol=0, atol=1e-12)  # fmt: skip
+    cap = world.threshold + 2.0
+    capped = world.segment_distance(a, b, cap=cap)
+    near = d <= cap
+    np.testing.assert_allclose(capped[near], d[near], rtol=0, atol=1e-12)
+    assert np.all(capped[~near] > cap)
+    pts = a[:500]
+    np.testing.assert_array_equal([world.point_free(*p) for p in pts],
+                                  brute.point_clearance(pts) >= world.threshold)  # fmt: skip
+
+
+def test_the_local_model_of_the_index_matches_the_full_check():
+    world = _crowded_world(4, 1.0)
+    rng = np.random.default_rng(4)
+    seg_lo = rng.uniform(0, 90, (12, 2))
+    seg_hi = seg_lo + rng.uniform(0.5, 10, (12, 2))
+    a = seg_lo + rng.uniform(0, 1, (40, 12, 2)) * (seg_hi - seg_lo)
+    b = seg_lo + rng.uniform(0, 1, (40, 12, 2)) * (seg_hi - seg_lo)
+    local = world.local_model(seg_lo, seg_hi).violation(a, b)
+    np.testing.assert_allclose(local, _brute(world).segment_violation(a, b), rtol=0, atol=1e-12)
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    cells=st.lists(st.tuples(st.integers(0, 19), st.integers(0, 19)), min_size=1, max_size=60,
+                   unique=True),
+    seg=st.tuples(point, point),
+    radius=st.sampled_from([0.0, 1.3, 5.0]),
+)  # fmt: skip
+def test_map_cells_are_exact_squares(cells, seg, radius):
+    """A segment is free of blocked 5 x 5 squares exactly when shapely's distance to their union
+    is at least the radius (away from the round-off band)."""
+    boxes = np.array([[5 * i, 5 * j, 5 * i + 5, 5 * j + 5] for i, j in cells], dtype=float)
+    world = World(BOUNDS, boxes=boxes, robot_radius=radius)
+    union = shapely.union_all([shapely.box(*b) for b in boxes])
+    a, b = seg
+    geom = shapely.Point(a) if a == b else shapely.LineString([a, b])
+    d = geom.distance(union)
+    assume(abs(d - world.threshold) > BOUNDARY_WINDOW)
+    assert world.motion_free(*a, *b) == (d >= world.threshold)
+    assert bool(world.segments_free(np.array([a]), np.array([b]))[0]) == (d >= world.threshold)
