@@ -1,27 +1,34 @@
-"""The exact shortest path for a disc robot among circles and polygons (the reference optimum).
+r"""The exact shortest path for a disc robot among circles, polygons and map cells (the reference
+optimum).
 
 The robot is a disc of radius ``R`` whose centre must stay in the bounds. In its configuration
 space every obstacle grows by ``R``: a circle of radius ``r`` becomes a circle of radius ``r + R``
-and a polygon becomes the polygon with rounded corners, each convex vertex the centre of a circle
-of radius ``R``. A shortest path in such a space consists of straight segments tangent to these
-circles and arcs along them (the classic tangent or "reduced visibility" graph; see e.g. LaValle,
-*Planning Algorithms*, 2006, section 6.2.4 and Latombe 1991 for the polygonal case). So:
+and a polygon (a box, a map's blocked cells) becomes the polygon with rounded corners, each convex
+corner the centre of a circle of radius ``R``. A shortest path in such a space consists of straight
+segments tangent to these circles and arcs along them (the tangent or "reduced visibility" graph;
+LaValle, *Planning Algorithms*, 2006, section 6.2.4; Latombe 1991 for the polygonal case):
 
-1. **Circles**: the start and the goal (radius 0), every obstacle circle (``r + R``) and every
-   convex polygon vertex (``R``).
-2. **Tangent segments**: for every pair of circles the up to four common tangents (two outer, two
-   inner), kept when both tangent points are free and in bounds and the whole segment is free
-   (exact segment distance, :meth:`rrtpso_ompl.model.World.segments_free`).
-3. **Arcs**: on each circle, the tangent points sorted by angle, joined to their neighbours by
-   arcs, kept when the arc is free: its exact distance to every circle and polygon edge, its
-   extent against the bounds.
-4. **Dijkstra** from the start to the goal over segments and arcs.
+1. **Circles**: the start and the goal (radius 0), every obstacle circle (``r + R``), every convex
+   vertex of a polygon and every convex corner of the union of the boxes (``R``; for a map, the
+   corners where exactly one of the four cells around a grid point is blocked).
+2. **A\* over tangents, built as it goes.** A node is a tangent point on a circle and the sense
+   (clockwise or counter-clockwise) in which the path wraps that circle; from it the path follows
+   the circle in that sense and leaves along a common tangent (two outer and two inner per pair of
+   circles) to another circle. An edge (arc, then tangent) is kept when the arc and the tangent
+   segment are free: exact distances to the candidate obstacles the spatial index names, the
+   bounds for the arc's extreme points. The heuristic is the straight distance to the goal.
+3. **Pruning that keeps exactness.** A valid path of length ``C`` (the grid certificate of
+   :func:`~rrtpso_ompl.evaluation.certify.grid_path`) bounds the optimum, so a circle that cannot
+   touch the ellipse ``|x - start| + |x - goal| <= C`` is never a candidate, and an edge whose end
+   already needs more than ``C`` is never checked. Only the tangents of the circles A\* expands are
+   ever built, instead of those of every pair: 10,000 circles take seconds, not terabytes.
 
-Every edge of the graph is a piece of a valid path (touching an obstacle is allowed, as everywhere
-in this package), so the result is never shorter than the true optimum; and the true optimum is a
-path of the graph, so the result is exact up to floating-point round-off. The box bounds add no
-circles: from inside, the box is convex, and so is every corner where an obstacle meets it, and
-a shortest path bends only around corners that are convex seen from the obstacle.
+Every edge is a piece of a valid path (touching an obstacle is allowed, as everywhere in this
+package), so the result is never shorter than the true optimum; and the true optimum is a path of
+this graph, which A\* with a consistent heuristic searches exactly, so the result is exact up to
+floating-point round-off. The box bounds add no circles: from inside, the box is convex, and so is
+every corner where an obstacle meets it, and a shortest path bends only around corners that are
+convex seen from the obstacle.
 
 The free configuration space is closed (touching allowed). For a point robot (``R = 0``) a path
 grazing a polygon corner would touch it with zero clearance, which the package's segment test
@@ -31,6 +38,7 @@ counts as entering; the corners are therefore rounded with a radius of twice the
 
 from __future__ import annotations
 
+import heapq
 import itertools
 import math
 import time
@@ -38,15 +46,13 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import dijkstra
 
 from ..errors import RrtpsoError
 from ..model.geometry import point_segment_distance
-from ..model.problem import Circle, Polygon, Problem
+from ..model.problem import Problem
 from ..model.world import World
 
-__all__ = ["OptimumResult", "Piece", "shortest_path"]
+__all__ = ["MAX_NODES", "OptimumResult", "OptimumTooLarge", "Piece", "shortest_path"]
 
 _TWO_PI = 2.0 * math.pi
 
@@ -196,21 +202,18 @@ class OptimumResult:
         }
 
 
-#: Most circles (start, goal, inflated circles and convex corners) the tangent graph is built on:
-#: its candidate tangents grow with the square of their number (about 0.5 GB at 1,000).
-MAX_NODE_CIRCLES = 2_002
+#: Most tangent nodes one search may create (memory: a few hundred bytes each).
+MAX_NODES = 5_000_000
 
 
 class OptimumTooLarge(RrtpsoError):
-    """The problem has too many obstacles for the exact optimum to be computed here."""
-
-
-def _estimated_gib(n: int) -> float:
-    return 0.47 * (n / 1000.0) ** 2
+    """The search for the exact optimum would need more memory than it is allowed."""
 
 
 # ----------------------------------------------------------------------------------------------
-def shortest_path(problem: Problem, world: World | None = None) -> OptimumResult:
+def shortest_path(
+    problem: Problem, world: World | None = None, upper_bound: float | None = None
+) -> OptimumResult:
     """The shortest collision-free path of ``problem`` for its disc robot (moving obstacles
     ignored).
 
@@ -220,6 +223,8 @@ def shortest_path(problem: Problem, world: World | None = None) -> OptimumResult
         A validated problem.
     world : World, optional
         Its static world, when already built.
+    upper_bound : float, optional
+        The length of any valid path (it prunes the search); by default the grid certificate's.
 
     Returns
     -------
@@ -229,315 +234,504 @@ def shortest_path(problem: Problem, world: World | None = None) -> OptimumResult
     Raises
     ------
     OptimumTooLarge
-        For more than :data:`MAX_NODE_CIRCLES` circles and convex corners.
+        When the search would create more than :data:`MAX_NODES` tangent nodes.
     """
     t0 = time.perf_counter()
     world = world or World.from_problem(problem)
-    tol = world.tol
-    radius = max(world.robot_radius, 2.0 * tol)  # see the module docstring for R = 0
+    radius = max(world.robot_radius, 2.0 * world.tol)  # see the module docstring for R = 0
     if radius != world.robot_radius:
         world = world.with_robot_radius(radius)
     start = np.asarray(problem.start[:2], dtype=float)
     goal = np.asarray(problem.goal[:2], dtype=float)
     goal_tol = float(problem.goal_tolerance)
-
     if math.dist(start, goal) <= goal_tol or np.array_equal(start, goal):
         still = Piece("line", tuple(map(float, start)), tuple(map(float, start)))
         return OptimumResult(problem.name, 0.0, [still], True, 1, 0, time.perf_counter() - t0)
-    circles = _node_circles(problem, start, goal, radius)
-    if len(circles) > MAX_NODE_CIRCLES:
-        raise OptimumTooLarge(
-            f"{problem.source}: the exact optimum of {len(circles) - 2:,} circles and convex "
-            f"corners would take about {_estimated_gib(len(circles)):.0f} GiB of memory; this "
-            f"version computes it for at most {MAX_NODE_CIRCLES - 2:,}"
-        )
-    graph = _TangentGraph(world, circles, goal_tol)
-    graph.build()
-    dist, pred = dijkstra(
-        graph.matrix, directed=False, indices=graph.start_node, return_predecessors=True
-    )
-    # Goal nodes: the goal point's tangent points, or with a tolerance the points where the legs
-    # towards the goal enter its disc (graph.goal_cost holds the leg's length, possibly 0).
-    costs = dist[graph.goal_nodes] + graph.goal_cost
+    if upper_bound is None:
+        upper_bound = _grid_bound(problem, world)
+    circles = _node_circles(problem, world, start, goal, radius)
+    search = _TangentSearch(world, circles, goal_tol, upper_bound, problem.source)
+    found = search.run()
     exact = goal_tol == 0.0 or bool(
         world.point_clearance(goal[None])[0] >= goal_tol + world.threshold
     )
-    elapsed = time.perf_counter() - t0
-    if not len(costs) or not np.isfinite(costs.min()):
-        return OptimumResult(problem.name, None, [], exact, graph.n_nodes, graph.n_edges, elapsed)
-    best = int(np.argmin(costs))
-    chain = [int(graph.goal_nodes[best])]
-    while chain[-1] != graph.start_node:
-        chain.append(int(pred[chain[-1]]))
-    chain.reverse()
-    pieces = [graph.piece(u, v) for u, v in itertools.pairwise(chain)]
-    tail = graph.goal_piece(best)
-    if tail is not None:
-        pieces.append(tail)
+    if found is None:
+        return OptimumResult(problem.name, None, [], exact, search.n_nodes, search.n_edges,
+                             time.perf_counter() - t0)  # fmt: skip
+    length, pieces = found
     pieces = _merge_arcs([p for p in pieces if p.length > 0.0] or pieces[:1])
     return OptimumResult(
         problem=problem.name,
-        length=float(costs[best]),
+        length=length,
         pieces=pieces,
         exact=exact,
-        n_nodes=graph.n_nodes,
-        n_edges=graph.n_edges,
+        n_nodes=search.n_nodes,
+        n_edges=search.n_edges,
         time=time.perf_counter() - t0,
     )
+
+
+def _grid_bound(problem: Problem, world: World) -> float:
+    """The length of a certified grid path (an upper bound on the optimum), or ``inf``."""
+    from .certify import GRID_POINTS, grid_path
+
+    (xmin, ymin), (xmax, ymax) = problem.bounds
+    side = max(xmax - xmin, ymax - ymin)
+    for factor in (1, 2, 4):
+        try:
+            path = grid_path(problem, side / (GRID_POINTS * factor))
+        except RrtpsoError:  # a grid that fine would be too large
+            break
+        if path is not None and world.path_valid(path):
+            return float(np.hypot(*np.diff(path, axis=0).T).sum())
+    return math.inf
 
 
 def _merge_arcs(pieces: list[Piece]) -> list[Piece]:
     """Join consecutive arcs on the same circle (the path passed a tangent point it did not use)."""
     out: list[Piece] = []
     for p in pieces:
-        q = out[-1] if out else None
-        if q and p.kind == q.kind == "arc" and p.center == q.center and p.radius == q.radius:
-            out[-1] = Piece("arc", q.start, p.end, q.center, q.radius, q.angle, q.sweep + p.sweep)
+        last = out[-1] if out else None
+        if (p.kind == "arc" and last is not None and last.kind == "arc"
+                and last.center == p.center and last.radius == p.radius
+                and math.copysign(1.0, last.sweep) == math.copysign(1.0, p.sweep)):  # fmt: skip
+            out[-1] = Piece("arc", last.start, p.end, last.center, last.radius, last.angle,
+                            last.sweep + p.sweep)  # fmt: skip
         else:
             out.append(p)
     return out
 
 
-def _node_circles(
-    problem: Problem, start: np.ndarray, goal: np.ndarray, radius: float
-) -> np.ndarray:
-    """(k, 3) circles ``(cx, cy, rho)``: start, goal, inflated obstacle circles, convex vertices."""
-    rows = [(*start, 0.0), (*goal, 0.0)]
-    for obstacle in problem.obstacles:
-        if isinstance(obstacle, Circle):
-            rows.append((*obstacle.center, obstacle.radius + radius))
-        elif isinstance(obstacle, Polygon):
-            p = np.asarray(obstacle.points, dtype=float)
-            prev, nxt = np.roll(p, 1, axis=0), np.roll(p, -1, axis=0)
-            e0, e1 = p - prev, nxt - p
-            turn = e0[:, 0] * e1[:, 1] - e0[:, 1] * e1[:, 0]
-            area2 = np.sum(p[:, 0] * nxt[:, 1] - nxt[:, 0] * p[:, 1])
-            # Convex vertices turn the way the ring runs; only they can bend a shortest path.
-            convex = turn * np.sign(area2) > 0.0
-            rows.extend((x, y, radius) for x, y in p[convex])
-    return np.asarray(rows, dtype=float)
+def _node_circles(problem: Problem, world: World, start, goal, radius: float) -> np.ndarray:
+    """(k, 3) circles ``(cx, cy, rho)``: start, goal, inflated obstacle circles, the convex
+    vertices of polygons and the convex corners of the union of the boxes."""
+    rows = [np.array([[*start, 0.0], [*goal, 0.0]])]
+    c = world.circles
+    rows.append(np.column_stack([c[:, :2], c[:, 2] + radius]))
+    for p in world.polygons:
+        prev, nxt = np.roll(p, 1, axis=0), np.roll(p, -1, axis=0)
+        e0, e1 = p - prev, nxt - p
+        turn = e0[:, 0] * e1[:, 1] - e0[:, 1] * e1[:, 0]
+        area2 = np.sum(p[:, 0] * nxt[:, 1] - nxt[:, 0] * p[:, 1])
+        # Convex vertices turn the way the ring runs; only they can bend a shortest path.
+        convex = p[turn * np.sign(area2) > 0.0]
+        rows.append(np.column_stack([convex, np.full(len(convex), radius)]))
+    corners = _convex_box_corners(world)
+    rows.append(np.column_stack([corners, np.full(len(corners), radius)]))
+    return np.vstack(rows)
 
 
-class _TangentGraph:
-    """Nodes are tangent points on the circles; edges are free tangent segments and free arcs."""
+def _convex_box_corners(world: World) -> np.ndarray:
+    """Corners of boxes where exactly one of the four quadrants around them is covered by boxes:
+    the convex corners of their union (shared edges and inner corners drop out)."""
+    b = world.boxes
+    if not len(b):
+        return np.empty((0, 2))
+    corners = np.unique(np.vstack([b[:, [0, 1]], b[:, [2, 1]], b[:, [2, 3]], b[:, [0, 3]]]),
+                        axis=0)  # fmt: skip
+    eps = 1e-6 * float(np.min(np.minimum(b[:, 2] - b[:, 0], b[:, 3] - b[:, 1])))
+    covered = np.zeros(len(corners), dtype=int)
+    for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1)):
+        x, y = corners[:, 0] + sx * eps, corners[:, 1] + sy * eps
+        covered += _in_boxes(world, x, y)
+    return corners[covered == 1]
 
-    def __init__(self, world: World, circles: np.ndarray, goal_tol: float) -> None:
+
+def _in_boxes(world: World, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Whether each point lies in a box (polygons and circles are not counted)."""
+    plain = World(world.bounds, boxes=world.boxes)
+    return plain.in_polygons(x, y)
+
+
+class _TangentSearch:
+    """A* over tangent nodes, built as it goes (see the module docstring)."""
+
+    def __init__(self, world: World, circles: np.ndarray, goal_tol: float, bound: float,
+                 source: str) -> None:  # fmt: skip
         self.world = world
-        self.circles = circles
         self.goal_tol = goal_tol
+        self.source = source
+        start, goal = circles[0, :2], circles[1, :2]
+        self.start, self.goal = start, goal
+        self.bound = bound * (1.0 + 1e-9) + 10.0 * world.tol if math.isfinite(bound) else math.inf
+        # Only circles that can touch the ellipse |x - start| + |x - goal| <= bound matter.
+        reach = np.hypot(*(circles[:, :2] - start).T) + np.hypot(*(circles[:, :2] - goal).T)
+        keep = reach - 2.0 * circles[:, 2] <= self.bound
+        keep[:2] = True
+        self.circles = circles[keep]
+        self.n_nodes = 0
+        self.n_edges = 0
+        # Node arrays grow as nodes are created.
+        self.xy: list[tuple[float, float]] = []
+        self.circle: list[int] = []
+        self.angle: list[float] = []
+        self.sense: list[int] = []
+        self.g: list[float] = []
+        self.parent: list[int] = []
+        self.leave: list[tuple[float, float]] = []  # the tangent's start on the parent's circle
+        self.sweep: list[float] = []  # the parent's arc to it, signed (counter-clockwise > 0)
+        self.goal_end: list[tuple[float, float] | None] = []
+        self.key: dict[int, int] = {}  # (from circle, to circle, which tangent) -> node
+        self._cache: dict[int, _Tangents] = {}  # circle -> its usable free tangents
 
     # ------------------------------------------------------------------------------------------
-    def build(self) -> None:
-        p, q, ci, cj, ai, aj = self._tangent_segments()
-        # Every segment end is a node: node 2k is segment k's start, 2k+1 its end.
-        n_seg = len(p)
-        self.node_xy = np.empty((2 * n_seg, 2))
-        self.node_xy[0::2], self.node_xy[1::2] = p, q
-        self.node_circle = np.empty(2 * n_seg, dtype=int)
-        self.node_circle[0::2], self.node_circle[1::2] = ci, cj
-        self.node_angle = np.empty(2 * n_seg)
-        self.node_angle[0::2], self.node_angle[1::2] = ai, aj
-        seg_u = np.arange(0, 2 * n_seg, 2)
-        seg_w = np.hypot(*(q - p).T)
-        arc_u, arc_v, arc_s = self._arcs()
-        arc_w = self.circles[self.node_circle[arc_u], 2] * arc_s
+    def run(self) -> tuple[float, list[Piece]] | None:
+        start = self._add(-1, tuple(self.circles[0, :2]), 0, 0.0, 0, 0.0, -1,
+                          (0.0, 0.0), 0.0)  # fmt: skip
+        heap = [(self._h(start), start)]
+        closed: set[int] = set()
+        while heap:
+            f, u = heapq.heappop(heap)
+            if u in closed or f > self.g[u] + self._h(u) + 1e-12:
+                continue
+            closed.add(u)
+            if self.circle[u] == 1:
+                return self.g[u], self._pieces(u)
+            for v in self._expand(u):
+                heapq.heappush(heap, (self.g[v] + self._h(v), v))
+        return None
 
-        u = np.concatenate([seg_u, arc_u])
-        v = np.concatenate([seg_u + 1, arc_v])
-        w = np.concatenate([seg_w, arc_w])
-        kind = np.concatenate([np.zeros(n_seg, int), np.ones(len(arc_u), int)])
-        # Parallel edges (two arcs joining the same pair of nodes) must not be summed: keep the
-        # shortest. scipy's graphs also drop explicit zeros, so zero lengths get a tiny weight.
-        lo, hi = np.minimum(u, v), np.maximum(u, v)
-        order = np.lexsort((w, hi, lo))
-        lo, hi, w, kind, u = lo[order], hi[order], w[order], kind[order], u[order]
-        first = np.ones(len(lo), dtype=bool)
-        first[1:] = (lo[1:] != lo[:-1]) | (hi[1:] != hi[:-1])
-        lo, hi, w, kind, u = lo[first], hi[first], w[first], kind[first], u[first]
-        # Per edge: whether it is an arc, and the node its counter-clockwise sweep starts from.
-        self.edges = {
-            (int(a), int(b)): (bool(k), int(s)) for a, b, k, s in zip(lo, hi, kind, u, strict=True)
-        }
-        n = max(len(self.node_xy), 1)
-        self.matrix = sp.csr_array((np.maximum(w, 1e-300), (lo, hi)), shape=(n, n))
-        self.n_nodes = len(self.node_xy)
-        self.n_edges = len(lo)
+    def _h(self, u: int) -> float:
+        d = math.dist(self.xy[u], self.goal)
+        return max(d - self.goal_tol, 0.0)
 
-        on_start = np.flatnonzero(self.node_circle == 0)
-        self.start_node = int(on_start[0]) if len(on_start) else 0
-        self._goal_targets()
+    def _add(self, key, xy, circle, angle, sense, g, parent, leave, sweep, goal_end=None) -> int:
+        k = len(self.xy)
+        if k >= MAX_NODES:
+            raise OptimumTooLarge(
+                f"{self.source}: the search for the exact optimum passed {MAX_NODES:,} tangent "
+                "nodes; the problem is too large for it"
+            )
+        self.key[key] = k
+        for store, value in ((self.xy, xy), (self.circle, circle), (self.angle, angle),
+                             (self.sense, sense), (self.g, g), (self.parent, parent),
+                             (self.leave, leave), (self.sweep, sweep),
+                             (self.goal_end, goal_end)):  # fmt: skip
+            store.append(value)
+        self.n_nodes = k + 1
+        return k
 
     # ------------------------------------------------------------------------------------------
-    def _tangent_segments(self) -> tuple[np.ndarray, ...]:
-        """All free common tangents of all pairs of circles."""
-        c = self.circles
-        i, j = np.triu_indices(len(c), k=1)
-        ri, rj = c[i, 2], c[j, 2]
-        d_vec = c[j, :2] - c[i, :2]
-        d = np.hypot(*d_vec.T)
-        base = np.arctan2(d_vec[:, 1], d_vec[:, 0])
+    def _expand(self, u: int) -> list[int]:
+        """Create or improve the nodes reached from ``u`` by an arc and a free tangent."""
+        i = self.circle[u]
+        cand = self._free_tangents(i)
+        if not len(cand.j):
+            return []
+        # The path keeps wrapping circle i the way it arrived, then leaves on the tangent.
+        rho_i = self.circles[i, 2]
+        if rho_i > 0:
+            cand = cand.take(np.flatnonzero(cand.sense_i == self.sense[u]))
+            sweep = np.mod(self.sense[u] * (cand.angle_i - self.angle[u]), _TWO_PI)
+        else:
+            sweep = np.zeros(len(cand.j))
+        g = self.g[u] + rho_i * sweep + cand.seg
+        idx = np.flatnonzero(g + cand.h <= self.bound)
+        if not len(idx):
+            return []
+        # No better than a node already reached by this tangent: nothing to do.
+        keys = cand.key[idx].tolist()
+        best = np.array([self.g[self.key[k]] if k in self.key else math.inf for k in keys])
+        better = g[idx] < best - 1e-12
+        idx = idx[better]
+        if rho_i > 0 and len(idx):
+            idx = idx[self._arcs_ok(u, sweep[idx])]
+        self.n_edges += len(idx)
         out = []
-        # Outer tangents: normal at angle base +- acos((ri - rj) / d) on both circles. Inner ones:
-        # base +- acos((ri + rj) / d), with the normal reversed on circle j. For a circle of
-        # radius 0 the inner tangents repeat the outer ones, and for two points both coincide.
-        for inner, sign in ((False, 1.0), (False, -1.0), (True, 1.0), (True, -1.0)):
-            if inner:
-                ok = (ri > 0) & (rj > 0) & (d > ri + rj)
-                cos_a = np.divide(ri + rj, d, out=np.ones_like(d), where=d > 0)
+        for k in idx.tolist():
+            key = int(cand.key[k])
+            leave = (float(cand.p[k, 0]), float(cand.p[k, 1]))
+            signed = float(self.sense[u] * sweep[k]) if rho_i > 0 else 0.0
+            if key in self.key:
+                v = self.key[key]
+                self.g[v], self.parent[v], self.leave[v], self.sweep[v] = g[k], u, leave, signed
             else:
-                ok = d > np.abs(ri - rj)
-                if sign < 0:
-                    ok &= (ri > 0) | (rj > 0)
-                cos_a = np.divide(ri - rj, d, out=np.ones_like(d), where=d > 0)
-            ang = base + sign * np.arccos(np.clip(cos_a, -1.0, 1.0))
-            n = np.column_stack([np.cos(ang), np.sin(ang)])
-            p = c[i, :2] + ri[:, None] * n
-            q = c[j, :2] + (-1.0 if inner else 1.0) * rj[:, None] * n
-            aj = ang + math.pi if inner else ang
-            out.append((p[ok], q[ok], i[ok], j[ok], ang[ok], aj[ok]))
-        p, q, ci, cj, ai, aj = (np.concatenate(parts) for parts in zip(*out, strict=True))
-        ai = np.where(c[ci, 2] > 0, np.mod(ai, _TWO_PI), 0.0)
-        aj = np.where(c[cj, 2] > 0, np.mod(aj, _TWO_PI), 0.0)
+                xy = (float(cand.q[k, 0]), float(cand.q[k, 1]))
+                v = self._add(key, xy, int(cand.j[k]), float(cand.angle_j[k]),
+                              int(cand.sense_j[k]), float(g[k]), u, leave, signed)  # fmt: skip
+            out.append(v)
+        return out
 
+    def _free_tangents(self, i: int) -> _Tangents:
+        """The tangents from circle ``i`` that some path within the bound could use and that are
+        free (segment and end points in bounds), computed once per circle.
+
+        Whether a tangent segment is free does not depend on the node it leaves from, so each
+        circle's are found once: drop those no path within the bound can use (start to the
+        tangent, the tangent, the straight line on to the goal: already longer), then those
+        the obstacles next to circle ``i`` surely block (:func:`_occluded`, a cheap angular
+        test), then test the rest exactly.
+        """
+        cached = self._cache.get(i)
+        if cached is not None:
+            return cached
+        cand = _tangents_from(self.circles, i)
+        cand.q = self._ends(cand, cand.j == 1)
+        cand.seg = np.hypot(*(cand.q - cand.p).T)
+        cand.h = np.maximum(np.hypot(*(cand.q - self.goal).T) - self.goal_tol, 0.0)
+        lower = np.hypot(*(cand.p - self.start).T) + cand.seg + cand.h
+        cand = cand.take(np.flatnonzero(lower <= self.bound))
+        if len(cand.j):
+            cand = cand.take(np.flatnonzero(~self._occluded(i, cand)))
+        if len(cand.j):
+            w = self.world
+            ok = w.points_in_bounds(cand.p) & w.points_in_bounds(cand.q)
+            idx = np.flatnonzero(ok)
+            idx = idx[w.segments_free(cand.p[idx], cand.q[idx])]
+            cand = cand.take(idx)
+        cand.key = (i * len(self.circles) + cand.j.astype(np.int64)) * 4 + cand.t
+        self._cache[i] = cand
+        return cand
+
+    def _occluded(self, i: int, cand: _Tangents) -> np.ndarray:
+        """Tangents from circle ``i`` surely blocked by a disc next to it (booleans).
+
+        A tangent leaving circle ``i`` (centre ``c``, radius ``rho``) in direction ``phi`` with
+        sense ``s`` runs on the line ``cross(x - c, u(phi)) = s rho``. A disc of radius ``r`` at
+        distance ``D`` and bearing ``theta`` from ``c`` cuts that line where
+        ``|D sin(phi - theta) - s rho| < r``, an interval of directions; the nearest point of
+        the line to the disc's centre lies ``D cos(phi - theta) <= D`` ahead. So a tangent
+        whose direction falls in the interval (with ``cos >= 0``) and that is at least ``D``
+        long passes closer than ``r`` to the centre: blocked. The discs are the inflated
+        circles near ``i`` and the discs inscribed in the inflated boxes near it; their
+        intervals, merged per sense into the least ``D`` over each piece of the circle of
+        directions, answer every tangent in one ``searchsorted``.
+        """
         w = self.world
-        # Chunks bound the (segments x obstacles) temporaries to a few MB.
-        chunk = max(1, 200_000 // max(1, len(w.circles) + len(w.polygon_edges)))
-        pts = np.concatenate([p, q])
-        point_ok = w.points_in_bounds(pts)
-        for s in range(0, len(pts), chunk):
-            point_ok[s : s + chunk] &= w.point_clearance(pts[s : s + chunk]) >= w.threshold
-        ok = point_ok[: len(p)] & point_ok[len(p) :]
-        idx = np.flatnonzero(ok)
-        free = np.zeros(len(idx), dtype=bool)
-        for s in range(0, len(idx), chunk):
-            k = idx[s : s + chunk]
-            free[s : s + chunk] = w.segments_free(p[k], q[k])
-        keep = idx[free]
-        return p[keep], q[keep], ci[keep], cj[keep], ai[keep], aj[keep]
+        ci, rho = self.circles[i, :2], float(self.circles[i, 2])
+        discs = self._near_discs(ci, rho)
+        blocked = np.zeros(len(cand.j), dtype=bool)
+        if not len(discs):
+            return blocked
+        rel = discs[:, :2] - ci
+        dist = np.hypot(rel[:, 0], rel[:, 1])
+        # Circle i's own obstacle (at distance 0) blocks nothing a tangent to it could use.
+        discs, rel, dist = discs[dist > 0], rel[dist > 0], dist[dist > 0]
+        theta = np.arctan2(rel[:, 1], rel[:, 0])
+        if not len(discs):
+            return blocked
+        r = discs[:, 2] - 2.0 * w.tol  # strictly inside: grazing tangents stay candidates
+        d = cand.q - cand.p
+        phi = np.mod(np.arctan2(d[:, 1], d[:, 0]), _TWO_PI)
+        for s in (-1, 1) if rho > 0 else (0,):
+            mine = np.flatnonzero(cand.sense_i == s) if rho > 0 else np.arange(len(phi))
+            if not len(mine):
+                continue
+            lo = np.clip((s * rho - r) / dist, -1.0, 1.0)
+            hi = np.clip((s * rho + r) / dist, -1.0, 1.0)
+            use = (r > 0) & (hi > lo)
+            a0 = np.mod(theta[use] + np.arcsin(lo[use]), _TWO_PI)
+            width = np.arcsin(hi[use]) - np.arcsin(lo[use])
+            need = _least_over_intervals(a0, width, dist[use], phi[mine])
+            blocked[mine] = cand.seg[mine] >= need
+        return blocked
 
-    # ------------------------------------------------------------------------------------------
-    def _arcs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Free arcs between angular neighbours on every circle: (u, v, sweep), counter-clockwise
-        from node u to node v."""
-        circle, angle = self.node_circle, self.node_angle
-        order = np.lexsort((angle, circle))
-        c_sorted, a_sorted = circle[order], angle[order]
-        same = np.flatnonzero(c_sorted[1:] == c_sorted[:-1])
-        u, v = order[same], order[same + 1]
-        sweep = a_sorted[same + 1] - a_sorted[same]
-        # Close each circle's ring: last node back to the first, the rest of the way round.
-        starts = np.flatnonzero(np.r_[True, c_sorted[1:] != c_sorted[:-1]])
-        ends = np.r_[starts[1:], len(order)] - 1
-        ring = ends > starts
-        u = np.concatenate([u, order[ends[ring]]])
-        v = np.concatenate([v, order[starts[ring]]])
-        sweep = np.concatenate([sweep, _TWO_PI - (a_sorted[ends[ring]] - a_sorted[starts[ring]])])
-        a0 = angle[u]
-        rho = self.circles[circle[u], 2]
-        sweep = np.where(rho > 0, sweep, 0.0)
-        free = np.zeros(len(u), dtype=bool)
-        # Chunks bound the (arcs x obstacles) temporaries to a few tens of MB.
-        chunk = max(1, 200_000 // max(1, len(self.world.circles) + len(self.world.polygon_edges)))
-        centers = self.circles[circle[u], :2]
-        for s in range(0, len(u), chunk):
-            k = slice(s, s + chunk)
-            free[k] = self._arcs_free(centers[k], rho[k], a0[k], sweep[k])
-        return u[free], v[free], sweep[free]
-
-    def _arcs_free(
-        self, center: np.ndarray, rho: np.ndarray, a0: np.ndarray, sweep: np.ndarray
-    ) -> np.ndarray:
-        """Exact test of counter-clockwise arcs against the obstacles and the bounds."""
+    def _near_discs(self, c: np.ndarray, rho: float) -> np.ndarray:
+        """(k, 3) discs inside the inflated obstacles within a few index cells of a circle."""
         w = self.world
-        ok = np.ones(len(rho), dtype=bool)
-        if not len(rho):
-            return ok
-        # Bounds: the arc's extreme points are its ends and the axis directions it passes.
-        ends = [a0, a0 + sweep]
-        xs = [center[:, 0] + rho * np.cos(a) for a in ends]
-        ys = [center[:, 1] + rho * np.sin(a) for a in ends]
-        for axis in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi):
-            inside = _in_sweep(axis, a0, sweep)
-            px = np.where(inside, center[:, 0] + rho * math.cos(axis), xs[0])
-            py = np.where(inside, center[:, 1] + rho * math.sin(axis), ys[0])
-            xs.append(px)
-            ys.append(py)
-        ok &= (
-            w.points_in_bounds(np.stack([np.concatenate(xs), np.concatenate(ys)], axis=1))
-            .reshape(-1, len(rho))
-            .all(axis=0)
-        )
+        if not w.n_obstacles:
+            return np.empty((0, 3))
+        reach = rho + 2.0 * w._grid.h
+        _, ids = w._grid.pairs_in_boxes(c - reach, c + reach)
+        kind = w._kind_of(ids)
+        circ = w.circles[ids[kind == 0]]
+        out = [np.column_stack([circ[:, :2], circ[:, 2] + w.threshold])]
+        box = w.boxes[ids[kind == 1] - w._n_circles]
+        if len(box):
+            half = 0.5 * np.minimum(box[:, 2] - box[:, 0], box[:, 3] - box[:, 1])
+            mid = 0.5 * (box[:, :2] + box[:, 2:])
+            out.append(np.column_stack([mid, half + w.threshold]))
+        return np.vstack(out)
 
-        if len(w.circles):
-            obs = w.circles
-            d = _arc_point_distance(
-                center[:, None, :], rho[:, None], a0[:, None], sweep[:, None], obs[None, :, :2]
-            )
-            ok &= np.all(d >= obs[None, :, 2] + w.threshold, axis=1)
-        if len(w.polygon_edges):
-            e = w.polygon_edges
-            d = _arc_segment_distance(
-                center[:, None, :],
-                rho[:, None],
-                a0[:, None],
-                sweep[:, None],
-                e[None, :, :2],
-                e[None, :, 2:],
-            )
-            ok &= np.all(d >= w.threshold, axis=1)
-            # An arc clear of every edge is wholly inside or outside each polygon.
-            mid = a0 + 0.5 * sweep
-            inside = w.in_polygons(
-                center[:, 0] + rho * np.cos(mid), center[:, 1] + rho * np.sin(mid)
-            )
-            ok &= ~inside
+    def _arcs_ok(self, u: int, sweep: np.ndarray) -> np.ndarray:
+        """Which arcs along node ``u``'s circle, from its angle through ``sweep``, are free."""
+        ok = np.ones(len(sweep), dtype=bool)
+        arcs = np.flatnonzero(sweep > 0)
+        if len(arcs):
+            s = sweep[arcs]
+            i = self.circle[u]
+            a0 = self.angle[u] if self.sense[u] > 0 else self.angle[u] - s
+            center = np.broadcast_to(self.circles[i, :2], (len(arcs), 2))
+            rho = np.full(len(arcs), self.circles[i, 2])
+            ok[arcs] = _arcs_free(self.world, center, rho, np.broadcast_to(a0, s.shape), s)
         return ok
 
-    # ------------------------------------------------------------------------------------------
-    def _goal_targets(self) -> None:
-        """Goal nodes and the length still to go from each (0 without a goal tolerance)."""
-        on_goal = np.flatnonzero(self.node_circle == 1)
-        if self.goal_tol == 0.0 or not len(self.node_xy):
-            self.goal_nodes = on_goal
-            self.goal_cost = np.zeros(len(on_goal))
-            self._goal_end = None
-            return
-        # With a tolerance, the path ends where the leg towards the goal point enters the disc of
-        # radius goal_tol: the nearest point of the disc, exact when the disc is free (a shortest
-        # path to a free convex target ends perpendicular to it, on a tangent to the goal point).
-        goal = self.circles[1, :2]
-        xy = self.node_xy
-        to_goal = goal - xy
-        dist = np.hypot(*to_goal.T)
-        frac = np.clip(1.0 - self.goal_tol / np.where(dist > 0, dist, 1.0), 0.0, 1.0)
-        end = xy + frac[:, None] * to_goal
-        free = self.world.segments_free(xy, end) & self.world.points_in_bounds(end)
-        self.goal_nodes = np.flatnonzero(free)
-        self.goal_cost = np.maximum(dist - self.goal_tol, 0.0)[free]
-        self._goal_end = end[free]
+    def _ends(self, cand, to_goal: np.ndarray) -> np.ndarray:
+        """Where each tangent ends: its tangent point, or inside a goal tolerance, the point where
+        it enters the goal disc."""
+        end = cand.q.copy()
+        if self.goal_tol > 0 and to_goal.any():
+            d = cand.q[to_goal] - cand.p[to_goal]
+            n = np.hypot(*d.T)
+            frac = np.clip(1.0 - self.goal_tol / np.where(n > 0, n, 1.0), 0.0, 1.0)
+            end[to_goal] = cand.p[to_goal] + frac[:, None] * d
+        return end
 
-    def goal_piece(self, k: int) -> Piece | None:
-        """The final leg into the goal disc from goal node number ``k``, if any."""
-        if self._goal_end is None:
-            return None
-        a = tuple(map(float, self.node_xy[self.goal_nodes[k]]))
-        return Piece("line", a, tuple(map(float, self._goal_end[k])))
+    def _pieces(self, v: int) -> list[Piece]:
+        """The path from the start to node ``v`` as arcs and tangent segments."""
+        chain = []
+        while v != -1:
+            chain.append(v)
+            v = self.parent[v]
+        chain.reverse()
+        pieces: list[Piece] = []
+        for u, v in itertools.pairwise(chain):
+            leave = self.leave[v]
+            if self.sweep[v] != 0.0:
+                c = self.circles[self.circle[u]]
+                pieces.append(Piece("arc", self.xy[u], leave, (float(c[0]), float(c[1])),
+                                    float(c[2]), self.angle[u], self.sweep[v]))  # fmt: skip
+            pieces.append(Piece("line", leave, self.xy[v]))
+        return pieces
 
-    def piece(self, a: int, b: int) -> Piece:
-        """The graph edge between nodes ``a`` and ``b``, oriented from ``a`` to ``b``."""
-        is_arc, ccw_from = self.edges[(min(a, b), max(a, b))]
-        pa = tuple(map(float, self.node_xy[a]))
-        pb = tuple(map(float, self.node_xy[b]))
-        if not is_arc:
-            return Piece("line", pa, pb)
-        c = self.circles[self.node_circle[a]]
-        rho = float(c[2])
-        ang_a, ang_b = float(self.node_angle[a]), float(self.node_angle[b])
-        if ccw_from == a:
-            sweep = float(np.mod(ang_b - ang_a, _TWO_PI))
+
+class _Tangents:
+    """The common tangents from one circle to many: arrays of the same length.
+
+    ``q`` is where each tangent ends (its tangent point, or where it enters the goal disc);
+    ``seg``, ``h`` and ``key`` (the tangent's length, its end's distance to the goal and the key
+    of the node it reaches) are filled in by the search.
+    """
+
+    _FIELDS = ("j", "t", "p", "q", "angle_i", "angle_j", "sense_i", "sense_j", "seg", "h", "key")
+
+    def __init__(self, j, t, p, q, angle_i, angle_j, sense_i, sense_j) -> None:
+        self.j, self.t, self.p, self.q = j, t, p, q
+        self.angle_i, self.angle_j = angle_i, angle_j
+        self.sense_i, self.sense_j = sense_i, sense_j
+        self.seg = self.h = self.key = None
+
+    def take(self, idx: np.ndarray) -> _Tangents:
+        out = _Tangents.__new__(_Tangents)
+        for name in self._FIELDS:
+            value = getattr(self, name)
+            setattr(out, name, None if value is None else value[idx])
+        return out
+
+
+def _least_over_intervals(
+    a0: np.ndarray, width: np.ndarray, value: np.ndarray, phi: np.ndarray
+) -> np.ndarray:
+    """For each angle ``phi`` in [0, 2 pi), the least ``value`` of the intervals
+    ``[a0, a0 + width]`` (angles modulo 2 pi, open at both ends) that contain it; ``inf`` where
+    none does."""
+    if not len(a0):
+        return np.full(len(phi), np.inf)
+    # Each interval also once shifted down a turn, so those that wrap past 2 pi are found.
+    lo = np.concatenate([a0, a0 - _TWO_PI])
+    hi = lo + np.concatenate([width, width])
+    val = np.concatenate([value, value])
+    edges = np.unique(np.concatenate([lo, hi, [0.0, _TWO_PI]]))
+    mids = 0.5 * (edges[:-1] + edges[1:])
+    inside = (lo[None, :] < mids[:, None]) & (mids[:, None] < hi[None, :])
+    least = np.where(inside, val[None, :], np.inf).min(axis=1)
+    piece = np.clip(np.searchsorted(edges, phi, side="right") - 1, 0, len(mids) - 1)
+    # An angle on a piece's edge may lie on an interval's open end: count it as outside.
+    on_edge = np.isin(phi, edges)
+    return np.where(on_edge, np.inf, least[piece])
+
+
+def _tangents_from(circles: np.ndarray, i: int) -> _Tangents:
+    """Every common tangent from circle ``i`` to the others (not back to the start), with the
+    sense in which a path along it wraps each circle (+1 counter-clockwise, -1 clockwise, 0 for
+    a point)."""
+    c = circles
+    j = np.arange(len(c))
+    j = j[(j != i) & (j != 0)]
+    ri, rj = c[i, 2], c[j, 2]
+    d_vec = c[j, :2] - c[i, :2]
+    d = np.hypot(*d_vec.T)
+    base = np.arctan2(d_vec[:, 1], d_vec[:, 0])
+    parts = []
+    # Outer tangents: normal at angle base +- acos((ri - rj) / d) on both circles. Inner ones:
+    # base +- acos((ri + rj) / d), with the normal reversed on circle j. A radius of 0 makes
+    # the inner tangents repeat the outer ones, and two points have one tangent.
+    for t, (inner, sign) in enumerate(((False, 1.0), (False, -1.0), (True, 1.0), (True, -1.0))):
+        if inner:
+            ok = (ri > 0) & (rj > 0) & (d > ri + rj)
+            cos_a = np.divide(ri + rj, d, out=np.ones_like(d), where=d > 0)
         else:
-            sweep = -float(np.mod(ang_a - ang_b, _TWO_PI))
-        return Piece("arc", pa, pb, (float(c[0]), float(c[1])), rho, ang_a, sweep)
+            ok = d > np.abs(ri - rj)
+            if sign < 0:
+                ok &= (ri > 0) | (rj > 0)
+            cos_a = np.divide(ri - rj, d, out=np.ones_like(d), where=d > 0)
+        ang = base + sign * np.arccos(np.clip(cos_a, -1.0, 1.0))
+        n = np.column_stack([np.cos(ang), np.sin(ang)])
+        p = c[i, :2] + ri * n
+        q = c[j, :2] + (-1.0 if inner else 1.0) * rj[:, None] * n
+        aj = ang + math.pi if inner else ang
+        parts.append((j[ok], np.full(int(ok.sum()), t), p[ok], q[ok], ang[ok], aj[ok]))
+    jj, tt, p, q, ai, aj = (np.concatenate(x) for x in zip(*parts, strict=True))
+    direction = q - p
+    sense_i = _sense(direction, c[i, :2] - p) if ri > 0 else np.zeros(len(jj), dtype=int)
+    sense_j = np.where(c[jj, 2] > 0, _sense(direction, c[jj, :2] - q), 0)
+    return _Tangents(jj, tt, p, q, np.mod(ai, _TWO_PI), np.mod(aj, _TWO_PI), sense_i, sense_j)
+
+
+def _sense(direction: np.ndarray, to_center: np.ndarray) -> np.ndarray:
+    """+1 when the centre lies to the left of the direction of travel (counter-clockwise)."""
+    z = direction[:, 0] * to_center[:, 1] - direction[:, 1] * to_center[:, 0]
+    return np.where(z > 0, 1, -1)
+
+
+def _arcs_free(world: World, center, rho, a0, sweep) -> np.ndarray:
+    """Exact test of counter-clockwise arcs (from ``a0`` through ``sweep``) against the bounds and
+    the obstacles the index names near each arc's circle."""
+    ok = np.ones(len(rho), dtype=bool)
+    # Bounds: the arc's extreme points are its ends and the axis directions it passes.
+    xs = [center[:, 0] + rho * np.cos(a) for a in (a0, a0 + sweep)]
+    ys = [center[:, 1] + rho * np.sin(a) for a in (a0, a0 + sweep)]
+    for axis in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi):
+        inside = _in_sweep(axis, a0, sweep)
+        xs.append(np.where(inside, center[:, 0] + rho * math.cos(axis), xs[0]))
+        ys.append(np.where(inside, center[:, 1] + rho * math.sin(axis), ys[0]))
+    pts = np.stack([np.concatenate(xs), np.concatenate(ys)], axis=1)
+    ok &= world.points_in_bounds(pts).reshape(-1, len(rho)).all(axis=0)
+    # Obstacles near each arc's circle (its bounding box, grown by the reach in the index).
+    lo = center - rho[:, None]
+    hi = center + rho[:, None]
+    arc, ids = world._grid.pairs_in_boxes(lo, hi) if world.n_obstacles else (np.empty(0, int),) * 2
+    kind = world._kind_of(ids)
+    c = kind == 0
+    if c.any():
+        obs = world.circles[ids[c]]
+        k = arc[c]
+        d = _arc_point_distance(center[k], rho[k], a0[k], sweep[k], obs[:, :2])
+        bad = d < obs[:, 2] + world.threshold
+        ok[np.unique(k[bad])] = False
+    e_arc, edges = _edges_of(world, arc, ids, kind)
+    if len(e_arc):
+        d = _arc_segment_distance(center[e_arc], rho[e_arc], a0[e_arc], sweep[e_arc],
+                                  edges[:, :2], edges[:, 2:])  # fmt: skip
+        ok[np.unique(e_arc[d < world.threshold])] = False
+    # An arc clear of every edge is wholly inside or outside each polygon and box.
+    mid = a0 + 0.5 * sweep
+    ok &= ~world.in_polygons(center[:, 0] + rho * np.cos(mid), center[:, 1] + rho * np.sin(mid))
+    return ok
+
+
+def _edges_of(world: World, arc: np.ndarray, ids: np.ndarray, kind: np.ndarray):
+    """(arc, edge) pairs for the boxes and polygons among the candidates."""
+    arcs, edges = [], []
+    x = kind == 1
+    if x.any():
+        b = world.boxes[ids[x] - world._n_circles]
+        for e in (b[:, [0, 1, 2, 1]], b[:, [2, 1, 2, 3]], b[:, [2, 3, 0, 3]], b[:, [0, 3, 0, 1]]):
+            arcs.append(arc[x])
+            edges.append(e)
+    p = kind == 2
+    if p.any():
+        poly = ids[p] - world._n_circles - world._n_boxes
+        start = world._edge_start[poly]
+        count = world._edge_start[poly + 1] - start
+        pair = np.repeat(np.arange(len(poly)), count)
+        edge = np.repeat(start, count) + np.arange(count.sum()) - np.repeat(
+            np.cumsum(count) - count, count)  # fmt: skip
+        arcs.append(arc[p][pair])
+        edges.append(world._edges[edge])
+    if not arcs:
+        return np.empty(0, dtype=int), np.empty((0, 4))
+    return np.concatenate(arcs), np.vstack(edges)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -369,8 +369,37 @@ class World:
         return v.reshape(shape)
 
     def segments_free(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """Boolean array: whether each segment ``a[i]-b[i]`` is free (bounds not checked)."""
-        return self.segment_distance(a, b, cap=self.threshold) >= self.threshold
+        """Boolean array: whether each segment ``a[i]-b[i]`` is free (bounds not checked).
+
+        Long segments are checked a stretch at a time from ``a``, each stretch twice as long as
+        the one before (4 index cells, then 8, 16, ...), and a segment leaves as soon as one
+        stretch is blocked. In a cluttered world most long segments are blocked within a few
+        cells, so they cost a few cells instead of their whole length; a free segment costs
+        ``log2`` of its length in rounds. A segment is free exactly when all its stretches are.
+        """
+        a, b, shape = _flat_pair(a, b)
+        thr = self.threshold
+        if not self._indexed or not len(a):
+            return (self.segment_distance(a, b, cap=thr) >= thr).reshape(shape)
+        d = b - a
+        length = np.hypot(d[:, 0], d[:, 1])
+        ok = np.ones(len(a), dtype=bool)
+        done = np.zeros(len(a))  # fraction of each segment already known to be free
+        alive = np.arange(len(a))
+        span = 4.0 * self._grid.h
+        while len(alive):
+            t0 = done[alive]
+            n = length[alive]
+            t1 = np.where(n > span, np.minimum(1.0, t0 + span / np.where(n > 0, n, 1.0)), 1.0)
+            # The last stretch ends exactly at b, so no rounding moves the end point.
+            pb = np.where((t1 >= 1.0)[:, None], b[alive], a[alive] + t1[:, None] * d[alive])
+            pa = np.where((t0 <= 0.0)[:, None], a[alive], a[alive] + t0[:, None] * d[alive])
+            free = self.segment_distance(pa, pb, cap=thr) >= thr
+            ok[alive[~free]] = False
+            done[alive] = t1
+            alive = alive[free & (t1 < 1.0)]
+            span *= 2.0
+        return ok.reshape(shape)
 
     def points_in_bounds(self, points: np.ndarray) -> np.ndarray:
         """Boolean array: whether each point lies in the bounds (inclusive, with tolerance)."""

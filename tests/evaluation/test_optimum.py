@@ -152,10 +152,11 @@ def test_start_equals_goal_and_goal_tolerance():
 
 
 # ----------------------------------------------------------------------------------------------
-def _brute_force(problem, quad_segs: int = 16) -> float | None:
+def _brute_force(problem, quad_segs: int = 16, bound: float = math.inf) -> float | None:
     """An independent check: the visibility graph of the grown obstacles drawn as shapely
     polygons (vertices on the true boundary, so slightly smaller than the grown obstacles: a
-    lower bound that tends to the optimum as ``quad_segs`` grows)."""
+    lower bound that tends to the optimum as ``quad_segs`` grows). Only vertices that a path
+    no longer than ``bound`` can pass are kept."""
     R = problem.robot.radius
     shapes = []
     for o in problem.obstacles:
@@ -171,6 +172,8 @@ def _brute_force(problem, quad_segs: int = 16) -> float | None:
             verts.extend(ring.coords[:-1])
     v = np.array(verts, float)
     v = v[(v[:, 0] >= x0) & (v[:, 0] <= x1) & (v[:, 1] >= y0) & (v[:, 1] <= y1)]
+    reach = np.hypot(*(v - v[0]).T) + np.hypot(*(v - v[1]).T)
+    v = v[reach <= bound]
     i, j = np.triu_indices(len(v), k=1)
     lines = shapely.linestrings(np.stack([v[i], v[j]], axis=1))
     ok = ~shapely.relate_pattern(union, lines, "T********")  # no interior in common
@@ -180,18 +183,22 @@ def _brute_force(problem, quad_segs: int = 16) -> float | None:
     return float(d) if np.isfinite(d) else None
 
 
-def _cluttered(seed: int, robot_radius: float) -> dict:
-    """Overlapping random circles and convex polygons across the start-goal line."""
+def _cluttered(seed: int, robot_radius: float, n: int = 9, sizes=(5, 14)) -> dict:
+    """Overlapping random circles, boxes and convex polygons across the start-goal line."""
     rng = np.random.default_rng(seed)
     start, goal = np.array([5.0, 50.0]), np.array([95.0, 50.0])
     obstacles = []
-    while len(obstacles) < 9:
+    while len(obstacles) < n:
         c = rng.uniform((20, 25), (80, 75))
-        size = rng.uniform(5, 14)
+        size = rng.uniform(*sizes)
         if min(np.linalg.norm(c - start), np.linalg.norm(c - goal)) < size + robot_radius + 3:
             continue
-        if rng.random() < 0.5:
+        kind = rng.random()
+        if kind < 0.4:
             obstacles.append({"type": "circle", "center": c.round(2).tolist(), "radius": size})
+        elif kind < 0.6:
+            lo, hi = (c - size * 0.7).round(2), (c + size * rng.uniform(0.3, 0.9)).round(2)
+            obstacles.append({"type": "rectangle", "min": lo.tolist(), "max": hi.tolist()})
         else:
             angles = np.sort(rng.uniform(0, 2 * np.pi, rng.integers(3, 7)))
             pts = c + size * np.column_stack([np.cos(angles), np.sin(angles)])
@@ -200,12 +207,18 @@ def _cluttered(seed: int, robot_radius: float) -> dict:
             "robot": {"radius": robot_radius}, "obstacles": obstacles}  # fmt: skip
 
 
-@pytest.mark.parametrize(("seed", "robot_radius"), [(1, 0.0), (2, 1.5), (3, 3.0), (4, 0.5)])
-def test_agrees_with_brute_force_and_is_below_a_certified_grid_path(seed, robot_radius):
-    problem = problem_from_dict(_cluttered(seed, robot_radius))
+@pytest.mark.parametrize(
+    ("seed", "robot_radius", "n"),
+    [(1, 0.0, 9), (2, 1.5, 9), (3, 3.0, 9), (4, 0.5, 9), (5, 0.5, 40), (6, 1.0, 50)],
+)
+def test_agrees_with_brute_force_and_is_below_a_certified_grid_path(seed, robot_radius, n):
+    """Few obstacles, and many (indexed world, tangents pruned by occlusion)."""
+    size = (5, 14) if n < 20 else (1.5, 4)
+    problem = problem_from_dict(_cluttered(seed, robot_radius, n, size))
     result = shortest_path(problem)
-    lower = _brute_force(problem)
-    assert result.found and lower is not None
+    assert result.found
+    lower = _brute_force(problem, bound=result.length * 1.001)
+    assert lower is not None
     assert result.length > math.dist(problem.start, problem.goal) + 0.1  # obstacles in the way
     # The inscribed polygons make the brute force slightly shorter, never longer.
     assert lower <= result.length * (1 + 1e-9)
@@ -297,3 +310,24 @@ def test_the_json_path_is_a_valid_path_of_nearly_the_exact_length(path):
     # The old chords were not valid wherever the path wraps an obstacle.
     chords = np.vstack([p.points()[[0, -1]] for p in result.pieces])
     assert path_length(chords) <= path_length(polyline)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_occlusion_never_drops_a_free_tangent(seed):
+    """The angular filter only removes tangents the exact check would reject."""
+    from rrtpso_ompl.evaluation.optimum import _node_circles, _tangents_from, _TangentSearch
+
+    problem = problem_from_dict(_cluttered(seed, 0.8, 40, (1.5, 4)))
+    world = World.from_problem(problem)
+    start, goal = np.array(problem.start[:2]), np.array(problem.goal[:2])
+    circles = _node_circles(problem, world, start, goal, world.robot_radius)
+    search = _TangentSearch(world, circles, 0.0, math.inf, "t")
+    dropped = 0
+    for i in range(len(search.circles)):
+        cand = _tangents_from(search.circles, i)
+        cand.seg = np.hypot(*(cand.q - cand.p).T)
+        blocked = search._occluded(i, cand)
+        if blocked.any():
+            assert not world.segments_free(cand.p[blocked], cand.q[blocked]).any()
+            dropped += int(blocked.sum())
+    assert dropped > 500  # the filter does real work
