@@ -27,6 +27,7 @@ from .planners.solve import SolveResult
 
 __all__ = [
     "animate_simulation",
+    "draw_map",
     "draw_world",
     "plot_bench",
     "plot_optimum",
@@ -48,6 +49,8 @@ def draw_world(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> None
     """Obstacles (filled), their safety zones (the obstacles grown by the robot radius, dashed:
     the robot's centre must stay outside them), bounds, start and goal."""
     r = problem.robot.radius
+    if problem.map is not None:
+        draw_map(ax, problem, safety_zones=safety_zones)
     for obs in problem.obstacles:
         if isinstance(obs, Circle):
             ax.add_patch(CirclePatch(obs.center, obs.radius, color=OBSTACLE, zorder=2))
@@ -87,6 +90,30 @@ def draw_world(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> None
     unit = f" [{problem.units}]" if problem.units else ""
     ax.set_xlabel(f"x{unit}")
     ax.set_ylabel(f"y{unit}")
+
+
+def draw_map(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> None:
+    """The occupancy grid under everything: occupied cells dark, unknown cells grey (light grey
+    when ``unknown: free``), free cells white; the robot's clearance zone around the blocked
+    cells shaded.
+
+    The shading is drawing only (cells whose centre lies within the robot radius of a blocked
+    cell's centre, from a Euclidean distance transform); the checks use the exact squares.
+    """
+    from scipy.ndimage import distance_transform_edt
+
+    grid = problem.map
+    (x0, y0), (x1, y1) = grid.extent
+    rgb = np.ones((*grid.state.shape, 3))
+    rgb[grid.state == -1] = 0.62 if grid.unknown_blocks else 0.85
+    rgb[grid.state == 1] = np.array([0x5B, 0x67, 0x70]) / 255.0  # OBSTACLE
+    r = problem.robot.radius
+    if safety_zones and r > 0 and grid.blocked.any() and not grid.blocked.all():
+        near = distance_transform_edt(~grid.blocked, sampling=grid.resolution) <= r
+        zone = near & ~grid.blocked
+        rgb[zone] = 0.55 * rgb[zone] + 0.45 * np.array([0xE0, 0xA0, 0x30]) / 255.0  # SAFETY
+    # Image row 0 is the top of the map, as in the file.
+    ax.imshow(rgb, extent=(x0, x1, y0, y1), origin="upper", interpolation="nearest", zorder=0)
 
 
 def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> Figure:

@@ -52,6 +52,17 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         "--plot", metavar="OUT.png", help="draw the world, the paths and the PSO best-cost curve"
     )
     p.add_argument(
+        "--path-out",
+        metavar="FILE",
+        help="write the path as a ROS nav_msgs/Path document (JSON for .json, else YAML)",
+    )
+    p.add_argument(
+        "--frame-id",
+        default="map",
+        metavar="FRAME",
+        help="header.frame_id of --path-out (default: map)",
+    )
+    p.add_argument(
         "--simplify",
         action="store_true",
         help="run OMPL's path simplifier on the result within the time limit",
@@ -88,6 +99,7 @@ def run(args: argparse.Namespace) -> int:
     outputs = [
         Output("--json", args.json),
         Output("--plot", args.plot, "image"),
+        Output("--path-out", args.path_out),
         Output("--trajectory", args.trajectory),
         Output("--plot-velocities", args.plot_velocities, "image"),
     ]
@@ -139,6 +151,10 @@ def _write_outputs(args: argparse.Namespace, problem: Any, result: Any, motion: 
         save_figure(plot_velocities(motion.trajectory, problem.units), args.plot_velocities)
     if motion and args.trajectory:
         motion.trajectory.write_csv(args.trajectory)
+    if args.path_out and result.solved:
+        from ..kinematics import nav_path, write_nav_path
+
+        write_nav_path(nav_path(result.path, args.frame_id), args.path_out)
     if args.json:
         from ..outputs import write_json_atomic
 

@@ -357,7 +357,9 @@ class ReplanningManager:
                 *wall,
                 *self._sweeps(obs, t_now, p_s, t_s, horizon),
             ]
-            world = World.from_obstacles(self.problem.bounds, obstacles, self.sr)
+            world = World.from_obstacles(
+                self.problem.bounds, obstacles, self.sr, self.problem.map_boxes
+            )
             if world.point_free(*goal):
                 return t_g, goal, obstacles, world
         return None

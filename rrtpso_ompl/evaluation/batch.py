@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ProblemError, RrtpsoError
+from ..model.occupancy import is_map_yaml
 from .results_file import ResultsFile, latest_rows, read_rows, row_key
 
 __all__ = [
@@ -78,9 +79,11 @@ def expand_inputs(items: Sequence[str]) -> list[tuple[str, str | None]]:
 
     for item in items:
         p = Path(item)
-        if p.is_dir():
+        if p.is_dir():  # a folder's map_server maps belong to its problems: not tasks
             found = sorted(
-                str(f) for f in p.rglob("*") if f.suffix in PROBLEM_SUFFIXES and f.is_file()
+                str(f)
+                for f in p.rglob("*")
+                if f.suffix in PROBLEM_SUFFIXES and f.is_file() and not is_map_yaml(f)
             )
             if not found:
                 add(item, "directory holds no .yaml problem files")

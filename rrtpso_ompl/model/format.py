@@ -20,6 +20,7 @@ from ..validation import MAX_COORDINATE, MAX_SECONDS, MIN_EXTENT, SEED_MAX
 
 __all__ = [
     "CIRCLE",
+    "MAP",
     "MOVING",
     "PLANNER",
     "POLYGON",
@@ -51,6 +52,9 @@ KINDS: dict[str, dict[str, Any]] = {
         "type": "object",
         "description": "planner parameters by name; see `rrtpso planners NAME`",
     },
+    # The short form (the map YAML's path) or the long form (a mapping).
+    "map": {"anyOf": [{"type": "string", "minLength": 1}, {"$ref": "#/$defs/map"}]},
+    "unknown": {"enum": ["obstacle", "free"]},
 }
 
 
@@ -139,12 +143,18 @@ MOVING = Section("moving_obstacle", (
     Key("heading_deg", "number", "direction of motion, counter-clockwise from +x", True, "deg"),
 ), "a disc moving at constant velocity (paper eqs. 14-15)")  # fmt: skip
 
+MAP = Section("map", (
+    Key("file", "name", "the map_server YAML file, relative to this problem file", True),
+    Key("unknown", "unknown", "unknown cells: obstacle (default) or free"),
+), "an occupancy-grid map in ROS map_server's format (YAML and image)")  # fmt: skip
+
 TOP = Section("problem", (
     Key("name", "name", "problem name (default: the file's stem)"),
     Key("description", "text", "free text"),
-    Key("units", "text", "label of the length unit for plots and reports"),
-    Key("bounds", "bounds", "[[xmin, ymin], [xmax, ymax]]: where the robot's centre may be",
-        True, "length"),
+    Key("units", "text", "label of the length unit for plots and reports (m with a map)"),
+    Key("map", "map", "the static world from an occupancy-grid map (besides obstacles)"),
+    Key("bounds", "bounds", "[[xmin, ymin], [xmax, ymax]]: where the robot's centre may be; "
+        "required unless a map gives them (its extent)", unit="length"),
     Key("start", "point", "start position", True, "length"),
     Key("goal", "point", "goal position", True, "length"),
     Key("goal_tolerance", "length", "how close to the goal a path must end", unit="length"),
@@ -154,7 +164,7 @@ TOP = Section("problem", (
     Key("planner", "planner", "planner defaults"),
 ), "a planning problem for a disc-shaped differential-drive robot")  # fmt: skip
 
-_SECTIONS = {"robot": ROBOT, "planner": PLANNER, "moving_obstacle": MOVING}
+_SECTIONS = {"robot": ROBOT, "planner": PLANNER, "moving_obstacle": MOVING, "map": MAP}
 
 
 def _section_schema(section: Section, type_const: str | None = None) -> dict[str, Any]:
@@ -200,6 +210,7 @@ def json_schema() -> dict[str, Any]:
     schema["properties"]["bounds"]["description"] += (
         f"; each side at least {MIN_EXTENT:g}, xmin < xmax and ymin < ymax"
     )
+    schema["anyOf"] = [{"required": ["bounds"]}, {"required": ["map"]}]
     return schema
 
 

@@ -31,7 +31,8 @@ from ..validation import (
     check_seed,
     describe,
 )
-from .format import MOVING, OBSTACLES, PLANNER, ROBOT, TOP
+from .format import MAP, MOVING, OBSTACLES, PLANNER, ROBOT, TOP
+from .occupancy import OccupancyMap, load_map
 from .yamlfile import read_yaml_file
 
 #: Why coordinates and lengths are bounded (for messages).
@@ -157,6 +158,20 @@ class Problem:
     description: str = ""
     units: str = ""
     source: str = "<dict>"
+    map: OccupancyMap | None = field(default=None, compare=False)
+
+    @property
+    def map_boxes(self) -> np.ndarray | None:
+        """(k, 4) boxes ``(xmin, ymin, xmax, ymax)`` blocked by the map: its merged blocked cells
+        and, when unknown cells block, the parts of the bounds outside the map; None without a
+        map."""
+        if self.map is None:
+            return None
+        boxes = self.map.boxes
+        if not self.map.unknown_blocks:
+            return boxes
+        outside = _outside(self.bounds, self.map.extent)
+        return np.vstack([boxes, outside]) if len(outside) else boxes
 
 
 def load_problem(path: str | Path) -> Problem:
@@ -182,10 +197,12 @@ def load_problem(path: str | Path) -> Problem:
     """
     path = Path(path)
     data = read_yaml_file(path)
-    return problem_from_dict(data, source=str(path), name=path.stem)
+    return problem_from_dict(data, source=str(path), name=path.stem, base=path.parent)
 
 
-def problem_from_dict(data: Any, source: str = "<dict>", name: str | None = None) -> Problem:
+def problem_from_dict(
+    data: Any, source: str = "<dict>", name: str | None = None, base: str | Path | None = None
+) -> Problem:
     """Validate an already-parsed mapping (as from YAML) into a :class:`Problem`.
 
     Parameters
@@ -196,6 +213,9 @@ def problem_from_dict(data: Any, source: str = "<dict>", name: str | None = None
         Named in error messages (the file path) and stored as ``Problem.source``.
     name : str, optional
         Default for the ``name`` key (the file's stem); ``"problem"`` when neither is given.
+    base : str or Path, optional
+        The folder a relative ``map`` path is taken from; default the folder of ``source``, or
+        the working directory for a ``source`` such as ``"<dict>"``.
 
     Returns
     -------
@@ -211,8 +231,21 @@ def problem_from_dict(data: Any, source: str = "<dict>", name: str | None = None
     v = _Validator(source)
     if data is None:
         raise v.error("", "the file is empty; a problem needs at least bounds, start, goal, robot")
+    if isinstance(data, Mapping) and {"image", "resolution"} <= set(data) and "start" not in data:
+        raise v.error(
+            "",
+            "this is an occupancy-grid map (map_server YAML), not a problem; "
+            "name it in a problem's map key",
+        )
     doc = v.mapping(data, "", _TOP_KEYS, required=_REQUIRED)
-    bounds = v.bounds(doc["bounds"], "bounds")
+    if base is None:  # a map path is relative to the problem file, when there is one
+        base = Path.cwd() if source.startswith("<") else Path(source).parent
+    occupancy = v.map(doc.get("map"), "map", Path(base))
+    if doc.get("bounds") is None and occupancy is None:
+        raise v.error("bounds", "required key is missing (or give a map, whose extent it is)")
+    bounds = v.bounds(doc["bounds"], "bounds") if doc.get("bounds") is not None else None
+    if bounds is None:
+        bounds = occupancy.extent
     robot = v.robot(doc["robot"], "robot")
     obstacles = tuple(
         v.obstacle(o, f"obstacles[{i}]") for i, o in enumerate(v.sequence(doc, "obstacles"))
@@ -224,7 +257,7 @@ def problem_from_dict(data: Any, source: str = "<dict>", name: str | None = None
     problem = Problem(
         name=v.string(_get(doc, "name", name or "problem"), "name"),
         description=v.string(_get(doc, "description", ""), "description", empty=True),
-        units=v.string(_get(doc, "units", ""), "units", empty=True),
+        units=v.string(_get(doc, "units", "m" if occupancy else ""), "units", empty=True),
         bounds=bounds,
         start=v.point(doc["start"], "start"),
         goal=v.point(doc["goal"], "goal"),
@@ -234,6 +267,7 @@ def problem_from_dict(data: Any, source: str = "<dict>", name: str | None = None
         moving_obstacles=moving,
         planner=v.planner(_get(doc, "planner", {}), "planner"),
         source=source,
+        map=occupancy,
     )
     for key in ("start", "goal"):
         v.free_position(problem, key)
@@ -250,6 +284,7 @@ _ROBOT_KEYS = ROBOT.names()
 _PLANNER_KEYS = PLANNER.names()
 _OBSTACLE_KEYS = {kind: section.names() for kind, section in OBSTACLES.items()}
 _MOVING_KEYS = MOVING.names()
+_MAP_KEYS = MAP.names()
 _REQUIRED = TOP.required()
 
 
@@ -436,6 +471,21 @@ class _Validator:
             ring.reverse()
         return Polygon(tuple(ring))
 
+    def map(self, value: Any, key: str, base: Path) -> OccupancyMap | None:
+        """The ``map`` key: a path (short form) or ``{file, unknown}``; the map it names, read."""
+        if value is None:
+            return None
+        if isinstance(value, str):
+            doc: Mapping[str, Any] = {"file": value}
+        else:
+            doc = self.mapping(value, key, _MAP_KEYS, required=MAP.required())
+        file = self.string(doc["file"], f"{key}.file" if not isinstance(value, str) else key)
+        unknown = _get(doc, "unknown", "obstacle")
+        if unknown not in ("obstacle", "free"):
+            raise self.error(f"{key}.unknown", f"must be obstacle or free, got {describe(unknown)}")
+        path = Path(file) if Path(file).is_absolute() else base / file
+        return load_map(path, unknown_blocks=unknown == "obstacle")
+
     def moving(self, value: Any, key: str) -> MovingObstacle:
         doc = self.mapping(value, key, _MOVING_KEYS, required=_MOVING_KEYS)
         # No bounds check: a moving obstacle may well enter the workspace from outside.
@@ -460,6 +510,8 @@ class _Validator:
         r = problem.robot.radius
         tol = touch_tolerance(problem.bounds)
         need = clearance_threshold(r, tol)
+        if problem.map is not None:
+            self.clear_of_map(problem, key, need)
         for i, obs in enumerate(problem.obstacles):
             d = _clearance(obs, x, y)
             if d >= need:
@@ -481,10 +533,58 @@ class _Validator:
                 f"({obs.kind}): clearance {d:.4g} < {r:g}",
             )
 
+    def clear_of_map(self, problem: Problem, key: str, need: float) -> None:
+        """Reject a start or goal in, or within the robot radius of, a blocked map cell."""
+        x, y = getattr(problem, key)
+        grid = problem.map
+        hit = grid.nearest_blocked(x, y, need)
+        r = problem.robot.radius
+        state = "occupied" if hit and grid.state[hit[0], hit[1]] == 1 else "unknown"
+        if hit is not None and hit[2] < need:
+            row, col, d = hit
+            x0, y0, x1, y1 = grid.cell_box(row, col)
+            where = (
+                f"the {state} map cell at image row {row}, column {col} "
+                f"(x {x0:g}..{x1:g}, y {y0:g}..{y1:g}) of {grid.source}"
+            )
+            if d == 0.0:
+                raise self.error(key, f"({x:g}, {y:g}) lies in {where}")
+            raise self.error(
+                key,
+                f"the robot disc (radius {r:g}) at ({x:g}, {y:g}) overlaps {where}: "
+                f"clearance {d:.4g} < {r:g}",
+            )
+        if grid.unknown_blocks:
+            outside = _outside(problem.bounds, grid.extent)
+            if len(outside):
+                dx = np.maximum.reduce([outside[:, 0] - x, 0 * outside[:, 0], x - outside[:, 2]])
+                dy = np.maximum.reduce([outside[:, 1] - y, 0 * outside[:, 1], y - outside[:, 3]])
+                d = float(np.hypot(dx, dy).min())
+                if d < need:
+                    raise self.error(
+                        key,
+                        f"the robot disc (radius {r:g}) at ({x:g}, {y:g}) reaches beyond the map "
+                        f"{grid.source} (unknown space, blocked; set map.unknown: free to allow)",
+                    )
+
 
 # ----------------------------------------------------------------------------------------------
 # Small pure helpers.
 # ----------------------------------------------------------------------------------------------
+def _outside(bounds: tuple[Point, Point], extent: tuple[Point, Point]) -> np.ndarray:
+    """(k <= 4, 4) boxes covering the part of ``bounds`` outside the map's ``extent``."""
+    (bx0, by0), (bx1, by1) = bounds
+    (mx0, my0), (mx1, my1) = extent
+    boxes = [
+        (bx0, by0, min(mx0, bx1), by1),  # left of the map
+        (max(mx1, bx0), by0, bx1, by1),  # right
+        (max(mx0, bx0), by0, min(mx1, bx1), min(my0, by1)),  # below, between left and right
+        (max(mx0, bx0), max(my1, by0), min(mx1, bx1), by1),  # above
+    ]
+    out = np.array([b for b in boxes if b[2] > b[0] and b[3] > b[1]], dtype=float)
+    return out.reshape(-1, 4)
+
+
 def touch_tolerance(bounds: tuple[Point, Point]) -> float:
     """Round-off allowance for "touching is allowed" comparisons in a workspace.
 

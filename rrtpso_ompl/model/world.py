@@ -667,7 +667,7 @@ def _segment_box_distance_v(a: np.ndarray, b: np.ndarray, box: np.ndarray) -> np
                  (-d[:, 1], a[:, 1] - box[:, 1]), (d[:, 1], box[:, 3] - a[:, 1])):  # fmt: skip
         zero = p == 0.0
         ok &= ~(zero & (q < 0.0))
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             t = np.where(zero, 0.0, q / np.where(zero, 1.0, p))
         t0 = np.where(~zero & (p < 0.0), np.maximum(t0, t), t0)
         t1 = np.where(~zero & (p > 0.0), np.minimum(t1, t), t1)

@@ -245,8 +245,9 @@ def test_inputs_too_large_for_the_machine_end_cleanly(folder):
                         f"{10 + (i // 60) * 16}], radius: 2}}" for i in range(2100))  # fmt: skip
     head = "bounds: [[0, 0], [1000, 1000]]\nstart: [1, 1]\ngoal: [999, 999]\n"
     name = _problem(folder, "many.yaml", f"{head}robot: {{radius: 0.5}}\nobstacles:\n{circles}\n")
-    proc = run("optimum", name, cwd=folder)
-    assert proc.returncode == 2 and "at most 2,000" in proc.stderr
+    # The optimum grows its graph as it searches: thousands of obstacles are routine now.
+    proc = run("optimum", name, "--json", "o.json", cwd=folder)
+    assert proc.returncode == 0 and json.loads((folder / "o.json").read_text())["length"] > 1400
     proc = run("generate", "circles", "--seed", "1", "--n", "100000000", "--out", "g.yaml",
                cwd=folder)  # fmt: skip
     assert proc.returncode == 2 and "n must be <= 100000" in proc.stderr

@@ -1,0 +1,484 @@
+"""Occupancy-grid maps as ROS's ``map_server`` (Nav2's ``nav2_map_server``) writes them: a YAML
+file and an image (PGM, PNG, BMP).
+
+The map YAML holds ``image`` (relative to the YAML file), ``resolution`` (metres per cell),
+``origin: [x, y, yaw]`` (the lower-left corner of the image in the map frame), ``negate``,
+``occupied_thresh``, ``free_thresh`` and ``mode`` (``trinary``, ``scale`` or ``raw``); other keys
+are ignored. Each pixel becomes a cell state, as ``docs/problem-format.md`` specifies:
+
+- colour is averaged to grey ``v`` (0..255; 16-bit PGMs are scaled to 0..255);
+- missing keys default to ``negate: 0``, ``occupied_thresh: 0.65``, ``free_thresh: 0.196``
+  (ROS map_saver's, under which its unknown grey 205 stays unknown) and ``mode: trinary``;
+- ``negate: 0``: occupancy ``p = (255 - v) / 255``; ``negate: 1``: ``p = v / 255``;
+- ``p >= occupied_thresh``: occupied; ``p <= free_thresh``: free; otherwise unknown (trinary)
+  or in between (scale; blocked like unknown unless ``unknown: free``);
+- ``raw``: ``v`` itself is the occupancy in percent; values above 100 are unknown (``negate``
+  does not apply), and ``v / 100`` is compared with the thresholds;
+- a pixel whose alpha is below 255 is unknown, in every mode.
+
+(Nav2 compares with ``>`` and ``<`` where the contract says ``>=`` and ``<=``; the two differ only
+for a pixel exactly on a threshold, which the usual 0.65, 0.25 and 0.196 never meet: ``255 * 0.35``,
+``255 * 0.75`` and ``255 * 0.804`` are not integers. Note that under Nav2's ``free_thresh: 0.25``
+the grey 205 reads as free, exactly as Nav2 reads it.)
+
+Image row 0 is the top of the map: the cell in row ``i``, column ``j`` of an ``H``-row image is
+the square ``[ox + j res, ox + (j + 1) res] x [oy + (H - 1 - i) res, oy + (H - i) res]``. The
+blocked cells are merged into axis-aligned rectangles (runs along rows, then equal runs of
+consecutive rows), which the exact checks of :class:`~rrtpso_ompl.model.world.World` treat as
+boxes: a 1.7-million-cell warehouse map becomes a few thousand boxes, not 260,000 squares.
+
+Every way a map can be wrong is one :class:`~rrtpso_ompl.errors.ProblemError` naming the file and
+the key. Images larger than :data:`MAX_CELLS` cells are refused before they are decoded.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import re
+import warnings
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ProblemError
+from ..validation import MAX_COORDINATE, describe
+from .yamlfile import read_yaml_file
+
+__all__ = [
+    "MAX_CELLS",
+    "MODES",
+    "OccupancyMap",
+    "is_map_yaml",
+    "load_map",
+    "merge_cells",
+    "read_pgm",
+]
+
+#: Most cells a map may have (25 million: 5,000 x 5,000, 250 m square at 5 cm).
+MAX_CELLS = 25_000_000
+#: The map_server modes.
+MODES = ("trinary", "scale", "raw")
+#: Cell states.
+FREE, OCCUPIED, UNKNOWN = 0, 1, -1
+#: Defaults of the optional keys: ROS map_saver's thresholds, which keep its unknown grey (205,
+#: occupancy 0.19608) unknown.
+_DEFAULTS = {"negate": 0, "occupied_thresh": 0.65, "free_thresh": 0.196, "mode": "trinary"}
+_MAP_KEYS = ("image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh", "mode")
+
+
+@dataclass(frozen=True, eq=False)
+class OccupancyMap:
+    """An occupancy grid read from a map_server YAML file and its image.
+
+    Attributes
+    ----------
+    source : str
+        The map YAML file.
+    image : str
+        The image file it names.
+    resolution : float
+        Side of a cell, map units (metres) per cell.
+    origin : (float, float)
+        Map-frame position of the lower-left corner of the image (yaw must be 0).
+    state : ndarray of int8, shape (H, W)
+        Cell states in image order (row 0 on top): 0 free, 1 occupied, -1 unknown or, in
+        ``scale`` mode, in between.
+    unknown_blocks : bool
+        Whether unknown cells are obstacles (the problem's ``unknown: obstacle``, the default).
+    mode : str
+        ``trinary``, ``scale`` or ``raw``.
+    negate : bool
+    occupied_thresh, free_thresh : float
+    """
+
+    source: str
+    image: str
+    resolution: float
+    origin: tuple[float, float]
+    state: np.ndarray = field(repr=False)
+    unknown_blocks: bool = True
+    mode: str = "trinary"
+    negate: bool = False
+    occupied_thresh: float = 0.65
+    free_thresh: float = 0.196
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(rows, columns) of the image."""
+        return self.state.shape
+
+    @property
+    def extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """``((xmin, ymin), (xmax, ymax))`` of the map, map units."""
+        h, w = self.state.shape
+        ox, oy = self.origin
+        return (ox, oy), (ox + w * self.resolution, oy + h * self.resolution)
+
+    @cached_property
+    def blocked(self) -> np.ndarray:
+        """(H, W) booleans in image order: occupied, and unknown unless ``unknown: free``."""
+        if self.unknown_blocks:
+            return self.state != FREE
+        return self.state == OCCUPIED
+
+    @cached_property
+    def boxes(self) -> np.ndarray:
+        """(k, 4) rectangles ``(xmin, ymin, xmax, ymax)`` covering exactly the blocked cells."""
+        return merge_cells(self.blocked, self.resolution, self.origin)
+
+    def cell_box(self, row: int, col: int) -> tuple[float, float, float, float]:
+        """The square of the cell in image row ``row``, column ``col``: (xmin, ymin, xmax, ymax)."""
+        h = self.state.shape[0]
+        res = self.resolution
+        x0 = self.origin[0] + col * res
+        y0 = self.origin[1] + (h - 1 - row) * res
+        return x0, y0, x0 + res, y0 + res
+
+    def nearest_blocked(self, x: float, y: float, reach: float) -> tuple[int, int, float] | None:
+        """The blocked cell nearest to ``(x, y)`` within ``reach``: ``(row, col, distance)``.
+
+        Exact distance from the point to the cell's square (0 inside it); only the cells of the
+        window ``reach`` around the point are looked at.
+        """
+        h, w = self.state.shape
+        res = self.resolution
+        ox, oy = self.origin
+        c0 = max(0, math.floor((x - reach - ox) / res))
+        c1 = min(w - 1, math.floor((x + reach - ox) / res))
+        # Rows from the bottom (y up), then flipped to image rows.
+        b0 = max(0, math.floor((y - reach - oy) / res))
+        b1 = min(h - 1, math.floor((y + reach - oy) / res))
+        if c0 > c1 or b0 > b1:
+            return None
+        window = self.blocked[h - 1 - b1 : h - b0, c0 : c1 + 1]
+        rows, cols = np.nonzero(window)
+        if not len(rows):
+            return None
+        rows = rows + (h - 1 - b1)
+        cols = cols + c0
+        x0 = ox + cols * res
+        y0 = oy + (h - 1 - rows) * res
+        dx = np.maximum.reduce([x0 - x, np.zeros(len(x0)), x - (x0 + res)])
+        dy = np.maximum.reduce([y0 - y, np.zeros(len(y0)), y - (y0 + res)])
+        d = np.hypot(dx, dy)
+        k = int(np.argmin(d))
+        if d[k] > reach:
+            return None
+        return int(rows[k]), int(cols[k]), float(d[k])
+
+    def counts(self) -> dict[str, int]:
+        """Cells by state: ``{"free", "occupied", "unknown", "blocked", "boxes"}``."""
+        return {
+            "free": int(np.count_nonzero(self.state == FREE)),
+            "occupied": int(np.count_nonzero(self.state == OCCUPIED)),
+            "unknown": int(np.count_nonzero(self.state == UNKNOWN)),
+            "blocked": int(np.count_nonzero(self.blocked)),
+            "boxes": len(self.boxes),
+        }
+
+
+# ----------------------------------------------------------------------------------------------
+def is_map_yaml(path: str | Path) -> bool:
+    """Whether a file looks like a map_server map YAML (small, with top-level ``image`` and
+    ``resolution`` keys) rather than a problem: folders of problems keep their maps beside them,
+    and a batch over the folder skips them."""
+    try:
+        if Path(path).stat().st_size > 65536:
+            return False
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            text = fh.read()
+    except OSError:
+        return False
+    keys = {m.group(1) for m in re.finditer(r"^([A-Za-z_]+)\s*:", text, re.MULTILINE)}
+    return {"image", "resolution"} <= keys and "start" not in keys
+
+
+def load_map(path: str | Path, unknown_blocks: bool = True) -> OccupancyMap:
+    """Read a map_server map: its YAML file and the image it names.
+
+    Parameters
+    ----------
+    path : str or Path
+        The map YAML file.
+    unknown_blocks : bool
+        Whether unknown cells are obstacles (default) or free.
+
+    Returns
+    -------
+    OccupancyMap
+
+    Raises
+    ------
+    ProblemError
+        Naming the map YAML and the key (``image`` for an image that is missing, unreadable or
+        too large) for anything wrong.
+    """
+    path = Path(path)
+    source = str(path)
+    doc = read_yaml_file(path)
+    if not isinstance(doc, dict):
+        raise ProblemError(source, "", f"a map YAML must be a mapping, got {describe(doc)}")
+    for key in ("image", "resolution", "origin"):
+        if doc.get(key) is None:
+            raise ProblemError(source, key, "required key is missing")
+    image = doc["image"]
+    if not isinstance(image, str) or not image.strip():
+        raise ProblemError(source, "image", f"must be a file name, got {describe(image)}")
+    resolution = _number(source, "resolution", doc["resolution"])
+    if not (0.0 < resolution <= MAX_COORDINATE):
+        raise ProblemError(
+            source, "resolution", f"must be > 0 (metres per cell), got {resolution:g}"
+        )
+    origin = doc["origin"]
+    if not isinstance(origin, list | tuple) or len(origin) not in (2, 3):
+        raise ProblemError(source, "origin", f"must be [x, y, yaw], got {describe(origin)}")
+    ox, oy, *rest = (_number(source, f"origin[{i}]", v) for i, v in enumerate(origin))
+    for i, v in enumerate((ox, oy)):
+        if abs(v) > MAX_COORDINATE:
+            raise ProblemError(source, f"origin[{i}]", f"must be within +-{MAX_COORDINATE:g}")
+    yaw = rest[0] if rest else 0.0
+    if yaw != 0.0:
+        raise ProblemError(
+            source,
+            "origin[2]",
+            f"a rotated map (yaw {yaw:g} rad) is not supported: the checks are exact for "
+            "axis-aligned cells; rotate the image and set yaw to 0",
+        )
+    negate = doc.get("negate", _DEFAULTS["negate"])
+    if negate is None:
+        negate = 0
+    if isinstance(negate, bool):
+        negate = int(negate)
+    if not isinstance(negate, numbers.Integral) or negate not in (0, 1):
+        raise ProblemError(source, "negate", f"must be 0 or 1, got {describe(negate)}")
+    occ = _number(source, "occupied_thresh", _get(doc, "occupied_thresh"))
+    free = _number(source, "free_thresh", _get(doc, "free_thresh"))
+    for key, v in (("occupied_thresh", occ), ("free_thresh", free)):
+        if not 0.0 <= v <= 1.0:
+            raise ProblemError(source, key, f"must be between 0 and 1, got {v:g}")
+    if not free < occ:
+        raise ProblemError(
+            source, "free_thresh", f"must be below occupied_thresh ({occ:g}), got {free:g}"
+        )
+    mode = _get(doc, "mode")
+    if mode not in MODES:
+        raise ProblemError(
+            source, "mode", f"must be one of {', '.join(MODES)}, got {describe(mode)}"
+        )
+    image_path = (path.parent / image).resolve() if not Path(image).is_absolute() else Path(image)
+    grey, alpha, maxval = _read_image(source, image_path)
+    state = _states(grey, alpha, maxval, mode, bool(negate), occ, free)
+    return OccupancyMap(
+        source=source,
+        image=str(image_path),
+        resolution=resolution,
+        origin=(ox, oy),
+        state=state,
+        unknown_blocks=unknown_blocks,
+        mode=mode,
+        negate=bool(negate),
+        occupied_thresh=occ,
+        free_thresh=free,
+    )
+
+
+def _get(doc: dict, key: str) -> Any:
+    """A key's value, or its default when absent or null."""
+    value = doc.get(key)
+    return _DEFAULTS[key] if value is None else value
+
+
+def _number(source: str, key: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ProblemError(source, key, f"must be a number, got {describe(value)}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise ProblemError(source, key, f"must be finite, got {x}")
+    return x
+
+
+def _states(grey, alpha, maxval: int, mode: str, negate: bool, occ: float, free: float):
+    """Cell states from grey values (see the module docstring)."""
+    if mode == "raw":
+        v = grey.astype(np.int32)
+        p = v / 100.0
+        known = v <= 100
+    else:
+        v = grey.astype(np.float64) * (255.0 / maxval) if maxval != 255 else grey
+        p = (v / 255.0) if negate else (255.0 - v) / 255.0
+        known = np.ones(grey.shape, dtype=bool)
+    state = np.full(grey.shape, UNKNOWN, dtype=np.int8)
+    state[known & (p <= free)] = FREE
+    state[known & (p >= occ)] = OCCUPIED
+    if alpha is not None:
+        state[alpha < 255] = UNKNOWN
+    return state
+
+
+# ----------------------------------------------------------------------------------------------
+def _read_image(source: str, path: Path) -> tuple[np.ndarray, np.ndarray | None, int]:
+    """Grey values (H, W), alpha (H, W) or None, and the grey maxval, of a map image."""
+    if not path.is_file():
+        raise ProblemError(source, "image", f"no such image file: {path}")
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(2)
+    except OSError as exc:
+        raise ProblemError(source, "image", f"cannot read {path}: {exc.strerror or exc}") from None
+    if head in (b"P2", b"P5"):
+        try:
+            grey, maxval = read_pgm(path)
+        except ValueError as exc:
+            raise ProblemError(source, "image", f"{path}: {exc}") from None
+        return grey, None, maxval
+    return _read_with_pillow(source, path)
+
+
+def read_pgm(path: str | Path) -> tuple[np.ndarray, int]:
+    """A PGM image (P2 ASCII or P5 binary, 8 or 16 bits): its (H, W) values and maxval.
+
+    Raises
+    ------
+    ValueError
+        For a malformed or truncated file, or one of more than :data:`MAX_CELLS` pixels.
+    """
+    with open(path, "rb") as fh:
+        data = fh.read(12 * MAX_CELLS + 4096)  # P2 text: up to 11 characters a value
+    magic = data[:2]
+    if magic not in (b"P2", b"P5"):
+        raise ValueError("not a PGM image (P2 or P5)")
+    pos, values = 2, []
+    while len(values) < 3:  # width, height, maxval, with # comments between tokens
+        while pos < len(data) and data[pos : pos + 1].isspace():
+            pos += 1
+        if data[pos : pos + 1] == b"#":
+            end = data.find(b"\n", pos)
+            pos = len(data) if end < 0 else end + 1
+            continue
+        start = pos
+        while pos < len(data) and data[pos : pos + 1].isdigit():
+            pos += 1
+        if start == pos:
+            raise ValueError("malformed PGM header (width, height and maxval expected)")
+        values.append(int(data[start:pos]))
+    width, height, maxval = values
+    if width <= 0 or height <= 0 or not 0 < maxval < 65536:
+        raise ValueError(f"bad PGM header: width {width}, height {height}, maxval {maxval}")
+    if width * height > MAX_CELLS:
+        raise ValueError(f"{width} x {height} pixels, more than the {MAX_CELLS:,} allowed")
+    n = width * height
+    if magic == b"P5":
+        pos += 1  # exactly one whitespace character ends the header
+        dtype = np.dtype(">u2") if maxval > 255 else np.dtype("u1")
+        need = n * dtype.itemsize
+        if len(data) - pos < need:
+            raise ValueError(f"truncated: {n} pixels need {need} bytes, {len(data) - pos} left")
+        raw = np.frombuffer(data[pos : pos + need], dtype=dtype)
+    else:
+        text = data[pos:].decode("ascii", errors="replace")
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # numpy warns, then stops, at a non-number
+            try:
+                raw = np.fromstring(text, dtype=np.int64, sep=" ")
+            except (ValueError, DeprecationWarning):
+                raise ValueError("P2 pixel values must be whitespace-separated integers") from None
+        if len(raw) < n:
+            raise ValueError(
+                f"truncated or not numbers: {n} pixel values expected, {len(raw)} read"
+            )
+        raw = raw[:n]
+    values_ = raw.astype(np.int64)
+    if values_.max(initial=0) > maxval:
+        raise ValueError(f"a pixel value exceeds maxval {maxval}")
+    return values_.reshape(height, width).astype(np.uint16 if maxval > 255 else np.uint8), maxval
+
+
+def _read_with_pillow(source: str, path: Path) -> tuple[np.ndarray, np.ndarray | None, int]:
+    """PNG, BMP and the other formats Pillow reads: grey (channels averaged) and alpha."""
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as img:
+            w, h = img.size
+            if w * h > MAX_CELLS:
+                too_many = f"{w} x {h} pixels, more than the {MAX_CELLS:,} allowed"
+                raise ProblemError(source, "image", f"{path}: {too_many}")
+            if img.mode == "P":  # palette: its colours (and transparency) decide
+                img = img.convert("RGBA")
+            elif img.mode in ("1", "CMYK", "YCbCr", "LAB", "HSV"):
+                img = img.convert("RGB")
+            arr = np.asarray(img)
+            mode = img.mode
+    except ProblemError:
+        raise
+    except (UnidentifiedImageError, OSError, ValueError, Image.DecompressionBombError) as exc:
+        raise ProblemError(source, "image", f"cannot read {path}: {exc}") from None
+    alpha = None
+    maxval = 255
+    if mode in ("I;16", "I;16B", "I;16L", "I"):
+        grey = arr.astype(np.int64)
+        maxval = 65535
+        grey = np.clip(grey, 0, maxval).astype(np.uint16)
+        return grey, None, maxval
+    if mode == "F":
+        raise ProblemError(source, "image", f"{path}: floating-point images are not supported")
+    if arr.ndim == 2:
+        return arr.astype(np.uint8), None, maxval
+    channels = arr.shape[2]
+    if mode in ("LA", "RGBA", "La", "RGBa"):
+        alpha = arr[..., -1]
+        colour = arr[..., :-1]
+    else:
+        colour = arr[..., : min(channels, 3)]
+    # Colour averaged to grey, as map_server does; rounded so that equal channels stay exact.
+    grey = np.rint(colour.astype(np.float64).mean(axis=2)).astype(np.uint8)
+    return grey, alpha, maxval
+
+
+# ----------------------------------------------------------------------------------------------
+def merge_cells(blocked: np.ndarray, resolution: float, origin) -> np.ndarray:
+    """Rectangles ``(xmin, ymin, xmax, ymax)`` that exactly cover the blocked cells.
+
+    Blocked cells are joined into runs along each row, and runs with the same columns in
+    consecutive rows into one rectangle (walls and shelves, drawn along the axes, become one box
+    each). Fully vectorised: O(cells) time, memory for the runs only.
+
+    Parameters
+    ----------
+    blocked : (H, W) bool ndarray
+        In image order (row 0 on top).
+    resolution : float
+        Side of a cell.
+    origin : (float, float)
+        Lower-left corner of the image.
+    """
+    h, w = blocked.shape
+    if not blocked.any():
+        return np.empty((0, 4))
+    # Runs along rows: where a row switches from free to blocked and back.
+    pad = np.zeros((h, w + 2), dtype=np.int8)
+    pad[:, 1:-1] = blocked
+    step = np.diff(pad, axis=1)
+    r_start, c_start = np.nonzero(step == 1)
+    _, c_end = np.nonzero(step == -1)  # both in row-major order, so they pair up
+    rows, c0, c1 = r_start, c_start, c_end  # columns c0 .. c1 - 1
+    # Equal runs in consecutive rows merge: sort by (c0, c1, row), break where they differ.
+    order = np.lexsort((rows, c1, c0))
+    rows, c0, c1 = rows[order], c0[order], c1[order]
+    new = np.ones(len(rows), dtype=bool)
+    new[1:] = (c0[1:] != c0[:-1]) | (c1[1:] != c1[:-1]) | (rows[1:] != rows[:-1] + 1)
+    group = np.cumsum(new) - 1
+    top = rows[new]  # first (top-most) image row of each rectangle
+    bottom = np.zeros(group[-1] + 1, dtype=rows.dtype)
+    np.maximum.at(bottom, group, rows)
+    left, right = c0[new], c1[new]
+    ox, oy = origin
+    xmin = ox + left * resolution
+    xmax = ox + right * resolution
+    ymin = oy + (h - 1 - bottom) * resolution
+    ymax = oy + (h - top) * resolution
+    return np.column_stack([xmin, ymin, xmax, ymax]).astype(float)
