@@ -19,6 +19,7 @@ Usage::
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
@@ -84,9 +85,9 @@ def office(rng) -> np.ndarray:
     return img
 
 
-def warehouse(rng) -> np.ndarray:
-    res = 0.05
-    w_m, h_m = 50.0, 85.0
+def warehouse(rng, w_m: float = 50.0, h_m: float = 85.0, res: float = 0.05) -> np.ndarray:
+    """A warehouse of ``w_m`` x ``h_m`` metres at ``res`` metres per cell; the pallets, speckle
+    and unmapped bay scale with its area."""
     img = np.full((round(h_m / res), round(w_m / res)), FREE, np.uint8)
     t = 0.2
     for x0, y0, x1, y1 in [(0, 0, w_m, t), (0, h_m - t, w_m, h_m), (0, 0, t, h_m),
@@ -102,16 +103,17 @@ def warehouse(rng) -> np.ndarray:
             y += length + 2.5
         x += 1.1 + 2.8
     # Pallets in the aisles and the staging area.
-    for _ in range(60):
+    area = w_m * h_m / (50.0 * 85.0)
+    for _ in range(round(60 * area)):
         px, py = rng.uniform(1.0, w_m - 2.0), rng.uniform(1.0, h_m - 2.0)
         _box(img, res, px, py, px + 1.0, py + 1.2)
     # Scanner speckle: isolated occupied cells.
-    n = 700
+    n = round(700 * area)
     rows = rng.integers(0, img.shape[0], n)
     cols = rng.integers(0, img.shape[1], n)
     img[rows, cols] = OCC
     # The loading bay (north-east) was never mapped.
-    _box(img, res, 38.0, 74.0, w_m - t, h_m - t, UNK)
+    _box(img, res, 0.76 * w_m, 0.87 * h_m, w_m - t, h_m - t, UNK)
     return img
 
 
@@ -176,13 +178,24 @@ def main() -> int:
     grey, alpha = lab(rng)
     Image.fromarray(np.dstack([grey, alpha]), mode="LA").save(GRIDS / "lab.png", optimize=True)
     (GRIDS / "lab.yaml").write_text(_yaml("lab", "lab.png", 0.025))
+    from rrtpso_ompl.evaluation import shortest_path
+    from rrtpso_ompl.model import load_problem
+
     for name, (mp, start, goal, radius, what) in PROBLEMS.items():
-        (OUT / f"{name}.yaml").write_text(
+        body = (
             f"name: {name}\ndescription: {what} ({mp[:-5]} map)\nmap: grids/{mp}\n"
             f"start: [{start[0]}, {start[1]}]\ngoal: [{goal[0]}, {goal[1]}]\n"
             f"robot:\n  radius: {radius}\n  wheel_radius: 0.05\n  track_width: 0.3\n"
             f"  speed: 0.5\n  sample_time: 0.1\n"
             f"planner:\n  time_limit: 2.0\n  seed: 1\n"
+        )
+        path = OUT / f"{name}.yaml"
+        path.write_text(body)
+        best = shortest_path(load_problem(path))
+        path.write_text(
+            f"# Made by benchmarks/make_maps.py. Shortest collision-free path: "
+            f"{best.length:.4f} m\n# exactly (`rrtpso optimum`; straight line "
+            f"{math.dist(start, goal):.2f} m).\n{body}"
         )
     print(f"wrote {OUT}", file=sys.stderr)
     return 0

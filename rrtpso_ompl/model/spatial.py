@@ -19,6 +19,7 @@ built on first use, for the scalar ones.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -95,8 +96,9 @@ class Grid:
             self._tuples[cell] = got
         return got
 
-    def cells_on_segment(self, ax: float, ay: float, bx: float, by: float) -> list[int]:
-        """Every cell the segment passes through (Amanatides-Woo traversal), in order.
+    def cells_on_segment(self, ax: float, ay: float, bx: float, by: float) -> Iterator[int]:
+        """Every cell the segment passes through (Amanatides-Woo traversal), in order, lazily
+        (a check that stops at the first blocked cell never walks the rest).
 
         Obstacles are registered with a margin beyond their reach, so a segment that grazes a
         cell corner exactly, and may be attributed to either neighbour, misses nothing.
@@ -113,17 +115,15 @@ class Grid:
         t_dy = abs(1.0 / dy) if dy != 0 else math.inf
         t_x = ((i + 1 - fx) if dx > 0 else (fx - i)) * t_dx if dx != 0 else math.inf
         t_y = ((j + 1 - fy) if dy > 0 else (fy - j)) * t_dy if dy != 0 else math.inf
-        cells = []
         for _ in range(abs(i_end - i) + abs(j_end - j) + 1):
             if 0 <= i < nx and 0 <= j < ny:
-                cells.append(j * nx + i)
+                yield j * nx + i
             if t_x < t_y:
                 t_x += t_dx
                 i += step_i
             else:
                 t_y += t_dy
                 j += step_j
-        return cells
 
     # -- vectorised queries ----------------------------------------------------------------------
     def pairs_in_boxes(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

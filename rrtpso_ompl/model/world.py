@@ -254,13 +254,14 @@ class World:
         first = grid.cell_of(ax, ay)
         if first == grid.cell_of(bx, by):
             return self._segment_clear(grid.items(first), ax, ay, bx, by)
-        seen: set[int] = set()
+        # Cells in order from a to b, so a blocked motion usually stops within a cell or two.
+        # An obstacle registered in several cells is looked at again in each: its bounding-box
+        # rejection is cheaper than keeping a set of those already seen.
+        clear = self._segment_clear
+        items = grid.items
         for cell in grid.cells_on_segment(ax, ay, bx, by):
-            ids = [k for k in grid.items(cell) if k not in seen]
-            if ids:
-                if not self._segment_clear(ids, ax, ay, bx, by):
-                    return False
-                seen.update(ids)
+            if not clear(items(cell), ax, ay, bx, by):
+                return False
         return True
 
     def _segment_clear(self, ids, ax: float, ay: float, bx: float, by: float) -> bool:

@@ -356,3 +356,20 @@ def test_generate_command_is_deterministic_and_checks_options(tmp_path):
          str(tmp_path / "c.yaml")], capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert bad.returncode == 2 and "cells" in bad.stderr and not (tmp_path / "c.yaml").exists()
+
+
+def test_thousands_of_obstacles_stay_feasible():
+    """Beyond 100 obstacles the default radii and robot shrink as 1 / sqrt(n): the world covers
+    the share of the workspace the default count does, and is certified solvable (by the grid,
+    or where the gaps are finer than the grid, by the exact optimum)."""
+
+    data = generate("circles", 5, n=3000)
+    problem = problem_from_dict(data)
+    assert len(problem.obstacles) == 3000
+    radii = np.array([o.radius for o in problem.obstacles])
+    covered = np.pi * np.sum(radii**2) / 100.0**2
+    assert 0.1 < covered < 0.2
+    assert problem.robot.radius < radii.min()
+    assert "A collision-free path of length" in data["description"]
+    world = World.from_problem(problem)
+    assert world.point_free(*problem.start) and world.point_free(*problem.goal)
