@@ -288,3 +288,29 @@ def test_the_library_maps_load_and_the_big_one_stays_small():
     assert counts["boxes"] < counts["blocked"] / 50  # merged
     for name in ("office_corridor", "lab_clutter"):
         assert load_problem(PROBLEMS / "maps" / f"{name}.yaml").map.counts()["unknown"] > 0
+
+
+def test_simulate_and_bench_accept_map_problems(tmp_path):
+    prob = _corridor(
+        tmp_path,
+        robot={"radius": 0.2, "wheel_radius": 0.05, "track_width": 0.3, "speed": 0.5,
+               "sample_time": 0.1, "sensor_range": 2.0},
+        moving_obstacles=[{"radius": 0.2, "start": [4.0, 3.5], "speed": 0.0, "heading_deg": 0}],
+    )  # fmt: skip
+    exe = rrtpso_exe()
+    out = tmp_path / "sim.json"
+    run = subprocess.run([*exe, "simulate", prob, "--json", str(out), "--seed", "1"],
+                         capture_output=True, text=True)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    doc = json.loads(out.read_text())
+    assert doc["reached_goal"] and doc["collisions"] == 0
+    world = World.from_problem(load_problem(prob))
+    xy = np.array(doc["trajectory"])[:, 1:3]
+    # Every sampled pose keeps the radius (chords between samples may cut a corner the robot
+    # drives round, so they are not checked).
+    assert (world.point_clearance(xy) >= world.threshold).all()
+    run = subprocess.run([*exe, "bench", prob, "--planner", "RRTstarPSO", "--runs", "1",
+                          "--time", "0.2", "--out", str(tmp_path / "b")],
+                         capture_output=True, text=True)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert (tmp_path / "b" / "benchmark.db").exists()
