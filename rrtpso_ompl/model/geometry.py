@@ -120,7 +120,9 @@ def turning_angles(paths: np.ndarray) -> np.ndarray:
 
 
 def shortcut(
-    path: np.ndarray, segments_free: Callable[[np.ndarray, np.ndarray], np.ndarray]
+    path: np.ndarray,
+    segments_free: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    terminate: Callable[[], bool] | None = None,
 ) -> np.ndarray:
     """Greedy shortcutting: from each kept vertex jump to the farthest vertex in free sight.
 
@@ -131,6 +133,9 @@ def shortcut(
     segments_free : callable
         ``segments_free(a, b)`` for ``(m, 2)`` end points returns ``(m,)`` booleans (exact, e.g.
         :meth:`~rrtpso_ompl.model.World.segments_free`).
+    terminate : callable, optional
+        Polled before each kept vertex; when it returns True the rest of the path is kept as it
+        is (still a valid path, just less shortened).
 
     Returns
     -------
@@ -151,6 +156,9 @@ def shortcut(
     i = 0
     last = len(p) - 1
     while i < last:
+        if terminate is not None and terminate():
+            keep.extend(range(i + 1, last + 1))
+            break
         window = 64
         while True:
             j = np.arange(i + 1, min(last, i + window) + 1)

@@ -372,7 +372,8 @@ class World:
     def segments_free(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Boolean array: whether each segment ``a[i]-b[i]`` is free (bounds not checked).
 
-        Long segments are checked a stretch at a time from ``a``, each stretch twice as long as
+        When the segments cross many index cells in all, long segments are checked a stretch at
+        a time from ``a``, each stretch twice as long as
         the one before (4 index cells, then 8, 16, ...), and a segment leaves as soon as one
         stretch is blocked. In a cluttered world most long segments are blocked within a few
         cells, so they cost a few cells instead of their whole length; a free segment costs
@@ -384,6 +385,8 @@ class World:
             return (self.segment_distance(a, b, cap=thr) >= thr).reshape(shape)
         d = b - a
         length = np.hypot(d[:, 0], d[:, 1])
+        if length.sum() <= 4096.0 * self._grid.h:  # few cells in all: one pass is cheaper
+            return (self.segment_distance(a, b, cap=thr) >= thr).reshape(shape)
         ok = np.ones(len(a), dtype=bool)
         done = np.zeros(len(a))  # fraction of each segment already known to be free
         alive = np.arange(len(a))

@@ -131,8 +131,10 @@ class SpaceInformationCollisionModel:
         free = self.segments_free(a, b)
         return np.where(free, 0.0, np.linalg.norm(b - a, axis=-1) + self.tol)
 
-    def segment_distance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        # Unknown distances: report "far" so that refinement never triggers.
+    def segment_distance(
+        self, a: np.ndarray, b: np.ndarray, cap: float | None = None
+    ) -> np.ndarray:
+        # Unknown distances: report "far" so that refinement never triggers (``cap`` as World's).
         a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
         return np.full(a.shape[:-1], np.inf)
 

@@ -27,7 +27,9 @@ Stages, each optional:
    visible), so the swarm searches the few dimensions that matter;
 2. *PSO* over the interior waypoints, seeded around the current path;
 3. *refine*: where a segment runs along an obstacle (a polyline can only approximate an arc by its
-   chords' tangents), insert mid-points and run the swarm again, up to ``max_waypoints``.
+   chords' tangents), insert mid-points and run the swarm again, up to ``max_waypoints``;
+4. *polish* (only with a deadline): more rounds re-centred on the best path while each still
+   pays, so the caller's budget is used while the cost falls.
 """
 
 from __future__ import annotations
@@ -76,10 +78,18 @@ OPTIMIZER_PARAMS = ParamTable(
               "Extra PSO rounds with mid-points inserted on segments that run along an obstacle.",
               low=0, high=20),
     ParamSpec("refine_margin", float, 0.05,
-              "A segment runs along an obstacle when its clearance is below robot radius x "
-              "(1 + refine_margin).", low=0.0, high=10.0),
+              "A segment runs along an obstacle when its clearance is below robot radius + "
+              "refine_margin x max(robot radius, segment length): scale-free, and it fires for "
+              "a point robot too.", low=0.0, high=10.0),
     ParamSpec("max_waypoints", int, 48, "Most waypoints refinement may create.",
               low=2, high=10_000),
+    ParamSpec("polish_rounds", int, 20,
+              "With a deadline, further rounds re-centred on the best path while each still "
+              "shortens it by more than `polish_tolerance` and time remains (0 = none).",
+              low=0, high=10_000),
+    ParamSpec("polish_tolerance", float, 1e-5,
+              "Relative shortening a polish round must achieve for the next one to run.",
+              low=0.0, high=1.0),
 )  # fmt: skip
 
 PathOptimizerOptions = (SWARM_PARAMS + OPTIMIZER_PARAMS).options_class(
@@ -177,10 +187,16 @@ class PathCost:
 
 
 def _refine(path: np.ndarray, world: World, margin: float, max_waypoints: int) -> np.ndarray:
-    """Insert the mid-point of every segment that runs along an obstacle (clearance tight)."""
+    """Insert the mid-point of every segment that runs along an obstacle (clearance tight).
+
+    Tight means a clearance below ``r + margin * max(r, l)`` for a segment of length ``l``: the
+    same share of the robot for a disc robot, and of the segment for a point robot (whose
+    clearance along a chord that should bend round a circle grows with the chord's length).
+    """
     r = world.robot_radius
-    d = world.segment_distance(path[:-1], path[1:])
-    tight = np.flatnonzero(d < r * (1.0 + margin) + world.tol)
+    seg = np.hypot(*np.diff(path, axis=0).T)
+    d = world.segment_distance(path[:-1], path[1:], cap=r + margin * max(r, float(seg.max())))
+    tight = np.flatnonzero(d < r + margin * np.maximum(r, seg) + world.tol)
     room = max_waypoints - len(path)
     if room <= 0 or len(tight) == 0:
         return path
@@ -298,8 +314,10 @@ def optimize_path(
     if len(original) < 2 or not world.path_valid(original):
         return result(original, [], 0, 0, 0)
 
+    if terminate is not None and terminate():
+        return result(original, [], 0, 0, 0)  # no time left: the input, as promised
     cost_model = PathCost(original[0], original[-1], world, options.smoothness_weight)
-    current = shortcut(original, world.segments_free) if options.prune else original
+    current = shortcut(original, world.segments_free, terminate) if options.prune else original
     history: list[np.ndarray] = []
     iters = evals = rounds = 0
     for r in range(1 + options.refine_rounds):
@@ -320,9 +338,28 @@ def optimize_path(
         if world.path_valid(candidate) and res.cost <= _cost_of(cost_model, current):
             current = candidate
 
+    # Anytime: with a deadline, keep polishing (boxes re-centred on the best path) while rounds
+    # still pay; the budget is the caller's, so none of it is left unused while the cost falls.
+    polish = options.polish_rounds if terminate is not None else 0
+    for _ in range(polish):
+        if terminate() or len(current) <= 2:
+            break
+        before = _cost_of(cost_model, current)
+        candidate, res = _pso_round(current, cost_model, options, rng, terminate)
+        history.append(res.history)
+        iters += res.n_iterations
+        evals += res.n_evaluations
+        rounds += 1
+        if not (world.path_valid(candidate) and res.cost <= before):
+            break
+        current = candidate
+        if before - res.cost <= options.polish_tolerance * before:
+            break
+
     # Drop waypoints that ended up collinear or redundant, then keep the contract: valid and never
     # longer than the input, else the input itself.
-    current = shortcut(current, world.segments_free)
+    if rounds:
+        current = shortcut(current, world.segments_free, terminate)
     if world.path_valid(current) and path_length(current) < input_length:
         return result(current, history, iters, evals, rounds)
     return result(original, history, iters, evals, rounds)

@@ -57,6 +57,14 @@ RRTSTAR_PSO_PARAMS = (
         BUDGET,
         ParamSpec("rrt_time_fraction", float, 0.9,
                   "Share of the budget given to RRT*; the PSO gets the rest.", low=1e-3, high=1.0),
+        ParamSpec("stall_fraction", float, 0.25,
+                  "Hand over to the swarm before RRT*'s share is used up once RRT*'s best cost "
+                  "has fallen by less than 0.1 % over this share of the budget (0 = never).",
+                  low=0.0, high=1.0),
+        ParamSpec("connect_after", float, 0.2,
+                  "With no RRT* path after this share of RRT*'s time, OMPL's BIT* looks for a "
+                  "first path (narrow passages) whose waypoints become the candidate nodes "
+                  "(1 = never).", low=0.0, high=1.0),
         ParamSpec("rrt_max_iterations", int, 0,
                   "Stop RRT* after this many iterations (0 = no limit); with a bounded PSO this "
                   "makes runs reproducible regardless of machine speed.", low=0),
@@ -80,6 +88,7 @@ class RRTstarPSOStats(PlannerStats):
     """
 
     rrt_length: float | None = None
+    first_solution: str = "RRTstar"
     rrt_time: float = 0.0
     rrt_iterations: int = 0
     rrt_waypoints: int = 0
@@ -223,22 +232,52 @@ class RRTstarPSO(PythonPlanner):
 
         # --- stage 2: OMPL's simplifier, so the swarm starts from a locally shortened path ------
         if values["simplify"] and not ptc():
-            xy = self._simplify(raw, xy, stats)
+            xy = self._simplify(raw, xy, stats, ptc, t0)
         stats.simplified_length = path_length(xy)
 
         # --- stage 3: PSO over the candidate nodes --------------------------------------------
-        result = self._swarm(xy, stats, t0, ptc)
+        best = self._swarm(xy, stats, t0, ptc).path
+
+        # --- anytime: RRT* stalled and the swarm converged with time left: grow the same tree
+        # on, and run the swarm again whenever RRT* finds a shorter path.
+        while self._resumable(t0, ptc):
+            seed_cost = self.inner.bestCost().value()
+            self._run_rrtstar(ptc, t0, stats, resume=True)
+            if not self.inner.bestCost().value() < seed_cost * (1.0 - 1e-9):
+                break
+            raw = pdef.getSolutionPath()
+            xy = path_to_array(raw)
+            if values["simplify"] and not ptc():
+                xy = self._simplify(raw, xy, stats, ptc, t0)
+            again = self._swarm(xy, stats, t0, ptc)
+            if again.length < path_length(best):
+                best = again.path
+        stats.pso_length = path_length(best)
+        stats.pso_waypoints = len(best)
+
         # Replace RRT*'s entry either way, so the solution is reported under this planner's name.
-        path = array_to_path(self.getSpaceInformation(), result.path)
+        path = array_to_path(self.getSpaceInformation(), best)
         pdef.clearSolutionPaths()
         pdef.addSolutionPath(path, False, 0.0, self.getName())
         return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
 
-    def _simplify(self, raw: og.PathGeometric, xy: np.ndarray, stats: RRTstarPSOStats):
-        """OMPL's ``simplifyMax`` on a copy of RRT*'s path; the shorter of the two waypoints."""
+    def _simplify(self, raw: og.PathGeometric, xy: np.ndarray, stats: RRTstarPSOStats, ptc, t0):
+        """OMPL's simplifier on a copy of RRT*'s path; the shorter of the two waypoints.
+
+        ``simplifyMax`` (about a millisecond on a typical path) without a budget; with one, at
+        most half of what is left, so a path of hundreds of waypoints through a maze cannot eat
+        the swarm's share.
+        """
         t1 = time.perf_counter()
         simplified = og.PathGeometric(raw)  # a copy: RRT*'s own path stays as it was
-        og.PathSimplifier(self.getSpaceInformation()).simplifyMax(simplified)
+        simplifier = og.PathSimplifier(self.getSpaceInformation())
+        budget = self._values["budget"]
+        if budget > 0:
+            left = max(0.5 * (t0 + budget - t1), 1e-4)
+            simplifier.simplify(simplified, ob.plannerOrTerminationCondition(
+                ptc, ob.timedPlannerTerminationCondition(left)))  # fmt: skip
+        else:
+            simplifier.simplifyMax(simplified)
         candidate = path_to_array(simplified)
         stats.simplify_time = time.perf_counter() - t1
         return candidate if path_length(candidate) < path_length(xy) else xy
@@ -260,20 +299,73 @@ class RRTstarPSO(PythonPlanner):
         model = collision_model_for(self.getSpaceInformation())
         options = PathOptimizerOptions.from_values(self._values)
         result = optimize_path(xy, model, options, self._rng(), terminate)
-        stats.pso_time = result.time
-        stats.pso_iterations = result.n_iterations
-        stats.pso_evaluations = result.n_evaluations
-        stats.pso_rounds = result.rounds
-        stats.pso_history = result.history.tolist()
+        # Summed over the swarm runs of one solve (one, unless the anytime loop ran more).
+        stats.pso_time += result.time
+        stats.pso_iterations += result.n_iterations
+        stats.pso_evaluations += result.n_evaluations
+        stats.pso_rounds += result.rounds
+        stats.pso_history.extend(result.history.tolist())
         stats.pso_length = result.length
         stats.pso_waypoints = len(result.path)
-        stats.pso_improved = result.improved
+        stats.pso_improved = stats.pso_improved or result.improved
         return result
 
+    def _resumable(self, t0: float, ptc) -> bool:
+        """Whether the anytime loop may grow RRT* again: a time budget with time left that the
+        swarm did not use, and no iteration cap (which keeps runs reproducible)."""
+        v = self._values
+        if v["budget"] <= 0 or v["stall_fraction"] <= 0 or v["rrt_max_iterations"] > 0:
+            return False
+        return not ptc() and time.perf_counter() < t0 + 0.98 * v["budget"]
+
+    def _has_exact(self) -> bool:
+        pdef = self.getProblemDefinition()
+        return pdef.hasSolution() and not pdef.hasApproximateSolution()
+
+    def _stalled(
+        self, progress: list[tuple[float, float]], elapsed: float, budget: float, since: float
+    ) -> bool:
+        """Whether RRT*'s best cost fell by less than 0.1 % over the last ``stall_fraction`` of
+        the budget (relative, so the same on every scale), looking no further back than
+        ``since`` (seconds into the solve)."""
+        window = self._values["stall_fraction"] * budget
+        if window <= 0 or not progress or elapsed < max(progress[0][0], since) + window:
+            return False
+        then = [c for t, c in progress if t <= elapsed - window]
+        if not then:
+            return False
+        now = progress[-1][1]
+        return then[-1] - now <= 1e-3 * now
+
+    def _connect(self, ptc, end: float, stats: RRTstarPSOStats) -> None:
+        """OMPL's BIT* on the same problem until ``end`` or its first path: through narrow
+        passages that RRT*'s single tree has not crossed yet.
+
+        Measured on narrow unique-solution mazes (point robot, corridors 1-2 % of the width):
+        RRTConnect found no path in 4 s where BIT*, whose batches of samples are searched as a
+        graph, found one in under a second (docs/benchmarking.md).
+        """
+        pdef = self.getProblemDefinition()
+        pdef.clearSolutionPaths()  # RRT*'s approximate path, if any
+        connect = og.BITstar(self.getSpaceInformation())
+        connect.setStopOnSolnImprovement(True)  # the first path is all it is asked for
+        connect.setProblemDefinition(pdef)
+        connect.setup()
+        left = max(end - time.perf_counter(), 1e-4)
+        connect.solve(ob.plannerOrTerminationCondition(
+            ptc, ob.timedPlannerTerminationCondition(left)))  # fmt: skip
+        stats.first_solution = "BITstar"
+
     def _run_rrtstar(
-        self, ptc: ob.PlannerTerminationCondition, t0: float, stats: RRTstarPSOStats
+        self,
+        ptc: ob.PlannerTerminationCondition,
+        t0: float,
+        stats: RRTstarPSOStats,
+        resume: bool = False,
     ) -> None:
-        """Grow RRT* until its share of the budget, its iteration cap or the outer condition.
+        """Grow RRT* until its share of the budget, its iteration cap or the outer condition, or
+        until its best cost stalls (the swarm gets the rest); with no path halfway through its
+        share, RRTConnect looks for the first one.
 
         The tree is grown in short slices (repeated ``solve`` calls continue the same tree) so that
         the best cost can be sampled over time: OMPL's progress properties are not reachable from
@@ -282,6 +374,11 @@ class RRTstarPSO(PythonPlanner):
         values = self._values
         budget = values["budget"]
         rrt_end = t0 + values["rrt_time_fraction"] * budget if budget > 0 else None
+        t_begin = time.perf_counter()
+        if resume:  # grown on after a swarm run: until a stall again, leaving the swarm a share
+            rrt_end = max(t_begin, t0 + budget - (1.0 - values["rrt_time_fraction"]) * budget)
+            if rrt_end - t_begin < 0.05 * budget:
+                rrt_end = t0 + 0.98 * budget
         max_iter = values["rrt_max_iterations"]
         start_iter = self.inner.numIterations()
         inner_cost = self.inner.bestCost
@@ -299,9 +396,17 @@ class RRTstarPSO(PythonPlanner):
             self.inner.solve(ob.PlannerTerminationCondition(stop))
         else:
             slice_s = 0.05 if budget <= 0 else max(0.01, values["rrt_time_fraction"] * budget / 20)
+            connect_at = None
+            if rrt_end is not None and values["connect_after"] < 1.0 and not resume:
+                connect_at = t0 + values["connect_after"] * (rrt_end - t0)
             while not ptc():
                 now = time.perf_counter()
                 if rrt_end is not None and now >= rrt_end:
+                    break
+                if connect_at is not None and now >= connect_at and not self._has_exact():
+                    self._connect(ptc, rrt_end, stats)
+                    break
+                if self._stalled(stats.rrt_progress, now - t0, budget, t_begin - t0):
                     break
                 step = slice_s if rrt_end is None else min(slice_s, rrt_end - now)
                 sub = ob.plannerOrTerminationCondition(
@@ -311,5 +416,5 @@ class RRTstarPSO(PythonPlanner):
                 cost = inner_cost().value()
                 if np.isfinite(cost):
                     stats.rrt_progress.append((time.perf_counter() - t0, float(cost)))
-        stats.rrt_time = time.perf_counter() - t0
-        stats.rrt_iterations = self.inner.numIterations() - start_iter
+        stats.rrt_time += time.perf_counter() - t_begin
+        stats.rrt_iterations += self.inner.numIterations() - start_iter
