@@ -364,8 +364,9 @@ class RRTstarPSO(PythonPlanner):
         resume: bool = False,
     ) -> None:
         """Grow RRT* until its share of the budget, its iteration cap or the outer condition, or
-        until its best cost stalls (the swarm gets the rest); with no path halfway through its
-        share, RRTConnect looks for the first one.
+        until its best cost stalls (the swarm gets the rest); with no path at ``connect_after``
+        of its share, BIT* looks for the first one. ``resume`` grows the tree on after a swarm
+        run, for at most 70 % of the time left.
 
         The tree is grown in short slices (repeated ``solve`` calls continue the same tree) so that
         the best cost can be sampled over time: OMPL's progress properties are not reachable from
@@ -375,10 +376,8 @@ class RRTstarPSO(PythonPlanner):
         budget = values["budget"]
         rrt_end = t0 + values["rrt_time_fraction"] * budget if budget > 0 else None
         t_begin = time.perf_counter()
-        if resume:  # grown on after a swarm run: until a stall again, leaving the swarm a share
-            rrt_end = max(t_begin, t0 + budget - (1.0 - values["rrt_time_fraction"]) * budget)
-            if rrt_end - t_begin < 0.05 * budget:
-                rrt_end = t0 + 0.98 * budget
+        if resume:  # grown on after a swarm run: until a stall again, or 70 % of what is left
+            rrt_end = t_begin + 0.7 * max(t0 + budget - t_begin, 0.0)
         max_iter = values["rrt_max_iterations"]
         start_iter = self.inner.numIterations()
         inner_cost = self.inner.bestCost
