@@ -38,7 +38,7 @@ def test_dynamic_guide_quotes_the_dynamic_benchmark():
     generated = {}
     for line in (DOCS / "dynamic-benchmark.md").read_text().splitlines():
         cells = [c.strip() for c in line.strip("|").split("|")]
-        if cells[0] in ("contour", "global"):
+        if cells[0] in ("contour", "global") and len(cells) >= 14:  # the main table
             generated[cells[0]] = cells
     guide = (DOCS / "dynamic.md").read_text().splitlines()
     assert set(generated) == {"contour", "global"}

@@ -5,9 +5,12 @@
 - :mod:`.prediction`: predicted collisions (:class:`Threat`) and swept capsules;
 - :mod:`.manager`: the :class:`ReplanningManager` (contour detours up and down, verification,
   wait and step-aside fallbacks);
-- :mod:`.simulation`: :func:`simulate`, the control loop, and its :class:`SimulationResult`.
+- :mod:`.simulation`: :func:`simulate`, the control loop, and its :class:`SimulationResult`;
+- :mod:`.bounds`: the limits strategies are measured against (the static optimum at full speed,
+  and a clairvoyant wait-then-drive baseline).
 """
 
+from .bounds import ClairvoyantWait, arrival_lower_bound, clairvoyant_wait
 from .manager import Detour, Replan, ReplanningManager
 from .motion import Motion, ObstacleTrack, closest_approach, first_entry
 from .prediction import Threat, capsule, predict_threats
@@ -15,6 +18,7 @@ from .simulation import STRATEGIES, DynamicOptions, SimulationResult, simulate
 
 __all__ = [
     "STRATEGIES",
+    "ClairvoyantWait",
     "Detour",
     "DynamicOptions",
     "Motion",
@@ -23,7 +27,9 @@ __all__ = [
     "ReplanningManager",
     "SimulationResult",
     "Threat",
+    "arrival_lower_bound",
     "capsule",
+    "clairvoyant_wait",
     "closest_approach",
     "first_entry",
     "predict_threats",
