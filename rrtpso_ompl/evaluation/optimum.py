@@ -331,16 +331,11 @@ def _convex_box_corners(world: World) -> np.ndarray:
                         axis=0)  # fmt: skip
     eps = 1e-6 * float(np.min(np.minimum(b[:, 2] - b[:, 0], b[:, 3] - b[:, 1])))
     covered = np.zeros(len(corners), dtype=int)
+    boxes_only = World(world.bounds, boxes=world.boxes)  # circles and polygons do not count
     for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1)):
         x, y = corners[:, 0] + sx * eps, corners[:, 1] + sy * eps
-        covered += _in_boxes(world, x, y)
+        covered += boxes_only.in_polygons(x, y)
     return corners[covered == 1]
-
-
-def _in_boxes(world: World, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Whether each point lies in a box (polygons and circles are not counted)."""
-    plain = World(world.bounds, boxes=world.boxes)
-    return plain.in_polygons(x, y)
 
 
 class _TangentSearch:
