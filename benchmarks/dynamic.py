@@ -1,23 +1,32 @@
-"""Benchmark the replanning manager on seeded random scenarios with moving obstacles.
+"""Benchmark the replanning strategies and a DWA local planner among moving obstacles.
 
-Each scenario takes the static world of ``problems/dynamic/paper_dynamic.yaml`` and adds 1-4 moving
-obstacles that cross the robot's static path: each picks a point of the path, a heading (any
-direction, so crossings from either side, head-on and overtaking all occur) and a speed up to the
-robot's, and starts where it would reach that point when the undisturbed robot does (plus a
-little jitter).
-Three strategies drive the same static path in the same scenario:
+Cases, each run in its own spawned process (OMPL's RNG is seeded once per process):
 
-* ``contour``: the paper's method (RRTstarPSO detours up and down, verified, with fallbacks);
+* ``random``: the static world of ``problems/dynamic/paper_dynamic.yaml`` plus 1-4 moving
+  obstacles that cross the robot's static path: each picks a point of the path, a heading (any
+  direction, so crossings from either side, head-on and overtaking all occur) and a speed up to
+  the robot's, and starts where it would reach that point when the undisturbed robot does (plus a
+  little jitter);
+* ``turning``: the same with obstacles that turn at random (``--heading-changes``: 0.2 turns
+  per second, 45 degrees standard deviation), so the constant-velocity prediction is wrong;
+* ``map``: the same generator on the office occupancy-grid map of
+  ``problems/dynamic/office_people.yaml`` (its two people replaced by the random obstacles);
+* every named scenario in ``problems/dynamic/`` with several seeds (the static path differs).
+
+Four strategies drive from the same static path in the same case:
+
+* ``contour``: the paper's method (RRTstarPSO detours up and down, and waiting, chosen by
+  predicted arrival; verified; the rest re-shortened once the obstacle has passed);
 * ``global``: replan the whole remaining path with stock RRT* at each prediction (same prediction,
   sweep model, verification and fallbacks);
-* ``none``: drive the static path blindly.
-
-Every scenario runs in its own spawned process (OMPL's RNG is seeded once per process).
+* ``none``: drive the static path blindly;
+* ``dwa``: a Dynamic Window Approach local planner (:mod:`rrtpso_ompl.dynamic.dwa`) following a
+  guide path planned with clearance for it.
 
 Usage::
 
-    python benchmarks/dynamic.py        # 100 scenarios, writes docs/dynamic-benchmark.md(.jsonl)
-    python benchmarks/dynamic.py --scenarios 10 --out /tmp/dyn.md
+    python benchmarks/dynamic.py        # writes docs/dynamic-benchmark.md(.jsonl)
+    python benchmarks/dynamic.py --scenarios 10 --turning 0 --map 0 --named-seeds 1 --out /tmp/d.md
 """
 
 from __future__ import annotations
@@ -32,11 +41,23 @@ import statistics
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
-BASE = REPO / "problems" / "dynamic" / "paper_dynamic.yaml"
-STRATEGIES = (("contour", "RRTstarPSO"), ("global", "RRTstar"), ("none", "RRTstarPSO"))
+DYNAMIC = REPO / "problems" / "dynamic"
+BASE = DYNAMIC / "paper_dynamic.yaml"
+MAP_BASE = DYNAMIC / "office_people.yaml"
+STRATEGIES = (
+    ("contour", "RRTstarPSO"),
+    ("global", "RRTstar"),
+    ("none", "RRTstarPSO"),
+    ("dwa", "DWA"),
+)
+#: Random heading changes of the ``turning`` family: per obstacle per second, and degrees.
+TURN_RATE, TURN_DEG = 0.2, 45.0
+#: Longest wait the clairvoyant baseline tries, s.
+MAX_CLAIRVOYANT_WAIT = 120.0
 
 
 def make_scenario(seed: int, static_path, problem):
@@ -61,7 +82,7 @@ def make_scenario(seed: int, static_path, problem):
             t_x = frac * s[-1] / v
             heading = rng.uniform(-math.pi, math.pi)
             speed = rng.uniform(0.2, 1.0) * v
-            radius = rng.uniform(15.0, 30.0)
+            radius = rng.uniform(0.53, 1.05) * sr  # 15-30 cm for the paper's robot
             start = x - speed * t_x * np.array([math.cos(heading), math.sin(heading)])
             start += rng.uniform(-0.5, 0.5, 2) * sr
             # Not on top of the robot at the start (that scenario has no collision-free motion).
@@ -72,11 +93,21 @@ def make_scenario(seed: int, static_path, problem):
     return out
 
 
-def run_scenario(
-    seed: int, replan_time: float, initial_time: float, optimum_path: list | None = None
-) -> list[dict]:
-    """All strategies on scenario ``seed``, in one fresh process; one row per strategy, each
-    with the scenario's limits (the optimum at full speed; the clairvoyant wait-then-drive)."""
+@dataclass(frozen=True)
+class Case:
+    """One benchmark case: a family (or a named scenario), its base problem and its seed."""
+
+    group: str
+    base: str
+    seed: int
+    randomize: bool
+    heading_changes: float = 0.0
+
+
+def run_case(case: Case, replan_time: float, initial_time: float,
+             optimum_path: list | None = None) -> list[dict]:  # fmt: skip
+    """All strategies on one case, in one fresh process; one row per strategy, each with the
+    case's limits (the optimum at full speed; the clairvoyant wait-then-drive)."""
     import dataclasses
 
     import numpy as np
@@ -88,57 +119,69 @@ def run_scenario(
         clairvoyant_wait,
         simulate,
     )
+    from rrtpso_ompl.dynamic.dwa import guide_path, simulate_dwa
     from rrtpso_ompl.model.geometry import path_length
     from rrtpso_ompl.model.problem import load_problem
     from rrtpso_ompl.ompl_setup import set_ompl_log_level
     from rrtpso_ompl.planners import solve
 
     set_ompl_log_level(0)
-    base = load_problem(BASE)
+    seed = case.seed
+    head = {"group": case.group, "seed": seed}
+    base = load_problem(case.base)
     static = solve(base, "RRTstarPSO", initial_time, seed)
     if not static.solved:
-        return [{"seed": seed, "strategy": s, "error": "no static path"} for s, _ in STRATEGIES]
-    moving = make_scenario(seed, static.path, base)
-    problem = dataclasses.replace(base, name=f"random_{seed}", moving_obstacles=tuple(moving))
+        return [{**head, "strategy": s, "error": "no static path"} for s, _ in STRATEGIES]
+    problem = base
+    if case.randomize:
+        moving = make_scenario(seed, static.path, base)
+        problem = dataclasses.replace(base, name=f"{case.group}_{seed}",
+                                      moving_obstacles=tuple(moving))  # fmt: skip
+    robot = problem.robot
     limits = {"lower_bound_time": None, "clairvoyant_time": None}
     if optimum_path is not None:
-        robot = problem.robot
         best = np.asarray(optimum_path)
         turn = 2.0 * (robot.max_wheel_speed or robot.speed) / robot.track_width
         limits["lower_bound_time"] = arrival_lower_bound(path_length(best), robot.speed)
-        tracks = [ObstacleTrack.from_obstacle(m) for m in moving]
-        wait = clairvoyant_wait(best, tracks, robot.radius, robot.speed, turn,
-                                robot.sample_time, 120.0)  # fmt: skip
-        limits["clairvoyant_time"] = wait.arrival if wait else None
+        if case.heading_changes == 0:  # the obstacles' future is known only without random turns
+            tracks = [ObstacleTrack.from_obstacle(m) for m in problem.moving_obstacles]
+            wait = clairvoyant_wait(best, tracks, robot.radius, robot.speed, turn,
+                                    robot.sample_time, MAX_CLAIRVOYANT_WAIT)  # fmt: skip
+            limits["clairvoyant_time"] = wait.arrival if wait else None
     rows = []
     for strategy, planner in STRATEGIES:
-        opts = DynamicOptions(planner=planner, strategy=strategy, replan_time=replan_time)
         t0 = time.perf_counter()
-        sim = simulate(problem, opts, seed=seed, initial_path=static.path)
+        if strategy == "dwa":
+            opts = DynamicOptions(heading_changes=case.heading_changes, heading_change_deg=TURN_DEG)
+            guide = guide_path(problem, static.path, "RRTstarPSO", 0.5, {"seed": seed})
+            sim = simulate_dwa(problem, guide, options=opts, seed=seed)
+        else:
+            opts = DynamicOptions(planner=planner, strategy=strategy, replan_time=replan_time,
+                                  heading_changes=case.heading_changes,
+                                  heading_change_deg=TURN_DEG)  # fmt: skip
+            sim = simulate(problem, opts, seed=seed, initial_path=static.path)
         planned = [r for r in sim.replans if r.kind in ("contour", "global")]
+        clearance = [d - c for d, c in
+                     zip(sim.min_separation_continuous, sim.contact_distance, strict=True)
+                     if d is not None]  # fmt: skip
         rows.append(
             {
-                "seed": seed,
+                **head,
+                "scenario": problem.name,
                 "strategy": strategy,
                 "planner": planner,
-                "obstacles": len(moving),
+                "status": sim.status,
+                "obstacles": len(problem.moving_obstacles),
                 "reached_goal": sim.reached_goal,
                 "collisions": sim.collisions,
-                "success": sim.success,
-                "min_clearance": min(
-                    (
-                        d - c
-                        for d, c in zip(
-                            sim.min_separation_continuous, sim.contact_distance, strict=True
-                        )
-                    ),
-                    default=None,
-                ),
+                "success": sim.success and sim.status == "ok",
+                "min_clearance": min(clearance, default=None),
                 "path_length": sim.path_length,
                 "static_length": sim.static_length,
                 "total_time": sim.total_time,
                 "replans": len(sim.replans),
-                "detours": len(planned),
+                "detours": sum(r.side != "wait" for r in planned),
+                "waits": sum(r.side == "wait" for r in planned),
                 "fallbacks": {
                     k: sum(r.kind == k for r in sim.replans)
                     for k in ("wait", "evade", "unavoidable")
@@ -151,47 +194,61 @@ def run_scenario(
     return rows
 
 
-def summarise(rows: list[dict], optimum: float | None) -> list[dict]:
+def summarise(rows: list[dict], group: str) -> list[dict]:
+    """Per strategy, over the rows of ``group``."""
     out = []
     for strategy, planner in STRATEGIES:
-        rs = [r for r in rows if r["strategy"] == strategy and "error" not in r]
+        rs = [r for r in rows if r["group"] == group and r["strategy"] == strategy
+              and "error" not in r]  # fmt: skip
         if not rs:
             continue
         reached = [r for r in rs if r["reached_goal"]]
-        overhead = [100 * (r["path_length"] / optimum - 1) for r in reached] if optimum else []
-        over_static = [100 * (r["path_length"] / r["static_length"] - 1) for r in reached]
         plan_t = [t for r in rs for t in r["planning_times"]]
         over_lb = [100 * (r["total_time"] / r["lower_bound_time"] - 1) for r in reached
                    if r.get("lower_bound_time")]  # fmt: skip
         over_cw = [100 * (r["total_time"] / r["clairvoyant_time"] - 1) for r in reached
                    if r.get("clairvoyant_time")]  # fmt: skip
+        feasible = [r for r in rs if r.get("clairvoyant_time")]
         out.append(
             {
                 "strategy": strategy,
                 "planner": planner if strategy != "none" else "-",
                 "runs": len(rs),
                 "success": sum(r["success"] for r in rs),
-                "reached": sum(r["reached_goal"] for r in rs),
+                "reached": len(reached),
                 "collision_runs": sum(r["collisions"] > 0 for r in rs),
-                "median_overhead": statistics.median(overhead) if overhead else None,
-                "p90_overhead": _quantile(overhead, 0.9),
-                "median_over_static": statistics.median(over_static) if over_static else None,
-                "p90_over_static": _quantile(over_static, 0.9),
+                "collision_runs_feasible": sum(r["collisions"] > 0 for r in feasible),
+                "feasible": len(feasible),
+                "median_arrival": _median([r["total_time"] for r in reached]),
+                "median_length": _median([r["path_length"] for r in reached]),
+                "median_over_lb": _median(over_lb),
+                "median_over_cw": _median(over_cw),
                 "mean_replans": statistics.fmean(r["replans"] for r in rs),
-                "mean_detours": statistics.fmean(r["detours"] for r in rs),
+                "waits": sum(r.get("waits", 0) for r in rs),
                 "fallbacks": sum(sum(r["fallbacks"].values()) for r in rs),
-                "unavoidable": sum(r["fallbacks"]["unavoidable"] for r in rs),
-                "median_plan_time": statistics.median(plan_t) if plan_t else None,
+                "median_plan_time": _median(plan_t),
+                "p90_plan_time": _quantile(plan_t, 0.9),
                 "max_plan_time": max(plan_t) if plan_t else None,
-                "min_clearance": min(r["min_clearance"] for r in rs),
-                "median_arrival": statistics.median(r["total_time"] for r in reached)
-                if reached
-                else None,
-                "median_over_lb": statistics.median(over_lb) if over_lb else None,
-                "median_over_cw": statistics.median(over_cw) if over_cw else None,
+                "min_clearance": min((r["min_clearance"] for r in rs
+                                      if r["min_clearance"] is not None), default=None),
             }
-        )
+        )  # fmt: skip
     return out
+
+
+def verdict(summary: list[dict]) -> str:
+    """Whether contour is no worse than global in median arrival and in median length."""
+    by = {s["strategy"]: s for s in summary}
+    c, g = by.get("contour"), by.get("global")
+    if not c or not g or c["median_arrival"] is None or g["median_arrival"] is None:
+        return "–"
+    ok = c["median_arrival"] <= g["median_arrival"] + 1e-9
+    ok &= c["median_length"] <= g["median_length"] + 1e-9
+    return "yes" if ok else "**no**"
+
+
+def _median(xs: list[float]) -> float | None:
+    return statistics.median(xs) if xs else None
 
 
 def _quantile(xs: list[float], q: float) -> float | None:
@@ -205,89 +262,154 @@ def _fmt(x, spec=".1f") -> str:
     return "–" if x is None else format(x, spec)
 
 
-def report(rows: list[dict], summary: list[dict], args, optimum: float | None, wall: float) -> str:
+GROUP_TEXT = {
+    "random": "static world of `paper_dynamic.yaml` (500 x 500 cm, robot SR 28.5 cm at 20 cm/s, "
+    "sensor range 100 cm), 1-4 random obstacles at constant velocity",
+    "turning": f"the same, the obstacles turning at random ({TURN_RATE} turns/s, "
+    f"{TURN_DEG:g} degrees standard deviation): the prediction is wrong after every turn",
+    "map": "office occupancy-grid map of `office_people.yaml` (30 x 20 m, SR 0.25 m at 0.5 m/s, "
+    "sensor range 3 m), 1-4 random obstacles at constant velocity",
+}
+
+
+def report(rows: list[dict], groups: dict[str, list[Case]], args, wall: float) -> str:
     lines = [
-        "# Dynamic benchmark: the replanning manager on random scenarios",
+        "# Dynamic benchmark: replanning strategies and a DWA among moving obstacles",
         "",
         f"Generated by `{' '.join(['python benchmarks/dynamic.py', *map(shlex.quote, args.argv)])}`"
         f" on {platform.platform()}, Python {platform.python_version()}, "
         f"{args.jobs} processes, {wall / 60:.1f} min.",
         "",
-        f"{args.scenarios} scenarios (seeds {args.first}..{args.first + args.scenarios - 1}) "
-        "in the static world of `problems/dynamic/paper_dynamic.yaml` (500 x 500 cm, robot SR "
-        "28.5 cm at 20 cm/s, sensor range 100 cm); each adds 1-4 moving obstacles (radius "
-        "15-30 cm, speed 0.2-1.0 x the robot's) timed to cross the robot's static RRTstarPSO "
-        "path. The three strategies drive the "
-        f"same static path. Replanning budget {args.replan_time} s of simulated time per replan "
-        "(split between the two contour detours).",
+        "Every case starts from one static RRTstarPSO path (1 s); `contour`, `global` and `none` "
+        "drive it, `dwa` follows a guide path planned with clearance for it. Replanning budget "
+        f"{args.replan_time} s of simulated time per replan (contour: both detours and the wait "
+        "search; global: one RRT* plan). Arrival is the simulated time to the goal, length the "
+        "distance driven, both medians over the runs that reached the goal. The lower bound is "
+        "the static exact optimum (`rrtpso optimum`) driven at full speed with no turning time: "
+        "no strategy can arrive earlier. The clairvoyant baseline knows every obstacle's future, "
+        "waits at the start for the least multiple of the control period after which driving "
+        "the static optimum (stop-and-turn) never touches an obstacle, checked exactly: it is "
+        "achievable, so it also proves that a collision-free motion exists (not computed when "
+        "obstacles turn at random). Planning time is measured wall-clock per replan.",
         "",
-        "Overhead is the driven length over the static world's exact shortest path "
-        f"({_fmt(optimum, '.2f')} cm, `rrtpso optimum`) and, in brackets, over the scenario's "
-        "static planned path (what the robot would have driven without moving obstacles), over "
-        "the runs that reached the goal. Planning time is measured wall-clock per detour replan "
-        "(both sides for contour).",
-        "",
-        "| strategy | planner | runs | success | reached | runs with a collision "
-        "| median overhead % | p90 overhead % | replans/run | detours/run | fallbacks "
-        "| unavoidable | median planning s | max planning s | min clearance cm |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
-    for s in summary:
-        lines.append(
-            f"| {s['strategy']} | {s['planner']} | {s['runs']} | {s['success']} | {s['reached']} | "
-            f"{s['collision_runs']} | {_fmt(s['median_overhead'])} "
-            f"({_fmt(s['median_over_static'])}) | {_fmt(s['p90_overhead'])} "
-            f"({_fmt(s['p90_over_static'])}) | "
-            f"{s['mean_replans']:.2f} | {s['mean_detours']:.2f} | {s['fallbacks']} | "
-            f"{s['unavoidable']} | "
-            f"{_fmt(s['median_plan_time'], '.3f')} | {_fmt(s['max_plan_time'], '.3f')} | "
-            f"{_fmt(s['min_clearance'])} |"
-        )
-    lb = [r["lower_bound_time"] for r in rows if r.get("lower_bound_time")]
-    cw = [r["clairvoyant_time"] for r in rows if r.get("clairvoyant_time")]
+    header = (
+        "| strategy | runs | success | collision runs (of those with a free motion) "
+        "| median arrival s | median length | over lower bound % | over clairvoyant % "
+        "| replans/run | waits chosen | fallbacks | planning s median / p90 / max "
+        "| min clearance |"
+    )
+    rule = "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    verdicts = []
+    for group, cases in groups.items():
+        if not cases:
+            continue
+        summary = summarise(rows, group)
+        text = GROUP_TEXT.get(group, f"named scenario `problems/dynamic/{group}.yaml`")
+        seeds = f"seeds {cases[0].seed}..{cases[-1].seed}"
+        verdicts.append((group, len(cases), verdict(summary), summary))
+        lines += [f"## {group}: {len(cases)} cases ({seeds})", "", text + ".", "", header, rule]
+        for s_ in summary:
+            lines.append(
+                f"| {s_['strategy']} | {s_['runs']} | {s_['success']} | {s_['collision_runs']} "
+                f"({s_['collision_runs_feasible']} of {s_['feasible']}) | "
+                f"{_fmt(s_['median_arrival'])} | {_fmt(s_['median_length'], '.2f')} | "
+                f"{_fmt(s_['median_over_lb'])} | {_fmt(s_['median_over_cw'])} | "
+                f"{s_['mean_replans']:.2f} | {s_['waits']} | {s_['fallbacks']} | "
+                f"{_fmt(s_['median_plan_time'], '.3f')} / {_fmt(s_['p90_plan_time'], '.3f')} / "
+                f"{_fmt(s_['max_plan_time'], '.3f')} | {_fmt(s_['min_clearance'], '.2f')} |"
+            )
+        lines.append("")
     lines += [
+        "## Target: contour no worse than global",
         "",
-        "Arrival time against the limits (issue 14): the lower bound is the static exact optimum "
-        "driven at full speed with no turning time (no strategy can arrive earlier); the "
-        "clairvoyant baseline knows every obstacle's future, waits at the start for the least "
-        "multiple of the control period after which driving the static optimum (with the "
-        "robot's stop-and-turn motion) never touches an obstacle, checked exactly. It is "
-        "achievable, so an upper bound on the space-time optimum; a strategy below it dodges "
-        "better than waiting.",
+        "Median arrival and median driven length of `contour` against `global`, per family and per "
+        "named scenario.",
         "",
-        f"Median lower bound {_fmt(statistics.median(lb) if lb else None)} s, median "
-        f"clairvoyant arrival {_fmt(statistics.median(cw) if cw else None)} s.",
-        "",
-        "| strategy | median arrival s | median overhead over the lower bound % | "
-        "median overhead over the clairvoyant wait % |",
-        "|---|---|---|---|",
+        "| cases | n | contour arrival / global arrival s | contour length / global length "
+        "| contour no worse |",
+        "|---|---|---|---|---|",
     ]
-    for s_ in summary:
+    for group, n, ok, summary in verdicts:
+        by = {s["strategy"]: s for s in summary}
+        c, g = by.get("contour", {}), by.get("global", {})
         lines.append(
-            f"| {s_['strategy']} | {_fmt(s_['median_arrival'])} | {_fmt(s_['median_over_lb'])} | "
-            f"{_fmt(s_['median_over_cw'])} |"
+            f"| {group} | {n} | {_fmt(c.get('median_arrival'))} / "
+            f"{_fmt(g.get('median_arrival'))} | {_fmt(c.get('median_length'), '.2f')} / "
+            f"{_fmt(g.get('median_length'), '.2f')} | {ok} |"
         )
-    bad = [r for r in rows if r.get("strategy") != "none" and not r.get("success", False)]
+    bad = [r for r in rows if r.get("strategy") in ("contour", "global")
+           and not r.get("success", False)]  # fmt: skip
     lines += ["", "Runs of the replanning strategies that did not succeed:", ""]
     if not bad:
         lines.append("none.")
     for r in bad:
         lines.append(
-            f"- seed {r['seed']} ({r['strategy']}): reached {r.get('reached_goal')}, collisions "
-            f"{r.get('collisions')}, min clearance {_fmt(r.get('min_clearance'))} cm, fallbacks "
-            f"{r.get('fallbacks')} {r.get('error', '')}"
+            f"- {r['group']} seed {r['seed']} ({r['strategy']}): reached {r.get('reached_goal')}, "
+            f"collisions {r.get('collisions')}, min clearance {_fmt(r.get('min_clearance'))}, "
+            f"clairvoyant {_fmt(r.get('clairvoyant_time'))} s, fallbacks {r.get('fallbacks')} "
+            f"{r.get('error', '')}"
         )
     return "\n".join(lines) + "\n"
 
 
+def figure(rows: list[dict], path: Path) -> None:
+    """Box plots of arrival over the lower bound per strategy, for each family."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    families = [g for g in ("random", "turning", "map") if any(r["group"] == g for r in rows)]
+    if not families:
+        return
+    fig, axes = plt.subplots(1, len(families), figsize=(4.2 * len(families), 3.6), squeeze=False)
+    names = [s for s, _ in STRATEGIES]
+    for ax, group in zip(axes[0], families, strict=True):
+        data = []
+        for strategy in names:
+            rs = [r for r in rows if r["group"] == group and r["strategy"] == strategy
+                  and r.get("reached_goal") and r.get("lower_bound_time")]  # fmt: skip
+            data.append([100 * (r["total_time"] / r["lower_bound_time"] - 1) for r in rs])
+        ax.boxplot(data, whis=(5, 95), showfliers=False)
+        ax.set_xticks(range(1, len(names) + 1), names)
+        ax.set_title(f"{group} ({len(data[0])} cases)")
+        ax.set_ylabel("arrival over the lower bound, %")
+        ax.grid(axis="y", alpha=0.3)
+    fig.suptitle("Arrival time over the static optimum at full speed, runs that reached the goal "
+                 "(whiskers: 5-95 %)")  # fmt: skip
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def cases(args) -> dict[str, list[Case]]:
+    """The benchmark's cases by group (family or named scenario)."""
+    out: dict[str, list[Case]] = {
+        "random": [Case("random", str(BASE), args.first + i, True) for i in range(args.scenarios)],
+        "turning": [Case("turning", str(BASE), 1001 + i, True, TURN_RATE)
+                    for i in range(args.turning)],
+        "map": [Case("map", str(MAP_BASE), 2001 + i, True) for i in range(args.map)],
+    }  # fmt: skip
+    for path in sorted(DYNAMIC.glob("*.yaml")):
+        out[path.stem] = [Case(path.stem, str(path), 1 + i, False)
+                          for i in range(args.named_seeds)]  # fmt: skip
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--scenarios", type=int, default=100)
-    ap.add_argument("--first", type=int, default=1, help="first seed")
+    ap.add_argument("--scenarios", type=int, default=100, help="random cases")
+    ap.add_argument("--first", type=int, default=1, help="first seed of the random cases")
+    ap.add_argument("--turning", type=int, default=50, help="cases with turning obstacles")
+    ap.add_argument("--map", type=int, default=50, help="random cases on the office map")
+    ap.add_argument("--named-seeds", type=int, default=5, help="seeds per named scenario")
     ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--replan-time", type=float, default=0.5)
+    ap.add_argument("--replan-time", type=float, default=0.1)
     ap.add_argument("--initial-time", type=float, default=1.0)
     ap.add_argument("--out", default=str(REPO / "docs" / "dynamic-benchmark.md"))
+    ap.add_argument("--figure", default=str(REPO / "docs" / "img" / "dynamic-benchmark.png"),
+                    help="box plots of arrival time (empty: none)")  # fmt: skip
     args = ap.parse_args(argv)
     args.argv = list(argv if argv is not None else sys.argv[1:])
 
@@ -297,28 +419,31 @@ def main(argv: list[str] | None = None) -> int:
     from rrtpso_ompl.model import World
     from rrtpso_ompl.model.problem import load_problem
 
-    # Every scenario shares the static world, so one exact optimum is the reference for all.
-    base = load_problem(BASE)
-    best = shortest_path(base)
-    optimum = best.length
-    best_path = best.valid_polyline(World.from_problem(base)).tolist()
+    groups = cases(args)
+    todo = [c for cs in groups.values() for c in cs]
+    # One exact optimum per static world, the reference of every case built on it.
+    optimum: dict[str, list] = {}
+    for base in sorted({c.base for c in todo}):
+        problem = load_problem(base)
+        best = shortest_path(problem)
+        optimum[base] = best.valid_polyline(World.from_problem(problem)).tolist()
     rows: list[dict] = []
     t0 = time.perf_counter()
     ctx = mp.get_context("spawn")
-    seeds = range(args.first, args.first + args.scenarios)
-    # One scenario per child process: OMPL takes each scenario's seed.
+    # One case per child process: OMPL takes each case's seed.
     with ProcessPoolExecutor(args.jobs, mp_context=ctx, max_tasks_per_child=1) as pool:
-        futures = [pool.submit(run_scenario, s, args.replan_time, args.initial_time, best_path)
-                   for s in seeds]  # fmt: skip
+        futures = [pool.submit(run_case, c, args.replan_time, args.initial_time,
+                               optimum[c.base]) for c in todo]  # fmt: skip
         for fut in tqdm(as_completed(futures), total=len(futures), file=sys.stderr,
-                        disable=not sys.stderr.isatty(), desc="scenarios"):  # fmt: skip
+                        disable=not sys.stderr.isatty(), desc="cases"):  # fmt: skip
             rows.extend(fut.result())
     wall = time.perf_counter() - t0
-    rows.sort(key=lambda r: (r["seed"], r["strategy"]))
-    summary = summarise(rows, optimum)
+    rows.sort(key=lambda r: (r["group"], r["seed"], r["strategy"]))
     out = Path(args.out)
     out.with_suffix(".jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
-    out.write_text(report(rows, summary, args, optimum, wall))
+    out.write_text(report(rows, groups, args, wall))
+    if args.figure:
+        figure(rows, Path(args.figure))
     print(out.read_text())
     return 0
 

@@ -32,3 +32,51 @@ def rrtpso_exe() -> list[str]:
 def write_yaml(path: Path, text: str) -> Path:
     path.write_text(text)
     return path
+
+
+# -- moving obstacles (tests/dynamic) ----------------------------------------------------------
+#: The paper's robot with a 150 cm sensor.
+ROBOT = {
+    "radius": 28.5,
+    "wheel_radius": 7.6,
+    "track_width": 38,
+    "speed": 20,
+    "sample_time": 0.15,
+    "sensor_range": 150,
+}
+
+
+def corridor(moving, obstacles=()):
+    """A 500 x 500 cm world, route along y = 250."""
+    from rrtpso_ompl.model.problem import problem_from_dict
+
+    return problem_from_dict(
+        {
+            "name": "corridor",
+            "bounds": [[0, 0], [500, 500]],
+            "start": [30, 250],
+            "goal": [470, 250],
+            "robot": ROBOT,
+            "obstacles": list(obstacles),
+            "moving_obstacles": moving,
+        }
+    )
+
+
+def manager_for(problem, seed=0, **kw):
+    """A replanning manager for ``problem`` (0.6 s replans, 5.7 cm margin) and the turn rate."""
+    import numpy as np
+
+    from rrtpso_ompl.dynamic import DynamicOptions, ReplanningManager
+
+    opts = DynamicOptions(replan_time=0.6, **kw)
+    speed, turn = problem.robot.speed, 2 * problem.robot.speed / problem.robot.track_width
+    return ReplanningManager(problem, opts, speed, turn, 5.7, np.random.default_rng(seed)), turn
+
+
+def observe(problem, t):
+    """What the robot senses at time ``t``: every moving obstacle, exactly."""
+    out = {}
+    for j, m in enumerate(problem.moving_obstacles):
+        out[j] = (m.position(t), m.velocity, m.radius)
+    return out

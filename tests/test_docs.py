@@ -33,26 +33,13 @@ def test_readme_table_is_the_overview_table():
 
 
 def test_dynamic_guide_quotes_the_dynamic_benchmark():
-    """docs/dynamic.md's table repeats docs/dynamic-benchmark.md (written by
-    benchmarks/dynamic.py): success, collisions, overhead, replans and planning times."""
-    generated = {}
-    for line in (DOCS / "dynamic-benchmark.md").read_text().splitlines():
-        cells = [c.strip() for c in line.strip("|").split("|")]
-        if cells[0] in ("contour", "global") and len(cells) >= 14:  # the main table
-            generated[cells[0]] = cells
-    guide = (DOCS / "dynamic.md").read_text().splitlines()
-    assert set(generated) == {"contour", "global"}
-    for strategy, c in generated.items():
-        row = next(line for line in guide if line.startswith(f"| {strategy} ("))
-        median, p90 = (c[i].split(" ")[0] for i in (6, 7))
-        expected = [
-            f"| {c[3]} / {c[2]} |",  # success of runs
-            f"| {c[5]} |",  # runs with a collision
-            f"| {median} % / {p90} % |",
-            f"| {c[8]} |",  # replans per run
-            f"{float(c[12]):.2f} s median, {float(c[13]):.2f} s max",
-        ]
-        assert all(e in row for e in expected), (strategy, row, expected)
+    """docs/dynamic.md repeats the target table of docs/dynamic-benchmark.md (written by
+    benchmarks/dynamic.py): contour against global per family and named scenario, verbatim."""
+    generated = (DOCS / "dynamic-benchmark.md").read_text().splitlines()
+    first = generated.index(next(line for line in generated if line.startswith("| cases | n |")))
+    table = generated[first : generated.index("", first)]
+    assert len(table) >= 2 + 3 + 7  # header, rule, three families, the named scenarios
+    assert "\n".join(table) in (DOCS / "dynamic.md").read_text()
 
 
 def test_the_published_json_schema_is_the_declared_format_and_accepts_the_library():

@@ -50,17 +50,24 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     m.add_argument(
         "--replan-time",
         type=float,
-        default=0.5,
         metavar="SECONDS",
-        help="simulated time one replan takes, split between the two detours (default 0.5)",
+        help="simulated time one replan takes, split between the two detours (default: "
+        "DynamicOptions.replan_time, see docs/dynamic.md)",
+    )
+    m.add_argument(
+        "--no-reshorten",
+        dest="reshorten",
+        action="store_false",
+        help="contour: keep a detour's bends after the obstacle has passed (default: shortcut "
+        "the rest of the plan once no collision is predicted)",
     )
     m.add_argument(
         "--strategy",
-        choices=("contour", "global", "none"),
+        choices=("contour", "global", "none", "dwa"),
         default="contour",
-        help="contour: detours up and down around the collision zone (the paper); "
-        "global: replan the whole remaining path; none: never replan "
-        "(default: contour)",
+        help="contour: detours up and down around the collision zone, or a wait (the paper); "
+        "global: replan the whole remaining path; none: never replan; dwa: a Dynamic Window "
+        "Approach local planner following the static path (default: contour)",
     )
     m.add_argument(
         "--heading-changes",
@@ -103,10 +110,12 @@ def run(args: argparse.Namespace) -> int:
 
     from ..dynamic import DynamicOptions, simulate
 
+    timing = {} if args.replan_time is None else {"replan_time": args.replan_time}
     options = DynamicOptions(
         planner=choice.entry.name,
-        strategy=args.strategy,
-        replan_time=args.replan_time,
+        strategy="none" if args.strategy == "dwa" else args.strategy,
+        **timing,
+        reshorten=args.reshorten,
         initial_time=args.time,
         heading_changes=args.heading_changes,
         params=choice.params,
@@ -119,7 +128,10 @@ def run(args: argparse.Namespace) -> int:
             bar.n = round(t, 1)
             bar.refresh()
 
-        sim = simulate(problem, options, seed=seed, progress=progress)
+        if args.strategy == "dwa":
+            sim = _simulate_dwa(problem, options, seed, choice)
+        else:
+            sim = simulate(problem, options, seed=seed, progress=progress)
     _write_outputs(args, problem, sim)
     verdict = "reached the goal" if sim.reached_goal else f"did not reach the goal ({sim.status})"
     note(
@@ -127,6 +139,20 @@ def run(args: argparse.Namespace) -> int:
         f"time {sim.total_time:.1f}s, length {sim.path_length:.1f}",
     )
     return EXIT_OK if sim.success else EXIT_UNSOLVED
+
+
+def _simulate_dwa(problem: Any, options: Any, seed: int | None, choice: Any) -> Any:
+    """The DWA peer: the static path planned with the chosen planner, then the DWA's guide path
+    (planned again with clearance for it, on the same budget), then the DWA drive."""
+    from ..dynamic.dwa import guide_path, simulate_dwa
+    from ..planners import solve
+
+    budget = options.initial_time
+    static = solve(problem, options.planner, budget, seed, dict(options.params))
+    guide = static.path
+    if static.solved:
+        guide = guide_path(problem, static.path, options.planner, static.time, options.params)
+    return simulate_dwa(problem, guide, options=options, seed=seed)
 
 
 def _write_outputs(args: argparse.Namespace, problem: Any, sim: Any) -> None:

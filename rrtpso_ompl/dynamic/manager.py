@@ -5,10 +5,16 @@ the detour starts where the robot will be when it is ready; the detour's goal is
 of the old path safely past the collision zone; the obstacles' predicted sweeps over the detour's
 time window become static obstacles (capsules); a thin wall on one side of the cross point makes
 the planner pass on the other side, and both detours, "contour path up" (left of the direction of
-travel) and "down" (right), are planned with the static planner (RRTstarPSO by default). Every
-candidate is then *verified* in space and time against all sensed obstacles; the verified one that
-arrives first is spliced in. Without a verified detour the robot waits or steps aside (also
-verified); it never drives into a predicted collision.
+travel) and "down" (right), are planned with the static planner (RRTstarPSO by default). A third
+candidate is *waiting*: the least stop (a multiple of the control period) after which the old plan
+passes every obstacle. Every candidate is *verified* in space and time against all sensed
+obstacles; the verified one that arrives first is spliced in (on a tie the shorter, so a wait
+beats an equally fast detour). Without a verified candidate the robot waits or steps aside (also
+verified); it never drives into a predicted collision. The planning budget (``replan_time``) is
+simulated time and also a wall-clock budget: the detours share what is left of it, less what a
+solve costs beyond its own time limit (measured as the manager goes). Once no collision is
+predicted, :meth:`ReplanningManager.reshorten` shortcuts the rest of the plan in the static
+world, so a detour's bends go when the obstacle has passed.
 
 Only the time windows in which the robot could actually meet an obstacle become static
 obstacles: the robot, driving at speed ``v`` from ``p_s`` at ``t_s`` on a detour at most
@@ -30,6 +36,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..model.geometry import shortcut
 from ..model.problem import Circle, PlannerConfig, Polygon, Problem
 from ..model.world import World
 from .motion import Motion, closest_approach
@@ -38,7 +45,15 @@ from .prediction import Threat, capsule, extrapolate, true_runs
 if TYPE_CHECKING:
     from .simulation import DynamicOptions
 
-__all__ = ["Detour", "Replan", "ReplanningManager"]
+__all__ = ["BUDGET_RESERVE", "MAX_WAIT_STEPS", "Detour", "Replan", "ReplanningManager"]
+
+#: Least planner budget of one detour, s (below it a solve cannot even set up).
+MIN_DETOUR_TIME = 0.01
+#: Share of the replanning budget kept back for the bookkeeping after the last solve (choosing,
+#: recording) and for the scatter of a solve's overrun around the measured estimate.
+BUDGET_RESERVE = 0.05
+#: Most waits one replan verifies (each is an exact check against every sensed obstacle).
+MAX_WAIT_STEPS = 400
 
 #: What the manager knows of an obstacle it senses: index -> (position, velocity, radius).
 Observations = Mapping[int, tuple[np.ndarray, np.ndarray, float]]
@@ -48,8 +63,9 @@ Observations = Mapping[int, tuple[np.ndarray, np.ndarray, float]]
 class Replan:
     """One reaction of the manager (JSON-ready through :meth:`to_dict`).
 
-    ``kind`` is ``"contour"``/``"global"`` for a planned detour, ``"wait"`` or ``"evade"`` for a
-    fallback, ``"unavoidable"`` when nothing verified. ``planning_time`` is the measured wall-clock
+    ``kind`` is ``"contour"``/``"global"`` for a planned reaction (``side`` ``"up"``, ``"down"``,
+    ``"wait"`` or None for global), ``"wait"`` or ``"evade"`` for a fallback, ``"unavoidable"``
+    when nothing verified. ``planning_time`` is the measured wall-clock
     time of the planners, ``budget`` the simulated time it was charged.
     """
 
@@ -92,9 +108,11 @@ class Detour:
     Attributes
     ----------
     side : str or None
-        ``"up"``, ``"down"`` or None (whole-path replanning).
+        ``"up"``, ``"down"``, ``"wait"`` (let the obstacle pass, then drive on) or None
+        (whole-path replanning).
     record : dict
-        Its JSON record in :attr:`Replan.candidates` (side, validity, length, reason...).
+        Its JSON record in :attr:`Replan.candidates` (side, validity, length, predicted arrival
+        in s, reason...).
     motion : Motion or None
         The spliced plan when the detour was planned and verified, else None.
     goal : ndarray or None
@@ -165,6 +183,8 @@ class ReplanningManager:
         # Detours must not reseed OMPL (once per process): planners that take a seed get one as
         # a parameter instead.
         self._seed_param = default_registry().get(options.planner).takes("seed")
+        # What a solve costs beyond its own budget (set-up, verification), s; measured per call.
+        self._overrun = 0.005
 
     # -- entry points ----------------------------------------------------------------------------
     def react(
@@ -185,12 +205,22 @@ class ReplanningManager:
             sides: tuple[str | None, ...] = ("up", "down")
         else:
             sides, tangent = (None,), None
-        share = budget / len(sides)
         clock = time.perf_counter()
-        detours = [
-            self._detour(t_now, plan, obs, p_s, th_s, t_s, t_exit, side, share, first, tangent)
-            for side in sides
-        ]
+        deadline = clock + (1.0 - BUDGET_RESERVE) * budget
+        detours = []
+        if self.options.strategy == "contour":
+            # Waiting is a contour option too: let the obstacle pass, then drive on (cheap: exact
+            # checks of the old plan delayed, no planning).
+            detours.append(self._wait(t_now, plan, obs, t_s, t_exit))
+        for i, side in enumerate(sides):
+            # Wall-clock budgeting: what is left, shared among the detours still to plan, less the
+            # set-up and verification a solve costs beyond its own budget (measured as we go).
+            share = (deadline - time.perf_counter()) / (len(sides) - i) - self._overrun
+            share = max(share, MIN_DETOUR_TIME)
+            started = time.perf_counter()
+            d = self._detour(t_now, plan, obs, p_s, th_s, t_s, t_exit, side, share, first, tangent)
+            self._overrun = max(0.75 * self._overrun, time.perf_counter() - started - share)
+            detours.append(d)
         elapsed = time.perf_counter() - clock
         candidates = [d.record for d in detours]
         usable = [d for d in detours if d.motion is not None]
@@ -200,7 +230,8 @@ class ReplanningManager:
             rec.planning_time, rec.budget = elapsed, budget
             rec.candidates = candidates + rec.candidates
             return new, rec
-        best = min(usable, key=lambda d: d.motion.t_end)  # the first to arrive
+        # The first to arrive; on a tie the shorter (a wait adds no length).
+        best = min(usable, key=lambda d: (round(d.motion.t_end, 6), d.length or 0.0))
         rec = Replan(
             t=t_now,
             kind=self.options.strategy,
@@ -261,7 +292,52 @@ class ReplanningManager:
         )
         return m, rec
 
+    def reshorten(self, t_now: float, plan: Motion, obs: Observations) -> Motion | None:
+        """The rest of ``plan`` shortcut in the static world once no collision is predicted
+        (a detour's bends are no longer needed after the obstacle has passed), or None when that
+        does not arrive earlier or would meet a sensed obstacle.
+
+        The shortcut takes effect one control period from now (the time it is computed in).
+        """
+        t_a = t_now + (self.problem.robot.sample_time or 0.1)
+        if t_a >= plan.t_end:
+            return None
+        rest = plan.waypoints_after(t_a)
+        if len(rest) < 3:
+            return None
+        short = shortcut(rest, self.world.segments_free)
+        if len(short) == len(rest):
+            return None
+        new = plan.until(t_a).then(
+            Motion.from_path(short, t_a, float(plan.heading(t_a)), self.speed, self.turn_rate)
+        )
+        if new.t_end >= plan.t_end - 1e-6:
+            return None
+        if obs and self._worst_separation(new, obs, t_now) < 0:
+            return None
+        return new
+
     # -- pieces ------------------------------------------------------------------------------------
+    def _wait(self, t_now, plan, obs, t_s, t_exit) -> Detour:
+        """The least wait at ``p_s`` (a multiple of the control period) after which driving on
+        along ``plan`` passes every sensed obstacle, verified exactly.
+
+        The search is bounded: waits up to ``2 (t_exit - t_now) + 4 s`` and at most
+        :data:`MAX_WAIT_STEPS` tries.
+        """
+        detour = Detour("wait", {"side": "wait", "valid": False, "length": 0.0, "reason": ""})
+        ts = self.problem.robot.sample_time or 0.1
+        longest = 2.0 * (t_exit - t_now) + 4.0
+        n = min(int(longest / ts), MAX_WAIT_STEPS)
+        for k in range(1, n + 1):
+            motion = plan.delayed(t_s, k * ts)
+            sep = self._worst_separation(motion, obs, t_now)
+            if sep >= 0:
+                detour.record.update(valid=True, wait=k * ts, margin_left=sep, arrival=motion.t_end)
+                detour.motion, detour.goal, detour.length = motion, None, 0.0
+                return detour
+        return detour.refuse(f"no wait of up to {n * ts:.3g} s passes every obstacle")
+
     def _fallback_options(
         self, p: np.ndarray, th: float, obs: Observations
     ) -> list[tuple[str, np.ndarray | None, float]]:
@@ -328,6 +404,7 @@ class ReplanningManager:
         if sep < 0:
             return detour.refuse("verification failed: the detour meets a predicted obstacle")
         detour.record["valid"] = True
+        detour.record["arrival"] = motion.t_end
         detour.motion, detour.goal, detour.length, detour.path = motion, goal, res.length, res.path
         return detour
 

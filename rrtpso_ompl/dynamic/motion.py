@@ -133,6 +133,17 @@ class Motion:
             np.append(self.theta[keep], self.heading(t)),
         )
 
+    def delayed(self, t: float, wait: float) -> Motion:
+        """This motion with a stop of ``wait`` seconds inserted at time ``t`` (the rest is the
+        same route, ``wait`` later)."""
+        head = self.until(t)
+        later = self.t > t
+        return Motion(
+            np.concatenate([head.t, [t + wait], self.t[later] + wait]),
+            np.vstack([head.xy, head.xy[-1:], self.xy[later]]),
+            np.concatenate([head.theta, head.theta[-1:], self.theta[later]]),
+        )
+
     def then(self, other: Motion) -> Motion:
         """This motion followed by ``other``, which must start where and when this one ends.
 

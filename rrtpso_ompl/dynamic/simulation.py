@@ -51,6 +51,9 @@ MAX_STEPS = 1_000_000
 #: plans or verifies, so this bounds the wall time of a run that can never get through.
 MAX_REPLANS = 500
 
+#: Least simulated time between two attempts to shortcut the rest of the plan, s.
+RESHORTEN_PERIOD = 1.0
+
 #: The strategies: the paper's contour detours, replanning the whole remaining path (baseline),
 #: or driving the static path blindly (baseline).
 STRATEGIES = ("contour", "global", "none")
@@ -87,19 +90,24 @@ class DynamicOptions:
         paper's constant velocity.
     heading_change_deg : float
         Standard deviation of a heading change, degrees.
+    reshorten : bool
+        ``contour`` only: while no collision is predicted, shortcut the rest of the plan in the
+        static world (at most every :data:`RESHORTEN_PERIOD` s, verified against the sensed
+        obstacles), so that a detour's bends go once the obstacle has passed.
     params : mapping
         Parameters for the planner.
     """
 
     planner: str = "RRTstarPSO"
     strategy: str = "contour"
-    replan_time: float = 0.5
+    replan_time: float = 0.1
     initial_time: float | None = None
     margin: float | None = None
     stretch: float = 2.0
     max_time: float | None = None
     heading_changes: float = 0.0
     heading_change_deg: float = 45.0
+    reshorten: bool = True
     params: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -303,11 +311,13 @@ def _drive(plan, tracks, robot, manager, options, margin, t_max, world_rng, prog
     plans = [(0.0, plan)]
     replans: list[Replan] = []
     busy_until = -math.inf
+    last_short = -math.inf
     change_p = options.heading_changes * robot.sample_time
     t = 0.0
     k = 0
     while t < plan.t_end - 1e-9 and t <= t_max and len(replans) < MAX_REPLANS:
         obs = _sense(plan.position(t), tracks, t, robot.sensor_range)
+        threats = []
         if obs and options.strategy != "none":
             threats = predict_threats(plan, t, obs, robot.radius, 0.5 * margin)
             rec = None
@@ -319,6 +329,19 @@ def _drive(plan, tracks, robot, manager, options, margin, t_max, world_rng, prog
                 plan, rec = manager.fallback(t, plan, obs, threats, t)
             if rec is not None:
                 replans.append(rec)
+                plans.append((t, plan))
+        if (
+            not threats
+            and options.reshorten
+            and options.strategy == "contour"
+            and len(plans) > 1
+            and t - last_short >= RESHORTEN_PERIOD
+        ):
+            # No collision predicted: the bends of an earlier detour may no longer be needed.
+            last_short = t
+            shorter = manager.reshorten(t, plan, obs)
+            if shorter is not None:
+                plan = shorter
                 plans.append((t, plan))
         k += 1
         t = k * robot.sample_time

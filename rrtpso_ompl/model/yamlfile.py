@@ -60,6 +60,9 @@ def read_yaml_file(path: str | Path) -> Any:
     try:
         return load_yaml(text)
     except yaml.YAMLError as exc:
+        if "maximum nesting depth" in str(getattr(exc, "problem", "")):
+            # libyaml (PyYAML >= 6.0.3 wheels) has a nesting limit of its own, met before ours.
+            exc.problem = f"lists or mappings nested too deeply (more than {MAX_DEPTH} levels)"
         raise ProblemError(source, "", f"malformed YAML{_yaml_message(exc)}") from None
     except RecursionError:
         raise ProblemError(

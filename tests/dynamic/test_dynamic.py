@@ -9,45 +9,20 @@ import subprocess
 
 import numpy as np
 import pytest
-from helpers import PROBLEMS, rrtpso_exe
+from helpers import PROBLEMS, corridor, manager_for, observe, rrtpso_exe
 
 from rrtpso_ompl.dynamic import (
     DynamicOptions,
     Motion,
     ObstacleTrack,
-    ReplanningManager,
     capsule,
     closest_approach,
     first_entry,
     predict_threats,
     simulate,
 )
-from rrtpso_ompl.model.problem import MovingObstacle, load_problem, problem_from_dict
+from rrtpso_ompl.model.problem import MovingObstacle, load_problem
 from rrtpso_ompl.model.world import World
-
-ROBOT = {
-    "radius": 28.5,
-    "wheel_radius": 7.6,
-    "track_width": 38,
-    "speed": 20,
-    "sample_time": 0.15,
-    "sensor_range": 150,
-}
-
-
-def corridor(moving, obstacles=()):
-    """A 500 x 500 cm world, route along y = 250."""
-    return problem_from_dict(
-        {
-            "name": "corridor",
-            "bounds": [[0, 0], [500, 500]],
-            "start": [30, 250],
-            "goal": [470, 250],
-            "robot": ROBOT,
-            "obstacles": list(obstacles),
-            "moving_obstacles": moving,
-        }
-    )
 
 
 def const(pos, vel):
@@ -165,25 +140,13 @@ def test_capsule_is_the_exact_sweep_of_a_disc():
 # ----------------------------------------------------------------------------------------------
 # The manager: choice of side, splicing, fallbacks
 # ----------------------------------------------------------------------------------------------
-def manager_for(problem, seed=0, **kw):
-    opts = DynamicOptions(replan_time=0.6, **kw)
-    speed, turn = problem.robot.speed, 2 * problem.robot.speed / problem.robot.track_width
-    return ReplanningManager(problem, opts, speed, turn, 5.7, np.random.default_rng(seed)), turn
-
-
-def observe(problem, t):
-    out = {}
-    for j, m in enumerate(problem.moving_obstacles):
-        out[j] = (m.position(t), m.velocity, m.radius)
-    return out
-
-
 def test_side_choice_avoids_the_blocked_side_and_splices_continuously():
     # A block above the route leaves no room to pass the rising obstacle in front ("up", on the
-    # robot's left); only "down" (behind it) exists.
+    # robot's left); only "down" (behind it) exists. The obstacle is slow, so waiting for it to
+    # pass arrives later than the detour behind it.
     block = {"type": "rectangle", "min": [150, 285], "max": [350, 500]}
     problem = corridor(
-        [{"radius": 28.5, "start": [250, 60], "speed": 20, "heading_deg": 90}], [block]
+        [{"radius": 28.5, "start": [250, 180], "speed": 6, "heading_deg": 90}], [block]
     )
     manager, turn = manager_for(problem)
     plan = Motion.from_path(np.array([problem.start, problem.goal]), 0.0, None, 20.0, turn)
@@ -193,8 +156,9 @@ def test_side_choice_avoids_the_blocked_side_and_splices_continuously():
     assert threats, "the crossing must be predicted"
     new, rec = manager.react(t_now, plan, obs, threats)
     assert rec.kind == "contour" and rec.side == "down"
-    up = next(c for c in rec.candidates if c.get("side") == "up")
-    assert not up["valid"]
+    sides = {c["side"]: c for c in rec.candidates}
+    assert not sides["up"]["valid"]
+    assert sides["wait"]["valid"] and sides["wait"]["arrival"] > sides["down"]["arrival"]
     # Splice: identical before the detour starts, continuous at its start, statically valid.
     t_s = t_now + 0.6
     ts = np.linspace(0, t_s, 50)
@@ -213,7 +177,7 @@ def test_side_choice_avoids_the_blocked_side_and_splices_continuously():
 
 def test_detour_downwards_when_the_obstacle_comes_from_above():
     problem = corridor(
-        [{"radius": 28.5, "start": [250, 440], "speed": 20, "heading_deg": -90}],
+        [{"radius": 28.5, "start": [250, 320], "speed": 6, "heading_deg": -90}],
         [{"type": "rectangle", "min": [150, 0], "max": [350, 215]}],
     )
     manager, turn = manager_for(problem, seed=1)
