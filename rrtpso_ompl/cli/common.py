@@ -88,13 +88,16 @@ class PlannerChoice:
     params : dict
         The file's ``planner.params`` under the ``--param`` values, checked against the planner.
     cli_params : dict
-        The ``--param`` values alone (as text).
+        The ``--param`` values alone (as text), the post-passes' included.
+    post : tuple of str
+        The post-passes after the planner: the spec's (``BITstar+pso``), then ``--post``'s.
     """
 
     problem: Problem
     entry: Any
     params: dict[str, Any]
     cli_params: dict[str, str]
+    post: tuple[str, ...] = ()
 
 
 def choose_planner(args: argparse.Namespace) -> PlannerChoice:
@@ -109,6 +112,7 @@ def choose_planner(args: argparse.Namespace) -> PlannerChoice:
         (``--planner``, ``planner.type``, ``--param NAME``, ``planner.params.NAME``).
     """
     from ..planners import DEFAULT_PLANNER, default_registry
+    from ..planners.post import split_params, split_spec
 
     if args.planner is not None and not args.planner.strip():
         raise UsageError("--planner: give a planner name (see 'rrtpso planners')")
@@ -119,20 +123,45 @@ def choose_planner(args: argparse.Namespace) -> PlannerChoice:
         "--planner" if args.planner else ("planner.type" if problem.planner.type else "planner")
     )
     try:
-        entry = default_registry().get(name)
+        base, steps = split_spec(name)
+        steps = (*steps, *post_steps(args, src))
+        entry = default_registry().get(base)
     except UnknownPlannerError as exc:
         raise UsageError(f"{src}: {origin}: {exc}") from None
+    except ParameterError as exc:
+        raise UsageError(f"{src}: {origin}: {exc}") from None
     cli_params = parse_params(args.param, src)
+    try:
+        _, post_params = split_params(entry, cli_params, steps)
+    except ParameterError as exc:
+        raise UsageError(f"{src}: --param {exc.name}: {exc}") from None
     for key, value in problem.planner.params.items():
         _check_param(entry, key, value, f"{src}: planner.params.{key}")
     for key, value in cli_params.items():
-        _check_param(entry, key, value, f"{src}: --param {key}")
-    params = {**problem.planner.params, **cli_params}
+        if key not in post_params:
+            _check_param(entry, key, value, f"{src}: --param {key}")
+    params = {**problem.planner.params, **{k: v for k, v in cli_params.items()
+                                           if k not in post_params}}  # fmt: skip
     try:
         entry.validate(params)  # the rules over several parameters (c1 + c2 < 4)
     except ParameterError as exc:
         raise UsageError(f"{src}: planner parameters: {exc}") from None
-    return PlannerChoice(problem, entry, params, cli_params)
+    return PlannerChoice(problem, entry, params, cli_params, tuple(dict.fromkeys(steps)))
+
+
+def post_steps(args: argparse.Namespace, src: str = "") -> tuple[str, ...]:
+    """``--post STEPS`` (a comma list) and ``--simplify`` (its alias for ``simplify``), checked:
+    an unknown step is a usage error that names the known ones."""
+    from ..planners.post import parse_steps
+
+    text = getattr(args, "post", None)
+    steps = [s for s in (text.split(",") if text else []) if s.strip()]
+    if getattr(args, "simplify", False) and "simplify" not in steps:
+        steps.insert(0, "simplify")
+    try:
+        return parse_steps(steps, "--post")
+    except ParameterError as exc:
+        raise UsageError(f"{src}: --post: {exc}" if src else f"--post: {exc}") from None
 
 
 def parse_params(items: list[str], src: str) -> dict[str, str]:
@@ -367,17 +396,26 @@ def check_planners(names: list[str], items: list[str], flag: str) -> dict[str, d
 
     A ``--param`` applies to the planners that have it; one that none of them has is an error.
     """
-    from ..planners import default_registry
+    from ..planners import ParamTable, PathOptimizerOptions, default_registry
+    from ..planners.post import POST_PARAMS, split_spec
 
     registry = default_registry()
     params = parse_params(items, flag)
     out = {}
     for name in names:
         try:
-            entry = registry.get(name)
-        except UnknownPlannerError as exc:
+            base, steps = split_spec(name)
+            entry = registry.get(base)
+        except (UnknownPlannerError, ParameterError) as exc:
             raise UsageError(f"{flag}: {exc}") from None
-        mine = {k: v for k, v in params.items() if entry.takes(k)}
+        post = POST_PARAMS + PathOptimizerOptions.PARAMS if steps else ParamTable()
+        for key in params:
+            if key in post and not entry.takes(key):
+                try:
+                    post[key].convert(params[key], "post-pass")
+                except ParameterError as exc:
+                    raise UsageError(f"--param {key}: {exc}") from None
+        mine = {k: v for k, v in params.items() if entry.takes(k) or k in post}
         for key, value in mine.items():
             _check_param(entry, key, value, f"--param {key}")
         out[name] = mine

@@ -63,9 +63,16 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         help="header.frame_id of --path-out (default: map)",
     )
     p.add_argument(
+        "--post",
+        metavar="STEPS",
+        help="post-passes after the planner, in order, within the same --time: a comma list of "
+        "simplify (OMPL's simplifier) and pso (the swarm); they get post_fraction of the time "
+        "(--param post_fraction=0.2); the planner name may carry them too (BITstar+simplify+pso)",
+    )
+    p.add_argument(
         "--simplify",
         action="store_true",
-        help="run OMPL's path simplifier on the result within the time limit",
+        help="alias of --post simplify (before any other --post step)",
     )
     p.add_argument(
         "--trajectory",
@@ -111,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
     from ..planners import solve
 
     result = solve(
-        problem, choice.entry.name, args.time, args.seed, choice.cli_params, simplify=args.simplify
+        problem, choice.entry.name, args.time, args.seed, choice.cli_params, post=choice.post
     )
     motion = _drive(problem, result, args.profile) if wants_motion and result.solved else None
     _write_outputs(args, problem, result, motion)

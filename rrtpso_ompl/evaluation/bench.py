@@ -20,6 +20,10 @@ here knows a planner by name.
 - Planners whose registry entry asks for it (OMPL's own) are followed by OMPL's path simplifier,
   as in OMPL's ``Benchmark``: ``time`` is the planner's, ``solution length`` its raw path,
   ``simplified solution length`` the simplified one, ``simplification time`` the simplifier's.
+- A planner spec with post-passes (``BITstar+simplify+pso``, :mod:`rrtpso_ompl.planners.post`) is
+  a configuration of its own: ``solution length`` is the planner's path, ``simplified solution
+  length`` the path after its post-passes and ``simplification time`` their time (all within the
+  one budget), so Planner Arena shows the gain per planner.
 - For RRTstarPSO the RRT* stage is the planner and the swarm the simplifier: ``simplification
   time`` is the PSO's time, ``time`` the rest of the solve (the RRT* stage and OMPL's simplifier,
   when on), so ``time + simplification time`` is the whole solve, within the budget;
@@ -78,10 +82,13 @@ PROGRESS_PROPERTIES: list[tuple[str, str]] = [("time", "REAL"), ("best cost", "R
 
 
 def _simplified_in_benchmarks(planner: str) -> bool:
-    """Whether benchmarks follow ``planner`` with OMPL's simplifier (its registry entry says)."""
+    """Whether benchmarks follow ``planner`` with OMPL's simplifier (its registry entry says); a
+    spec with post-passes (``BITstar+simplify+pso``) says itself what follows the planner."""
+    from ..planners.post import split_spec
     from ..planners.registry import default_registry
 
-    return default_registry().get(planner).capabilities.simplify_in_benchmark
+    name, steps = split_spec(planner)
+    return not steps and default_registry().get(name).capabilities.simplify_in_benchmark
 
 
 def bench_tasks(

@@ -3,8 +3,9 @@
 1. OMPL's C++ ``og.RRTstar`` shares this planner's ProblemDefinition and grows its tree for
    ``rrt_time_fraction`` of the time budget (always also stopped by the outer termination
    condition). Its best path's waypoints are the paper's "candidate nodes".
-2. :func:`rrtpso_ompl.planners.optimize_path` shortens (and optionally smooths) them with the
-   PSO of eqs. 4-5, checking every candidate segment exactly.
+2. :class:`rrtpso_ompl.planners.PSOPathOptimizer` (the post-pass any planner gets with
+   ``+pso``) shortens (and optionally smooths) them with the PSO of eqs. 4-5, checking every
+   candidate segment exactly.
 3. The result replaces RRT*'s path in the ProblemDefinition (``clearSolutionPaths`` then
    ``addSolutionPath``), so ``ss.getSolutionPath()`` returns it like any planner's path.
 
@@ -34,7 +35,8 @@ from ..ompl_setup import array_to_path, path_to_array
 from .base import BUDGET, SEED, PlannerStats, PythonPlanner, collision_model_for
 from .ompl_planners import RRTSTAR_PARAMS
 from .params import ParamSpec, ParamTable
-from .path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions, optimize_path
+from .path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
+from .post import PSOPathOptimizer
 from .result import BenchmarkRun
 from .swarm import SWARM_PARAMS
 
@@ -296,9 +298,11 @@ class RRTstarPSO(PythonPlanner):
             def terminate() -> bool:
                 return ptc() or time.perf_counter() >= deadline
 
-        model = collision_model_for(self.getSpaceInformation())
+        # The same post-pass any planner gets with "+pso" (one optimiser, not two).
+        si = self.getSpaceInformation()
         options = PathOptimizerOptions.from_values(self._values)
-        result = optimize_path(xy, model, options, self._rng(), terminate)
+        optimizer = PSOPathOptimizer(si, options, collision_model_for(si), self._rng())
+        result = optimizer.optimize_array(xy, terminate)
         # Summed over the swarm runs of one solve (one, unless the anytime loop ran more).
         stats.pso_time += result.time
         stats.pso_iterations += result.n_iterations

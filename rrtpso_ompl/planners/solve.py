@@ -8,9 +8,10 @@ dynamic replanner and the tests all go through here, so every planner is measure
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,6 +23,7 @@ from ..model.problem import Problem
 from ..model.world import World
 from ..ompl_setup import PlanningContext, make_context, path_to_array, seed_ompl
 from ..validation import check_seconds, check_seed
+from .post import POST_PARAMS, PostStep, parse_steps, run_post, split_params, split_spec
 from .registry import PlannerEntry, PlannerRegistry, default_registry
 from .result import BenchmarkRun, SolveResult
 
@@ -117,6 +119,7 @@ def solve(
     seed: int | None = None,
     params: Mapping[str, Any] | None = None,
     *,
+    post: Sequence[str] = (),
     simplify: bool = False,
     progress: bool = False,
     registry: PlannerRegistry | None = None,
@@ -130,6 +133,7 @@ def solve(
         A validated problem.
     planner : str, optional
         Registered planner name or alias; the problem's ``planner.type``, else ``"RRTstarPSO"``.
+        A spec such as ``"BITstar+simplify+pso"`` adds post-passes (see ``post``).
     time_limit : float, optional
         Seconds; the problem's ``planner.time_limit``, else 1.0.
     seed : int, optional
@@ -137,9 +141,16 @@ def solve(
         numpy generators; the problem's ``planner.seed`` when omitted.
     params : mapping, optional
         Planner parameters by name, on top of the problem's ``planner.params``.
+    post : sequence of str
+        Post-passes after the planner, in order, within the same budget: ``"simplify"`` (OMPL's
+        simplifier) and ``"pso"`` (:class:`~rrtpso_ompl.planners.post.PSOPathOptimizer`), after
+        those of the spec. The planner then gets ``1 - post_fraction`` of the time
+        (:data:`~rrtpso_ompl.planners.post.POST_PARAMS`, settable in ``params``); each step's
+        lengths and time are in ``stages["post"]``.
     simplify : bool
         Run OMPL's path simplifier on an exact result, as OMPL's Benchmark does: after the
         planner's budget, with its time reported separately (``stages["simplification_time"]``).
+        Ignored when there are post-passes (they say what follows the planner).
     progress : bool
         Sample the best cost over time (``result.benchmark.progress``), as OMPL's Benchmark does.
     registry : PlannerRegistry, optional
@@ -158,20 +169,31 @@ def solve(
     UnknownPlannerError, ParameterError
         For an unknown planner, parameter name or value (before anything is planned).
     """
-    request = resolve_request(problem, planner, time_limit, seed, params, registry)
+    name, spec_steps = split_spec(planner) if planner else (None, ())
+    steps = tuple(dict.fromkeys((*spec_steps, *parse_steps(post))))
+    registry = registry or default_registry()
+    entry = registry.get(name or problem.planner.type or DEFAULT_PLANNER)
+    params, post_values = split_params(entry, params or {}, steps)
+    request = resolve_request(problem, name, time_limit, seed, params, registry)
+    planner_limit = request.time_limit
+    if steps:
+        fraction = post_values.get("post_fraction", POST_PARAMS["post_fraction"].default)
+        planner_limit = request.time_limit * (1.0 - fraction)
+        if request.entry.takes("budget") and "budget" not in params:
+            request.values["budget"] = planner_limit
     seed_ompl(request.seed)
     ctx = make_context(problem, world)
     instance = request.entry.make(ctx.si, request.values)
     ctx.ss.setPlanner(instance)
     ctx.ss.setup()
 
-    sampler = _ProgressSampler(instance, request) if progress else None
+    sampler = _ProgressSampler(instance, planner_limit, request) if progress else None
     t0 = time.perf_counter()
     if sampler is not None and sampler.polls:
         sampler.t0 = t0
         status = ctx.ss.solve(ob.PlannerTerminationCondition(sampler))
     else:
-        status = ctx.ss.solve(ob.timedPlannerTerminationCondition(request.time_limit))
+        status = ctx.ss.solve(ob.timedPlannerTerminationCondition(planner_limit))
     elapsed = time.perf_counter() - t0
     code = status.getStatus()
 
@@ -180,7 +202,14 @@ def solve(
     stats = request.entry.collect_stats(instance)
     stages = stats.to_dict()
     run = stats.benchmark_run(elapsed, _length(raw))
-    if simplify and ctx.ss.haveExactSolutionPath():
+    spent = elapsed
+    if steps and ctx.ss.haveExactSolutionPath():
+        done = run_post(ctx.si, pdef.getSolutionPath(), steps, t0 + request.time_limit,
+                        post_values)  # fmt: skip
+        run = _with_post(run, done)
+        spent += sum(d.time for d in done)
+        stages["post"] = [d.to_dict() for d in done]
+    elif simplify and ctx.ss.haveExactSolutionPath():
         run, simplification = _simplify(ctx, run, raw)
         stages.update(simplification)
     path, label, valid = _checked_path(ctx, pdef, code)
@@ -191,12 +220,14 @@ def solve(
         run = _with_progress(run, sampler.rows(), elapsed, final)
     return SolveResult(
         problem=problem.name,
-        planner=request.entry.name,
+        # The planner as asked: a spec keeps its post-passes in the name (a configuration of its
+        # own in benchmarks); those of ``post`` are in ``stages["post"]`` only.
+        planner=request.entry.name + "".join(f"+{step}" for step in spec_steps),
         status=label,
         ompl_status=str(status),
         solved=label == "exact",
         length=_length(path),
-        time=elapsed,
+        time=spent,
         seed=request.seed,
         path=path,
         time_limit=request.time_limit,
@@ -241,6 +272,17 @@ def _simplify(
         "unsimplified_valid": bool(ctx.world.path_valid(raw)),
     }
     return run, stages
+
+
+def _with_post(run: BenchmarkRun, done: list[PostStep]) -> BenchmarkRun:
+    """The run with the post-passes as OMPL's simplification: their time after the planner's
+    own simplification stage, and the length they left."""
+    own = run.simplification_time or 0.0
+    return dataclasses.replace(
+        run,
+        simplification_time=own + sum(d.time for d in done),
+        simplified_length=done[-1].length_after if done else run.simplified_length,
+    )
 
 
 def _checked_path(ctx: PlanningContext, pdef: Any, code: Any) -> tuple[np.ndarray, str, bool]:
@@ -288,8 +330,8 @@ class _ProgressSampler:
     progress, if any.
     """
 
-    def __init__(self, planner: Any, request: PlannerRequest) -> None:
-        self.time_limit = request.time_limit
+    def __init__(self, planner: Any, time_limit: float, request: PlannerRequest) -> None:
+        self.time_limit = time_limit
         self.t0 = time.perf_counter()
         self._next = PROGRESS_PERIOD
         #: Whether to poll this condition.

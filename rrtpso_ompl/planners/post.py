@@ -1,0 +1,234 @@
+"""Post-passes after any planner: OMPL's simplifier and the swarm as an OMPL path optimiser.
+
+:class:`PSOPathOptimizer` is shaped like OMPL's ``og.PathSimplifier``: it is made from a
+``SpaceInformation`` (and the swarm's declared parameters) and ``optimize(path, ptc_or_seconds)``
+improves an ``og.PathGeometric`` in place, returning whether it changed it. It never makes a path
+longer or invalid. It checks candidates through the space information's own validity checker and
+motion validator (:class:`~rrtpso_ompl.planners.base.SpaceInformationCollisionModel`), so it
+works in any OMPL setup; when the setup is ours (the validity checker carries a
+:class:`~rrtpso_ompl.model.World`), it uses the exact vectorised world instead.
+
+A *planner spec* names a planner and the post-passes that follow it, in order:
+``"BITstar+simplify+pso"``. :func:`run_post` runs such steps on a solution path within a deadline;
+:func:`~rrtpso_ompl.planners.solve` gives them :data:`POST_PARAMS`' ``post_fraction`` of the
+time budget.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from ..errors import ParameterError
+from ..ompl_setup import path_to_array
+from .base import collision_model_for
+from .params import ParamSpec, ParamTable
+from .path_optimizer import PathOptimizationResult, PathOptimizerOptions, optimize_path
+
+__all__ = [
+    "POST_PARAMS",
+    "POST_STEPS",
+    "PSOPathOptimizer",
+    "PostStep",
+    "parse_steps",
+    "run_post",
+    "split_params",
+    "split_spec",
+]
+
+#: The post-passes, in the order a spec may name them: OMPL's simplifier and the swarm.
+POST_STEPS = ("simplify", "pso")
+
+#: The harness's parameters of the post-passes.
+POST_PARAMS = ParamTable(
+    ParamSpec("post_fraction", float, 0.2,
+              "Share of the time budget kept for the post-passes after the planner (the planner "
+              "gets the rest); only used when post-passes are asked for.", low=0.0, high=0.9),
+    ParamSpec("simplify_share", float, 0.5,
+              "Most of the post-pass time OMPL's simplifier may take when the swarm follows it.",
+              low=0.0, high=1.0),
+)  # fmt: skip
+
+
+def parse_steps(items: Iterable[str], where: str = "post") -> tuple[str, ...]:
+    """Post-pass names, checked; ParameterError naming the known ones otherwise."""
+    steps = tuple(s.strip() for s in items)
+    for step in steps:
+        if step not in POST_STEPS:
+            known = ", ".join(POST_STEPS)
+            raise ParameterError(f"unknown post-pass {step!r} (known: {known})", where)
+    return steps
+
+
+def split_spec(spec: str) -> tuple[str, tuple[str, ...]]:
+    """``"BITstar+simplify+pso"`` -> ``("BITstar", ("simplify", "pso"))``; steps checked."""
+    name, *steps = spec.split("+")
+    return name.strip(), parse_steps(steps, f"planner {spec!r}")
+
+
+def split_params(
+    entry: Any, params: Mapping[str, Any], steps: tuple[str, ...]
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """``(planner's, post-passes')`` parameters: with post-passes, a parameter the planner does
+    not take goes to them when they declare it (:data:`POST_PARAMS`, the swarm's and the path
+    optimiser's), converted and checked; anything else stays with the planner (whose own check
+    then names it)."""
+    if not steps:
+        return dict(params), {}
+    table = POST_PARAMS + PathOptimizerOptions.PARAMS
+    mine: dict[str, Any] = {}
+    post: dict[str, Any] = {}
+    for key, value in params.items():
+        if key in table and not entry.takes(key):
+            post[key] = table[key].convert(value, "post-pass")
+        else:
+            mine[key] = value
+    return mine, post
+
+
+@dataclass(frozen=True)
+class PostStep:
+    """One post-pass on one path: lengths before and after (units) and its time (s)."""
+
+    step: str
+    length_before: float
+    length_after: float
+    time: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"step": self.step, "length_before": self.length_before,
+                "length_after": self.length_after, "time": self.time}  # fmt: skip
+
+
+class PSOPathOptimizer:
+    """The particle swarm (paper eqs. 4-5) as an OMPL path optimiser, like ``og.PathSimplifier``.
+
+    Parameters
+    ----------
+    si : ompl.base.SpaceInformation
+        A 2-D real vector space with the user's validity checker (and motion validator).
+    options : PathOptimizerOptions, optional
+        The swarm's and the optimiser's parameters (defaults when omitted); or pass them by name
+        in ``params``.
+    world : World, optional
+        An exact collision model to use instead of the space information's checks (found on the
+        validity checker when the setup is ours).
+    rng : numpy.random.Generator, optional
+        Drawn from OMPL's RNG when omitted, so ``ompl.util.RNG.setSeed`` makes runs reproducible.
+    **params
+        Parameters by name (``swarm_size=40, ...``), as :data:`PathOptimizerOptions` declares.
+
+    Examples
+    --------
+    >>> optimizer = PSOPathOptimizer(ss.getSpaceInformation())      # doctest: +SKIP
+    >>> optimizer.optimize(ss.getSolutionPath(), 0.2)                # doctest: +SKIP
+    True
+    """
+
+    def __init__(
+        self,
+        si: ob.SpaceInformation,
+        options: PathOptimizerOptions | None = None,
+        world: Any = None,
+        rng: np.random.Generator | None = None,
+        **params: Any,
+    ) -> None:
+        if options is not None and params:
+            raise TypeError("give the options or parameters by name, not both")
+        unknown = [k for k in params if k not in PathOptimizerOptions.PARAMS]
+        if unknown:
+            raise ParameterError(f"PSOPathOptimizer has no parameter {unknown[0]!r}", unknown[0])
+        self.si = si
+        self.options = options or PathOptimizerOptions.from_values(params)
+        self.model = world if world is not None else collision_model_for(si)
+        if rng is None:
+            rng = np.random.default_rng(ou.RNG().uniformInt(0, 2**31 - 2))
+        self.rng = rng
+        #: The :class:`PathOptimizationResult` of the last call.
+        self.last_result: PathOptimizationResult | None = None
+
+    def optimize(self, path: og.PathGeometric, ptc_or_seconds: Any = None) -> bool:
+        """Shorten ``path`` in place; True when it changed it (then shorter and valid).
+
+        Parameters
+        ----------
+        path : og.PathGeometric
+        ptc_or_seconds : ob.PlannerTerminationCondition, float or None
+            When to stop: a termination condition, a time in seconds, or None (the swarm's
+            iteration and round limits only).
+        """
+        result = self.optimize_array(path_to_array(path), _terminator(ptc_or_seconds))
+        if not result.improved:
+            return False
+        _assign(self.si, path, result.path)
+        return True
+
+    def optimize_array(
+        self, xy: np.ndarray, terminate: Callable[[], bool] | None = None
+    ) -> PathOptimizationResult:
+        """The same on an ``(n, 2)`` array of waypoints; the input is never modified."""
+        self.last_result = optimize_path(xy, self.model, self.options, self.rng, terminate)
+        return self.last_result
+
+
+def run_post(
+    si: ob.SpaceInformation,
+    path: og.PathGeometric,
+    steps: Iterable[str],
+    deadline: float,
+    values: Mapping[str, Any] | None = None,
+    world: Any = None,
+    rng: np.random.Generator | None = None,
+) -> list[PostStep]:
+    """Run the post-passes ``steps`` on ``path`` in place, in order, until ``deadline``
+    (``time.perf_counter()`` seconds).
+
+    OMPL's simplifier gets at most ``simplify_share`` of what is left when the swarm follows it;
+    the swarm gets the rest. ``values`` holds the swarm's and :data:`POST_PARAMS`' parameters by
+    name (defaults for the missing ones).
+    """
+    steps = tuple(steps)
+    values = dict(values or {})
+    post = POST_PARAMS.defaults() | {k: v for k, v in values.items() if k in POST_PARAMS}
+    out: list[PostStep] = []
+    for i, step in enumerate(steps):
+        t0 = time.perf_counter()
+        before = float(path.length())
+        left = max(deadline - t0, 0.0)
+        if step == "simplify":
+            share = post["simplify_share"] if "pso" in steps[i + 1 :] else 1.0
+            if left > 0:
+                og.PathSimplifier(si).simplify(path, max(share * left, 1e-4))
+        else:
+            optimizer = PSOPathOptimizer(si, PathOptimizerOptions.from_values(values), world, rng)
+            optimizer.optimize(path, left if left > 0 else 0.0)
+        out.append(PostStep(step, before, float(path.length()), time.perf_counter() - t0))
+    return out
+
+
+def _terminator(ptc_or_seconds: Any) -> Callable[[], bool] | None:
+    """A zero-argument stop test from a termination condition or a number of seconds."""
+    if ptc_or_seconds is None:
+        return None
+    if isinstance(ptc_or_seconds, int | float):
+        deadline = time.perf_counter() + float(ptc_or_seconds)
+        return lambda: time.perf_counter() >= deadline
+    ptc = ptc_or_seconds
+    return lambda: bool(ptc())
+
+
+def _assign(si: ob.SpaceInformation, path: og.PathGeometric, xy: np.ndarray) -> None:
+    """Replace the states of ``path`` by the waypoints ``xy`` (in place: the caller's object,
+    e.g. the problem definition's solution path, changes)."""
+    path.clear()
+    state = si.allocState()  # owned by Python; append copies it
+    for x, y in np.asarray(xy, dtype=float):
+        state[0], state[1] = float(x), float(y)
+        path.append(state)

@@ -1,0 +1,203 @@
+"""The swarm as a post-pass for every planner (issue 15): PSOPathOptimizer, planner specs such as
+``BITstar+simplify+pso``, ``rrtpso solve --post`` and the OMPL log of ``rrtpso bench``."""
+
+from __future__ import annotations
+
+import json
+import math
+import sqlite3
+import subprocess
+
+import numpy as np
+import pytest
+from helpers import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
+from ompl import base as ob
+from ompl import geometric as og
+
+from rrtpso_ompl.errors import ParameterError
+from rrtpso_ompl.model import World, load_problem
+from rrtpso_ompl.model.problem import problem_from_dict
+from rrtpso_ompl.ompl_setup import array_to_path, make_context, path_to_array
+from rrtpso_ompl.planners import (
+    POST_STEPS,
+    PSOPathOptimizer,
+    default_registry,
+    solve,
+    split_spec,
+)
+from rrtpso_ompl.planners.base import SpaceInformationCollisionModel
+
+
+def test_specs_name_a_planner_and_its_post_passes():
+    assert split_spec("BITstar") == ("BITstar", ())
+    assert split_spec("PRMstar+simplify+pso") == ("PRMstar", ("simplify", "pso"))
+    with pytest.raises(ParameterError, match="known: simplify, pso"):
+        split_spec("RRT+smooth")
+    assert POST_STEPS == ("simplify", "pso")
+
+
+@pytest.mark.parametrize("name", default_registry().names())
+def test_the_post_pass_never_lengthens_or_invalidates_for_any_planner(name):
+    """The contract, for every registered planner: each step leaves the path no longer than it
+    found it, and the final path is valid (exact check) and no longer than the planner's."""
+    problem = problem_from_dict(SINGLE_CIRCLE)
+    result = solve(problem, f"{name}+simplify+pso", 0.3, 5)
+    assert result.planner == f"{name}+simplify+pso"
+    if not result.solved:
+        pytest.skip(f"{name} found no path in 0.24 s")
+    steps = result.stages["post"]
+    assert [s["step"] for s in steps] == ["simplify", "pso"]
+    for s in steps:
+        assert s["length_after"] <= s["length_before"] + 1e-9
+    assert steps[1]["length_before"] == pytest.approx(steps[0]["length_after"])
+    assert result.length == pytest.approx(steps[-1]["length_after"])
+    assert World.from_problem(problem).path_valid(result.path)
+    run = result.benchmark
+    assert run.simplified_length == pytest.approx(result.length)
+    assert run.simplified_length <= run.solution_length + 1e-9
+    assert run.simplification_time >= steps[0]["time"] + steps[1]["time"] - 1e-9
+
+
+def test_a_path_through_a_narrow_gap_stays_in_its_gap():
+    # wall_gap: a point robot, a gap 1 unit wide at y = 9.5..10.5 in a wall at x = -5..5. A path
+    # through the gap must still cross x = 0 inside it after the swarm (not jump the wall).
+    problem = load_problem(PROBLEMS / "static" / "wall_gap.yaml")
+    world = World.from_problem(problem)
+    ctx = make_context(problem, world)
+    route = np.array([[-20, 0], [-8, 9.0], [-5, 10.0], [5, 10.0], [8, 9.0], [20, 0]], float)
+    assert world.path_valid(route)
+    path = array_to_path(ctx.si, route)
+    optimizer = PSOPathOptimizer(ctx.si, rng=np.random.default_rng(3))
+    assert optimizer.model is world  # our setup: the exact vectorised world
+    assert optimizer.optimize(path, 0.3)
+    out = path_to_array(path)
+    assert world.path_valid(out)
+    assert optimizer.last_result.length < optimizer.last_result.input_length
+    crossing = [a + (b - a) * (0 - a[0]) / (b[0] - a[0])
+                for a, b in zip(out[:-1], out[1:], strict=True) if (a[0] - 0) * (b[0] - 0) < 0]  # fmt: skip
+    assert len(crossing) == 1 and 9.5 <= crossing[0][1] <= 10.5
+    assert optimizer.last_result.length >= 45.51 - 1e-6  # never below the exact optimum
+
+
+def foreign_setup():
+    """test_optimal_planning's world in a plain SimpleSetup with the user's own checker."""
+    space = ob.RealVectorStateSpace(2)
+    space.setBounds(0.0, 1.0)
+    ss = og.SimpleSetup(space)
+    calls = {"n": 0}
+
+    def valid(s) -> bool:
+        calls["n"] += 1
+        return not (0.3 < s[0] < 0.7 and 0.3 < s[1] < 0.7)
+
+    ss.setStateValidityChecker(valid)
+    start, goal = space.allocState(), space.allocState()
+    start[0], start[1], goal[0], goal[1] = 0.1, 0.1, 0.9, 0.9
+    ss.setStartAndGoalStates(start, goal, 1e-9)
+    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(ss.getSpaceInformation()))
+    return ss, valid, calls
+
+
+def test_a_foreign_validity_checker_is_honoured():
+    ss, valid, calls = foreign_setup()
+    ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
+    assert ss.solve(0.5).getStatus() == ob.PlannerStatus.EXACT_SOLUTION
+    path = ss.getSolutionPath()
+    before = path.length()
+    si = ss.getSpaceInformation()
+    optimizer = PSOPathOptimizer(si, swarm_size=20, rng=np.random.default_rng(1))
+    assert isinstance(optimizer.model, SpaceInformationCollisionModel)
+    n0 = calls["n"]
+    changed = optimizer.optimize(path, 0.3)
+    assert calls["n"] > n0  # candidates went through the user's checker
+    assert changed and path.length() < before
+    # Valid under the user's own checks, segment by segment.
+    states = path.getStates()
+    assert all(si.checkMotion(a, b) for a, b in zip(states[:-1], states[1:], strict=True))
+    assert all(valid(s) for s in states)
+    # Not below the true optimum around the square (1.26491 = 2 * |(0.1, 0.1) - (0.3, 0.7)|).
+    assert path.length() >= 2 * math.hypot(0.2, 0.6) - 0.01
+
+
+def test_nothing_to_gain_leaves_the_path_alone():
+    ss, _, _ = foreign_setup()
+    si = ss.getSpaceInformation()
+    straight = array_to_path(si, np.array([[0.1, 0.1], [0.1, 0.9]]))
+    assert not PSOPathOptimizer(si, rng=np.random.default_rng(0)).optimize(straight, 0.1)
+    assert path_to_array(straight).tolist() == [[0.1, 0.1], [0.1, 0.9]]
+    with pytest.raises(ParameterError, match="swarm_sizes"):
+        PSOPathOptimizer(si, swarm_sizes=3)
+
+
+def test_rrtstarpso_and_the_post_pass_share_one_optimiser(monkeypatch):
+    from rrtpso_ompl.planners import post
+
+    made = []
+    original = post.PSOPathOptimizer.optimize_array
+
+    def spy(self, xy, terminate=None):
+        made.append(len(xy))
+        return original(self, xy, terminate)
+
+    monkeypatch.setattr(post.PSOPathOptimizer, "optimize_array", spy)
+    result = solve(problem_from_dict(SINGLE_CIRCLE), "RRTstarPSO", 0.3, 2)
+    assert result.solved and made  # RRTstarPSO's swarm stage is the post-pass optimiser
+
+
+def test_post_passes_share_the_one_budget():
+    problem = problem_from_dict(SINGLE_CIRCLE)
+    plain = solve(problem, "PRMstar", 0.4, 3, {"post_fraction": 0.5}, post=["pso"])
+    assert plain.planner == "PRMstar"  # as asked; the post-passes are in the stages
+    assert plain.benchmark.time < 0.4 * 0.5 + 0.05  # the planner had half
+    assert plain.stages["post"][0]["step"] == "pso"
+    with pytest.raises(ParameterError, match="post_fraction"):
+        solve(problem, "PRMstar", 0.4, 3, {"post_fraction": 0.95}, post=["pso"])
+
+
+def run_cli(*args, timeout=120):
+    return subprocess.run([*rrtpso_exe(), *args], capture_output=True, text=True, timeout=timeout)
+
+
+def test_solve_post_flag_reports_each_step(tmp_path):
+    out = tmp_path / "r.json"
+    proc = run_cli("solve", str(PROBLEMS / "static" / "single_circle.yaml"), "--planner", "RRT",
+                   "--post", "simplify,pso", "--time", "0.3", "--seed", "2", "--json", str(out))  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(out.read_text())
+    assert data["planner"] == "RRT"  # as asked (the contract); the post-passes are in the stages
+    steps = data["stages"]["post"]
+    assert [s["step"] for s in steps] == ["simplify", "pso"]
+    assert all(set(s) == {"step", "length_before", "length_after", "time"} for s in steps)
+    assert data["length"] == pytest.approx(steps[-1]["length_after"])
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [(["--post", "pso,smooth"], "--post: unknown post-pass 'smooth' (known: simplify, pso)"),
+     (["--planner", "RRT+zap"], "--planner: unknown post-pass 'zap' (known: simplify, pso)"),
+     (["--post", "pso", "--param", "post_fraction=1.5"], "post_fraction")],
+)  # fmt: skip
+def test_solve_post_errors_exit_2(tmp_path, args, fragment):
+    out = tmp_path / "r.json"
+    proc = run_cli("solve", str(PROBLEMS / "static" / "single_circle.yaml"), *args,
+                   "--json", str(out))  # fmt: skip
+    assert proc.returncode == 2
+    assert fragment in proc.stderr and "Traceback" not in proc.stderr
+    assert not out.exists()
+
+
+def test_bench_logs_each_spec_as_a_configuration(tmp_path):
+    proc = run_cli("bench", str(PROBLEMS / "static" / "single_circle.yaml"), "--planner",
+                   "RRT+simplify,RRT+simplify+pso", "--runs", "2", "--time", "0.2", "--jobs", "2",
+                   "--out", str(tmp_path / "b"), "-q", timeout=300)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    db = sqlite3.connect(tmp_path / "b" / "benchmark.db")
+    names = {n for (n,) in db.execute("SELECT name FROM plannerConfigs")}
+    assert {"geometric_RRT+simplify", "geometric_RRT+simplify+pso"} <= names
+    rows = db.execute(
+        "SELECT c.name, r.solution_length, r.simplified_solution_length, r.simplification_time "
+        "FROM runs r JOIN plannerConfigs c ON r.plannerid = c.id"
+    ).fetchall()
+    assert len(rows) == 4
+    for _, raw, simplified, seconds in rows:
+        assert simplified <= raw + 1e-9 and seconds >= 0
