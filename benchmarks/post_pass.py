@@ -32,7 +32,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from families import FAMILIES, REPO, TUNING_FILES  # noqa: E402
+from families import FAMILIES, REPO, TUNING_FILES
 
 #: OMPL's planners as registered (RRTstarPSO and the PSO baseline are ours).
 STOCK = ("BFMT", "BITstar", "BKPIECE1", "FMT", "InformedRRTstar", "KPIECE1", "LBKPIECE1", "PRM",

@@ -145,12 +145,12 @@ def test_params_by_name_and_validation(single_circle):
 
 
 def test_crash_is_reported_not_raised(single_circle, monkeypatch):
-    from rrtpso_ompl.planners import rrtstar_pso
+    from rrtpso_ompl.planners import post
 
     def boom(*args, **kwargs):
         raise RuntimeError("injected failure")
 
-    monkeypatch.setattr(rrtstar_pso, "optimize_path", boom)
+    monkeypatch.setattr(post, "optimize_path", boom)
     ctx, _ = _make(single_circle, "RRTstarPSO", 0.1)
     status = ctx.ss.solve(ob.timedPlannerTerminationCondition(0.1))
     assert status.getStatus() == ob.PlannerStatus.CRASH

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import sqlite3
@@ -74,7 +75,7 @@ def test_a_path_through_a_narrow_gap_stays_in_its_gap():
     assert world.path_valid(out)
     assert optimizer.last_result.length < optimizer.last_result.input_length
     crossing = [a + (b - a) * (0 - a[0]) / (b[0] - a[0])
-                for a, b in zip(out[:-1], out[1:], strict=True) if (a[0] - 0) * (b[0] - 0) < 0]  # fmt: skip
+                for a, b in itertools.pairwise(out) if a[0] * b[0] < 0]  # fmt: skip
     assert len(crossing) == 1 and 9.5 <= crossing[0][1] <= 10.5
     assert optimizer.last_result.length >= 45.51 - 1e-6  # never below the exact optimum
 
@@ -113,7 +114,7 @@ def test_a_foreign_validity_checker_is_honoured():
     assert changed and path.length() < before
     # Valid under the user's own checks, segment by segment.
     states = path.getStates()
-    assert all(si.checkMotion(a, b) for a, b in zip(states[:-1], states[1:], strict=True))
+    assert all(si.checkMotion(a, b) for a, b in itertools.pairwise(states))
     assert all(valid(s) for s in states)
     # Not below the true optimum around the square (1.26491 = 2 * |(0.1, 0.1) - (0.3, 0.7)|).
     assert path.length() >= 2 * math.hypot(0.2, 0.6) - 0.01
@@ -161,7 +162,8 @@ def run_cli(*args, timeout=120):
 def test_solve_post_flag_reports_each_step(tmp_path):
     out = tmp_path / "r.json"
     proc = run_cli("solve", str(PROBLEMS / "static" / "single_circle.yaml"), "--planner", "RRT",
-                   "--post", "simplify,pso", "--time", "0.3", "--seed", "2", "--json", str(out))  # fmt: skip
+                   "--post", "simplify,pso", "--time", "0.3", "--seed", "2",
+                   "--json", str(out))  # fmt: skip
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())
     assert data["planner"] == "RRT"  # as asked (the contract); the post-passes are in the stages
