@@ -17,6 +17,8 @@
 from __future__ import annotations
 
 import logging
+import math
+import time
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -96,30 +98,94 @@ class PlannerStats:
         return asdict(self)
 
 
-class SpaceInformationCollisionModel:
-    """The :class:`~rrtpso_ompl.model.World` interface the path optimiser needs, answered one
-    segment at a time by ``si.checkMotion``.
+#: A user's checker is sampled this much finer than the space's validity-checking resolution
+#: when the swarm checks its candidates: an optimiser searches for exactly the gaps a coarse
+#: discrete check leaves, so it must look closer than the planner did.
+FINE_RESOLUTION = 0.1
 
-    Used when a planner runs in a ``SimpleSetup`` that was not built by this package. Exact only as
-    far as the space information's motion validator is; slower than the vectorised World. The
-    violation of a colliding segment is its length (there is no distance to measure).
+
+class SpaceInformationCollisionModel:
+    """The :class:`~rrtpso_ompl.model.World` interface the path optimiser needs, answered through
+    the space information's own validity checker.
+
+    Used when a planner or :class:`~rrtpso_ompl.planners.PSOPathOptimizer` runs in a
+    ``SimpleSetup`` that was not built by this package. A segment is free when every state along
+    it, ``fine`` times the space's validity-checking resolution apart (a tenth by default), is
+    valid (after the space information's own ``checkMotion``, so a user's motion validator is
+    honoured too): not exact (nothing is, with a user's point checker), but ten times
+    finer than the discrete motion check a planner used, so the swarm cannot hide a shortcut in
+    the gaps of that check. The violation of a colliding segment is its length (there is no
+    distance to measure).
+
+    Parameters
+    ----------
+    si : ompl.base.SpaceInformation
+    fine : float
+        Sampling step as a share of the space's resolution
+        (``si.getStateValidityCheckingResolution() * si.getMaximumExtent()``).
+
+    Attributes
+    ----------
+    step : float
+        Distance between checked states, units.
+    stop : callable or None
+        Set by the optimiser: once it returns True, the swarm's evaluations count segments as
+        blocked without checking them, so a slow checker cannot hold the swarm past its deadline
+        (validation, :meth:`segments_free` and :meth:`path_valid`, always checks).
+    length_checked, check_time : float
+        Segment length checked (units) and the seconds it took: the checker's measured cost.
     """
 
-    def __init__(self, si: ob.SpaceInformation) -> None:
+    def __init__(self, si: ob.SpaceInformation, fine: float = FINE_RESOLUTION) -> None:
         self.si = si
         bounds = si.getStateSpace().getBounds()
         self.bounds = ((bounds.low[0], bounds.low[1]), (bounds.high[0], bounds.high[1]))
         self.tol = touch_tolerance(self.bounds)
         self.robot_radius = 0.0
-        self._a = si.allocState()
-        self._b = si.allocState()
+        resolution = si.getStateValidityCheckingResolution() * si.getMaximumExtent()
+        self.step = max(fine * resolution, 1e-12)
+        self.stop: Any = None
+        self.length_checked = 0.0
+        self.check_time = 0.0
+        self._state = si.allocState()
+        self._end = si.allocState()
+
+    def seconds_per_length(self) -> float:
+        """Measured checking time per unit of segment length, s (0 before any check)."""
+        return self.check_time / self.length_checked if self.length_checked > 0 else 0.0
+
+    def probe(self, point: np.ndarray, n: int = 8) -> float:
+        """Time ``n`` checks of ``point`` and return the estimated seconds per unit length at
+        this model's step (the user's checker may be slow: a millisecond per state is common
+        with a physics engine behind it)."""
+        st = self._state
+        st[0], st[1] = float(point[0]), float(point[1])
+        t0 = time.perf_counter()
+        for _ in range(n):
+            self.si.isValid(st)
+        return (time.perf_counter() - t0) / n / self.step
 
     def _free(self, a: np.ndarray, b: np.ndarray) -> bool:
-        self._a[0], self._a[1] = float(a[0]), float(a[1])
-        self._b[0], self._b[1] = float(b[0]), float(b[1])
-        if not self.si.isValid(self._a) or not self.si.isValid(self._b):
-            return False
-        return bool(self.si.checkMotion(self._a, self._b))
+        length = math.hypot(b[0] - a[0], b[1] - a[1])
+        n = max(1, math.ceil(length / self.step))
+        st, sb, valid = self._state, self._end, self.si.isValid
+        t0 = time.perf_counter()
+        try:
+            st[0], st[1], sb[0], sb[1] = float(a[0]), float(a[1]), float(b[0]), float(b[1])
+            # The user's own motion validator first (it may be exact, or cheaper), then the
+            # states in between, ten times finer than it looked.
+            if not self.si.checkMotion(st, sb):
+                return False
+            for k in range(1, n):
+                u = k / n
+                st[0] = float(a[0] + u * (b[0] - a[0]))
+                st[1] = float(a[1] + u * (b[1] - a[1]))
+                if not valid(st):
+                    return False
+            return True
+        finally:
+            self.length_checked += max(length, self.step)
+            self.check_time += time.perf_counter() - t0
 
     def segments_free(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
@@ -127,7 +193,11 @@ class SpaceInformationCollisionModel:
         return np.array(flat, dtype=bool).reshape(a.shape[:-1])
 
     def segment_violation(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """The swarm's cost term: a blocked segment's length. Once :attr:`stop` fires, segments
+        count as blocked unchecked (a candidate is only ever accepted after ``path_valid``)."""
         a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
+        if self.stop is not None and self.stop():
+            return np.linalg.norm(b - a, axis=-1) + self.tol
         free = self.segments_free(a, b)
         return np.where(free, 0.0, np.linalg.norm(b - a, axis=-1) + self.tol)
 

@@ -16,6 +16,7 @@ time budget.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
@@ -27,14 +28,18 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from ..errors import ParameterError
+from ..model.geometry import path_length as path_length_of
 from ..ompl_setup import path_to_array
-from .base import collision_model_for
+from .base import SpaceInformationCollisionModel, collision_model_for
 from .params import ParamSpec, ParamTable
 from .path_optimizer import PathOptimizationResult, PathOptimizerOptions, optimize_path
 
 __all__ = [
+    "ITERATIONS_NEEDED",
+    "MIN_SWARM",
     "POST_PARAMS",
     "POST_STEPS",
+    "VALIDATIONS_NEEDED",
     "PSOPathOptimizer",
     "PostStep",
     "parse_steps",
@@ -42,6 +47,15 @@ __all__ = [
     "split_params",
     "split_spec",
 ]
+
+#: With a user's checker, the time left must hold this many validations of the path (the input's,
+#: the final one, and room for the swarm), or the swarm does not run.
+VALIDATIONS_NEEDED = 4
+#: ... and the swarm is shrunk so that this many iterations fit (a particle costs about one
+#: validation per iteration).
+ITERATIONS_NEEDED = 3
+#: The smallest swarm worth running.
+MIN_SWARM = 4
 
 #: The post-passes, in the order a spec may name them: OMPL's simplifier and the swarm.
 POST_STEPS = ("simplify", "pso")
@@ -153,6 +167,8 @@ class PSOPathOptimizer:
         self.rng = rng
         #: The :class:`PathOptimizationResult` of the last call.
         self.last_result: PathOptimizationResult | None = None
+        #: Why the last call left the path alone without running the swarm ("" when it ran).
+        self.skipped = ""
 
     def optimize(self, path: og.PathGeometric, ptc_or_seconds: Any = None) -> bool:
         """Shorten ``path`` in place; True when it changed it (then shorter and valid).
@@ -161,21 +177,71 @@ class PSOPathOptimizer:
         ----------
         path : og.PathGeometric
         ptc_or_seconds : ob.PlannerTerminationCondition, float or None
-            When to stop: a termination condition, a time in seconds, or None (the swarm's
-            iteration and round limits only).
+            When to stop: a termination condition, a time in seconds (which also sizes the work
+            to a slow checker, see :meth:`optimize_array`), or None (the swarm's iteration and
+            round limits only).
         """
-        result = self.optimize_array(path_to_array(path), _terminator(ptc_or_seconds))
+        deadline = None
+        if isinstance(ptc_or_seconds, int | float):
+            deadline = time.perf_counter() + float(ptc_or_seconds)
+        result = self.optimize_array(
+            path_to_array(path), _terminator(ptc_or_seconds, deadline), deadline
+        )
         if not result.improved:
             return False
         _assign(self.si, path, result.path)
         return True
 
     def optimize_array(
-        self, xy: np.ndarray, terminate: Callable[[], bool] | None = None
+        self,
+        xy: np.ndarray,
+        terminate: Callable[[], bool] | None = None,
+        deadline: float | None = None,
     ) -> PathOptimizationResult:
-        """The same on an ``(n, 2)`` array of waypoints; the input is never modified."""
-        self.last_result = optimize_path(xy, self.model, self.options, self.rng, terminate)
+        """The same on an ``(n, 2)`` array of waypoints; the input is never modified.
+
+        With the user's checker (not our exact world) and a ``deadline``
+        (``time.perf_counter()`` seconds), the work is sized to the checker's measured cost:
+        validating the path once must fit :data:`VALIDATIONS_NEEDED` times in the time left, or
+        the input comes back untouched; the swarm is shrunk so that
+        :data:`ITERATIONS_NEEDED` iterations fit; and its evaluations stop (count as blocked) a
+        validation's time before the deadline, so that the final check still fits.
+        """
+        model, options = self.model, self.options
+        self.skipped = ""
+        if isinstance(model, SpaceInformationCollisionModel) and deadline is not None:
+            options, reserve = self._size(xy, deadline)
+            if options is None:
+                self.last_result = _unchanged(xy)
+                return self.last_result
+            model.stop = lambda: time.perf_counter() >= deadline - reserve
+        try:
+            self.last_result = optimize_path(xy, model, options, self.rng, terminate)
+        finally:
+            if isinstance(model, SpaceInformationCollisionModel):
+                model.stop = None
         return self.last_result
+
+    def _size(self, xy: np.ndarray, deadline: float) -> tuple[PathOptimizerOptions | None, float]:
+        """The swarm sized to a user's checker and the time left, and the time kept back for
+        the final validation; None when even validating the path does not fit."""
+        model = self.model
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        rate = model.seconds_per_length() or model.probe(xy[0])
+        validate = rate * max(path_length_of(xy), model.step)
+        left = deadline - time.perf_counter()
+        if left < VALIDATIONS_NEEDED * validate:
+            self.skipped = (f"the checker needs {validate:.3g} s to validate the path once, "
+                            f"{left:.3g} s are left")  # fmt: skip
+            return None, 0.0
+        # One particle costs about one validation per iteration.
+        spare = left - (VALIDATIONS_NEEDED - 1) * validate
+        particles = int(spare / (ITERATIONS_NEEDED * validate))
+        size = min(self.options.swarm_size, particles)
+        if size < MIN_SWARM:
+            self.skipped = f"room for {particles} particles only"
+            return None, 0.0
+        return dataclasses.replace(self.options, swarm_size=size), 1.5 * validate
 
 
 def run_post(
@@ -213,15 +279,23 @@ def run_post(
     return out
 
 
-def _terminator(ptc_or_seconds: Any) -> Callable[[], bool] | None:
+def _terminator(ptc_or_seconds: Any, deadline: float | None = None) -> Callable[[], bool] | None:
     """A zero-argument stop test from a termination condition or a number of seconds."""
     if ptc_or_seconds is None:
         return None
-    if isinstance(ptc_or_seconds, int | float):
-        deadline = time.perf_counter() + float(ptc_or_seconds)
+    if deadline is not None:
         return lambda: time.perf_counter() >= deadline
     ptc = ptc_or_seconds
     return lambda: bool(ptc())
+
+
+def _unchanged(xy: np.ndarray) -> PathOptimizationResult:
+    """The result that hands the input back (the swarm did not run)."""
+    p = np.asarray(xy, dtype=float).reshape(-1, 2)
+    length = path_length_of(p)
+    return PathOptimizationResult(path=p, length=length, input_length=length, improved=False,
+                                  history=np.empty(0), n_iterations=0, n_evaluations=0, rounds=0,
+                                  time=0.0)  # fmt: skip
 
 
 def _assign(si: ob.SpaceInformation, path: og.PathGeometric, xy: np.ndarray) -> None:

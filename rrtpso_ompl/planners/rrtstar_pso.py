@@ -32,7 +32,14 @@ from ompl import geometric as og
 from ..model.geometry import path_length
 from ..model.world import World
 from ..ompl_setup import array_to_path, path_to_array
-from .base import BUDGET, SEED, PlannerStats, PythonPlanner, collision_model_for
+from .base import (
+    BUDGET,
+    SEED,
+    PlannerStats,
+    PythonPlanner,
+    SpaceInformationCollisionModel,
+    collision_model_for,
+)
 from .ompl_planners import RRTSTAR_PARAMS
 from .params import ParamSpec, ParamTable
 from .path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
@@ -46,6 +53,7 @@ _INNER = ("range", "goal_bias", "rewire_factor", "informed_sampling", "tree_prun
 __all__ = [
     "RANGE_PER_CLEARANCE",
     "RRTSTAR_PSO_PARAMS",
+    "SIMPLIFIER_PASS_LENGTHS",
     "RRTstarPSO",
     "RRTstarPSOStats",
     "clutter_range",
@@ -86,7 +94,9 @@ class RRTstarPSOStats(PlannerStats):
     """Per-stage figures of one RRTstarPSO solve (the ``stages`` of a solve result).
 
     Lengths are in problem units, times in seconds. In OMPL's benchmark terms the RRT* stage and
-    OMPL's simplifier are the planning, the swarm is the simplification.
+    OMPL's simplifier are the planning, the swarm is the simplification. ``rrt_path`` is RRT*'s
+    first path, ``seed_path`` the RRT* path the returned one was made from (a later one when the
+    anytime loop found a shorter).
     """
 
     rrt_length: float | None = None
@@ -95,6 +105,7 @@ class RRTstarPSOStats(PlannerStats):
     rrt_iterations: int = 0
     rrt_waypoints: int = 0
     rrt_path: list[list[float]] = field(default_factory=list)
+    seed_path: list[list[float]] = field(default_factory=list)
     rrt_progress: list[tuple[float, float]] = field(default_factory=list)
     simplified_length: float | None = None
     simplify_time: float = 0.0
@@ -136,6 +147,10 @@ class RRTstarPSOStats(PlannerStats):
             progress=self.progress(),
         )
 
+
+#: How many times over OMPL's simplifier checks the path's length in one pass (vertex reduction,
+#: shortcuts, collapsing), for sizing it to a user's slow checker: an estimate on the safe side.
+SIMPLIFIER_PASS_LENGTHS = 20
 
 #: RRT*'s automatic range is at most this many times the median clearance of free points.
 RANGE_PER_CLEARANCE = 10.0
@@ -190,10 +205,13 @@ class RRTstarPSO(PythonPlanner):
         for name in _INNER:
             getattr(self.inner, self.PARAMS[name].setter)(self._values[name])
         self.inner.setup()
+        # Our exact world, or the user's checker behind a fine-sampling model whose measured
+        # cost sizes the swarm (one model per planner, so the measurements carry over).
+        self._model = collision_model_for(self.getSpaceInformation())
         if self._values["range"] == 0.0:
             # OMPL's default (a fifth of the space's extent) is right for a few obstacles; among
             # thousands almost every motion that long is blocked and the tree barely grows.
-            world = collision_model_for(self.getSpaceInformation())
+            world = self._model
             if isinstance(world, World):
                 self.inner.setRange(clutter_range(world, self.inner.getRange()))
             self._values["range"] = self.inner.getRange()  # report what was chosen
@@ -232,6 +250,7 @@ class RRTstarPSO(PythonPlanner):
             # The tree never reached the goal: nothing to optimise between fixed end points.
             return ob.PlannerStatus(ob.PlannerStatus.APPROXIMATE_SOLUTION)
 
+        stats.seed_path = stats.rrt_path
         # --- stage 2: OMPL's simplifier, so the swarm starts from a locally shortened path ------
         if values["simplify"] and not ptc():
             xy = self._simplify(raw, xy, stats, ptc, t0)
@@ -249,11 +268,12 @@ class RRTstarPSO(PythonPlanner):
                 break
             raw = pdef.getSolutionPath()
             xy = path_to_array(raw)
+            seed = xy.tolist()
             if values["simplify"] and not ptc():
                 xy = self._simplify(raw, xy, stats, ptc, t0)
             again = self._swarm(xy, stats, t0, ptc)
             if again.length < path_length(best):
-                best = again.path
+                best, stats.seed_path = again.path, seed
         stats.pso_length = path_length(best)
         stats.pso_waypoints = len(best)
 
@@ -271,9 +291,11 @@ class RRTstarPSO(PythonPlanner):
         the swarm's share.
         """
         t1 = time.perf_counter()
+        budget = self._values["budget"]
+        if budget > 0 and not self._simplifier_fits(xy, 0.5 * (t0 + budget - t1)):
+            return xy
         simplified = og.PathGeometric(raw)  # a copy: RRT*'s own path stays as it was
         simplifier = og.PathSimplifier(self.getSpaceInformation())
-        budget = self._values["budget"]
         if budget > 0:
             left = max(0.5 * (t0 + budget - t1), 1e-4)
             simplifier.simplify(simplified, ob.plannerOrTerminationCondition(
@@ -281,8 +303,41 @@ class RRTstarPSO(PythonPlanner):
         else:
             simplifier.simplifyMax(simplified)
         candidate = path_to_array(simplified)
+        better = path_length(candidate) < path_length(xy) and self._fine_valid(candidate, t0)
         stats.simplify_time = time.perf_counter() - t1
-        return candidate if path_length(candidate) < path_length(xy) else xy
+        return candidate if better else xy
+
+    def _simplifier_fits(self, xy: np.ndarray, left: float) -> bool:
+        """Whether OMPL's simplifier can be trusted to stop within ``left`` seconds.
+
+        It polls its termination condition only between whole passes, each of which checks
+        motions along the path many times over (:data:`SIMPLIFIER_PASS_LENGTHS`). With our world
+        a motion check costs microseconds; with a user's checker of a millisecond per state a
+        single pass can take a second, so it only runs when a pass fits."""
+        model = self._model
+        if not isinstance(model, SpaceInformationCollisionModel):
+            return True
+        si = self.getSpaceInformation()
+        per_state = model.probe(xy[0]) * model.step
+        states = path_length(xy) / (si.getStateValidityCheckingResolution() * si.getMaximumExtent())
+        return SIMPLIFIER_PASS_LENGTHS * per_state * states <= left
+
+    def _fine_valid(self, xy: np.ndarray, t0: float) -> bool:
+        """Whether the user's checker, sampled finer than the space's resolution, passes ``xy``
+        (always True with our exact world, whose motion validator OMPL's simplifier used).
+
+        OMPL's simplifier checks motions at the space's resolution, and a shortcut into the gap
+        between two checked states is exactly what it finds: its path is only kept when the fine
+        check passes, and when that check fits in what is left of the budget."""
+        model = self._model
+        if not isinstance(model, SpaceInformationCollisionModel):
+            return True
+        budget = self._values["budget"]
+        if budget > 0:
+            rate = model.seconds_per_length() or model.probe(xy[0])
+            if rate * path_length(xy) > 0.5 * (t0 + budget - time.perf_counter()):
+                return False
+        return model.path_valid(xy)
 
     def _swarm(
         self, xy: np.ndarray, stats: RRTstarPSOStats, t0: float, ptc: ob.PlannerTerminationCondition
@@ -291,7 +346,7 @@ class RRTstarPSO(PythonPlanner):
         budget = self._values["budget"]
         # With a known budget the PSO stops at its end (and at the outer condition); without one
         # the outer condition has already fired, so the swarm is bounded by its iterations only.
-        terminate = None
+        terminate = deadline = None
         if budget > 0:
             deadline = t0 + budget
 
@@ -301,8 +356,8 @@ class RRTstarPSO(PythonPlanner):
         # The same post-pass any planner gets with "+pso" (one optimiser, not two).
         si = self.getSpaceInformation()
         options = PathOptimizerOptions.from_values(self._values)
-        optimizer = PSOPathOptimizer(si, options, collision_model_for(si), self._rng())
-        result = optimizer.optimize_array(xy, terminate)
+        optimizer = PSOPathOptimizer(si, options, self._model, self._rng())
+        result = optimizer.optimize_array(xy, terminate, deadline)
         # Summed over the swarm runs of one solve (one, unless the anytime loop ran more).
         stats.pso_time += result.time
         stats.pso_iterations += result.n_iterations

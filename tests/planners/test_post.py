@@ -136,9 +136,9 @@ def test_rrtstarpso_and_the_post_pass_share_one_optimiser(monkeypatch):
     made = []
     original = post.PSOPathOptimizer.optimize_array
 
-    def spy(self, xy, terminate=None):
+    def spy(self, xy, *args):
         made.append(len(xy))
-        return original(self, xy, terminate)
+        return original(self, xy, *args)
 
     monkeypatch.setattr(post.PSOPathOptimizer, "optimize_array", spy)
     result = solve(problem_from_dict(SINGLE_CIRCLE), "RRTstarPSO", 0.3, 2)
