@@ -34,13 +34,11 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import multiprocessing as mp
 import platform
 import shlex
 import statistics
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -56,6 +54,8 @@ STRATEGIES = (
 )
 #: Random heading changes of the ``turning`` family: per obstacle per second, and degrees.
 TURN_RATE, TURN_DEG = 0.2, 45.0
+#: Longest a case may run before its process is stopped, s.
+CASE_TIMEOUT = 1800.0
 #: Longest wait the clairvoyant baseline tries, s.
 MAX_CLAIRVOYANT_WAIT = 120.0
 
@@ -192,6 +192,23 @@ def run_case(case: Case, replan_time: float, initial_time: float,
             }
         )
     return rows
+
+
+def _run(job: tuple) -> list[dict]:
+    return run_case(*job)
+
+
+def _case_timeout(job: tuple) -> float:
+    return CASE_TIMEOUT
+
+
+def _warm() -> None:
+    """What a worker imports once, before it forks a process per case."""
+    import rrtpso_ompl.dynamic.dwa
+    import rrtpso_ompl.evaluation.optimum  # noqa: F401
+    from rrtpso_ompl.planners import default_registry
+
+    default_registry()
 
 
 def summarise(rows: list[dict], group: str) -> list[dict]:
@@ -416,6 +433,7 @@ def main(argv: list[str] | None = None) -> int:
     from tqdm import tqdm
 
     from rrtpso_ompl.evaluation.optimum import shortest_path
+    from rrtpso_ompl.evaluation.workers import ChildFailure, run_local
     from rrtpso_ompl.model import World
     from rrtpso_ompl.model.problem import load_problem
 
@@ -429,14 +447,18 @@ def main(argv: list[str] | None = None) -> int:
         optimum[base] = best.valid_polyline(World.from_problem(problem)).tolist()
     rows: list[dict] = []
     t0 = time.perf_counter()
-    ctx = mp.get_context("spawn")
-    # One case per child process: OMPL takes each case's seed.
-    with ProcessPoolExecutor(args.jobs, mp_context=ctx, max_tasks_per_child=1) as pool:
-        futures = [pool.submit(run_case, c, args.replan_time, args.initial_time,
-                               optimum[c.base]) for c in todo]  # fmt: skip
-        for fut in tqdm(as_completed(futures), total=len(futures), file=sys.stderr,
-                        disable=not sys.stderr.isatty(), desc="cases"):  # fmt: skip
-            rows.extend(fut.result())
+    # One case per process, forked from a warm worker (imports done once per worker): OMPL
+    # takes each case's seed, and a case that crashes is its error rows.
+    jobs = [(c, args.replan_time, args.initial_time, optimum[c.base]) for c in todo]
+    results = run_local(jobs, _run, args.jobs, warm=_warm, timeout_of=_case_timeout)
+    for job, result in tqdm(results, total=len(jobs), file=sys.stderr,
+                            disable=not sys.stderr.isatty(), desc="cases"):  # fmt: skip
+        if isinstance(result, ChildFailure):
+            case = job[0]
+            head = {"group": case.group, "seed": case.seed, "error": result.message}
+            rows.extend({**head, "strategy": s} for s, _ in STRATEGIES)
+        else:
+            rows.extend(result)
     wall = time.perf_counter() - t0
     rows.sort(key=lambda r: (r["group"], r["seed"], r["strategy"]))
     out = Path(args.out)

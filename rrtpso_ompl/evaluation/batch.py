@@ -3,8 +3,9 @@
 Every run gets an OMPL of its own, seeded before any of its random generators exists (OMPL takes
 its seed once per process): the local executor's warm workers fork one child per run
 (:mod:`rrtpso_ompl.evaluation.workers`), after loading the run's problem once per worker; the
-Dask executor starts a process per run. So each row is reproducible from its seed, whichever
-worker ran it, and a run that crashes is an error row, not the end of the batch. Rows are written
+Dask executor forks a process per run from a warm fork server. So each row is reproducible from
+its seed, whichever worker ran it, and a run that crashes is an error row, not the end of the
+batch. Rows are written
 by the parent as they finish, one whole line per write, to a locked results file
 (:mod:`rrtpso_ompl.evaluation.results_file`), so an interrupted batch leaves a valid file that
 ``resume=True`` continues.
@@ -259,11 +260,12 @@ def _local_results(tasks: list[Task], jobs: int) -> Iterator[dict[str, Any]]:
 
 
 def _run_isolated(task: Task) -> dict[str, Any]:
-    """``run_task`` in a process of its own (inside a long-lived Dask worker, which may run
-    threads, so it is spawned rather than forked)."""
+    """``run_task`` in a process of its own, inside a long-lived Dask worker: the worker may run
+    threads, so the process is forked from a fork server that has done the imports (which the
+    Dask worker keeps), not from the worker itself."""
     from .workers import run_spawned
 
-    return _row_of(task, run_spawned(run_task, task, _timeout(task)))
+    return _row_of(task, run_spawned(run_task, task, _timeout(task), warm=True))
 
 
 def _dask_results(tasks: list[Task], scheduler: str | Any) -> Iterator[dict[str, Any]]:

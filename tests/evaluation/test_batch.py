@@ -144,6 +144,30 @@ def test_dask_local_cluster_runs_the_same_batch(folder, tmp_path):
     assert len(read_rows(tmp_path / "d.jsonl")) == 4
 
 
+def _cluster_batch(tasks, out):
+    """A batch on a real process-based Dask cluster (its workers are daemonic processes)."""
+    import distributed
+
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                       dashboard_address=None)  # fmt: skip
+    with cluster, distributed.Client(cluster) as client:
+        return run_batch(tasks, out, executor="dask", scheduler=client, optimum=False)
+
+
+def test_dask_process_workers_fork_warm_runs_with_the_same_paths(tmp_path):
+    """Dask's worker processes are daemonic and run threads: each run is forked from a warm fork
+    server instead, and its path is the one the local warm workers give for the same seed."""
+    pytest.importorskip("distributed")
+    problem = str(PROBLEMS / "static" / "single_circle.yaml")
+    tasks = make_tasks([problem], ["RRTConnect", "RRT"], runs=2, seed=3, time_limit=1.0)
+    on_dask = {(r["planner"], r["seed"]): r for r in _cluster_batch(tasks, tmp_path / "d.jsonl")}
+    local = {(r["planner"], r["seed"]): r
+             for r in run_batch(tasks, tmp_path / "l.jsonl", jobs=2, optimum=False)}  # fmt: skip
+    assert len(on_dask) == 4 and not any(r["error"] for r in on_dask.values())
+    for key, row in local.items():
+        assert on_dask[key]["path"] == row["path"], key
+
+
 def test_only_a_solved_row_gets_a_ratio():
     """An approximate path stops short of the goal, so it can be shorter than the optimum: it
     gets the optimum but no ratio (seen on the maze at 0.2 s: ratio 0.39 before the fix)."""
