@@ -417,7 +417,8 @@ def check_planners(names: list[str], items: list[str], flag: str) -> dict[str, d
                     raise UsageError(f"--param {key}: {exc}") from None
         mine = {k: v for k, v in params.items() if entry.takes(k) or k in post}
         for key, value in mine.items():
-            _check_param(entry, key, value, f"--param {key}")
+            if entry.takes(key):  # the post-passes' own were checked above
+                _check_param(entry, key, value, f"--param {key}")
         out[name] = mine
     for key in params:
         if not any(key in p for p in out.values()):

@@ -203,3 +203,18 @@ def test_bench_logs_each_spec_as_a_configuration(tmp_path):
     assert len(rows) == 4
     for _, raw, simplified, seconds in rows:
         assert simplified <= raw + 1e-9 and seconds >= 0
+
+
+def test_batch_takes_post_pass_parameters_for_the_specs_that_have_post_passes(tmp_path):
+    out = tmp_path / "b.jsonl"
+    proc = run_cli("batch", str(PROBLEMS / "static" / "single_circle.yaml"), "--planner",
+                   "RRT+pso,BITstar", "--param", "post_fraction=0.5", "--time", "0.2",
+                   "--out", str(out), "-q")  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    rows = {r["planner"]: r for r in map(json.loads, out.read_text().splitlines())}
+    assert rows["RRT+pso"]["stages"]["post"][0]["step"] == "pso"
+    assert "post" not in rows["BITstar"]["stages"] and rows["BITstar"]["error"] is None
+    bad = run_cli("batch", str(PROBLEMS / "static" / "single_circle.yaml"), "--planner",
+                  "RRT+pso", "--param", "post_fraction=5",
+                  "--out", str(tmp_path / "c.jsonl"))  # fmt: skip
+    assert bad.returncode == 2 and "post_fraction" in bad.stderr
