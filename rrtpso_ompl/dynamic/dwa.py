@@ -27,6 +27,7 @@ obstacle).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, fields
 
@@ -131,7 +132,7 @@ def simulate_dwa(
     params = params or DWAParams()
     options = options or DynamicOptions()
     robot = _Robot.of(problem)
-    options_dwa = DynamicOptions(**{**_public(options), "strategy": "none", "planner": "DWA"})
+    options_dwa = dataclasses.replace(options, strategy="none", planner="DWA")
     path = np.asarray(guide_path, dtype=float).reshape(-1, 2)
     tracks = [ObstacleTrack.from_obstacle(m) for m in problem.moving_obstacles]
     if len(path) < 2:
@@ -154,8 +155,7 @@ def simulate_dwa(
     result.planner = "DWA"
     # Unlike a planned path, DWA's arcs are not checked exactly before they are driven.
     free = world.segments_free(motion.xy[:-1], motion.xy[1:])
-    inside = np.array([world.in_bounds(*p) for p in motion.xy])
-    if not (free.all() and inside.all()):
+    if not (free.all() and world.points_in_bounds(motion.xy).all()):
         result.status = "clipped a static obstacle or left the bounds"
     return result
 
@@ -168,14 +168,13 @@ def guide_path(
     params: dict | None = None,
 ) -> np.ndarray:
     """The path the DWA follows: the static problem re-planned (with ``planner`` for
-    ``time_limit`` s) for a robot larger by 10 % of SR plus the DWA's sampling pad
+    ``time_limit`` s) for a robot larger by 10 % of SR plus half a control period's travel
     (``v_max * sample_time / 2``); ``static_path`` when that problem has no solution.
 
-    A shortest path touches obstacles (zero clearance): a DWA whose arcs must keep a pad cannot
-    follow it there and crawls. OMPL is not reseeded here (give ``params={"seed": ...}``).
+    A shortest path touches obstacles (zero clearance): a DWA, whose sampled arcs and clearance
+    term keep it off the obstacles, cannot follow it there and crawls. OMPL is not reseeded here
+    (give ``params={"seed": ...}``).
     """
-    import dataclasses
-
     from ..planners import solve
 
     robot = problem.robot
@@ -186,10 +185,6 @@ def guide_path(
     )
     res = solve(bigger, planner, time_limit, None, params)
     return res.path if res.solved else np.asarray(static_path, dtype=float)
-
-
-def _public(options: DynamicOptions) -> dict:
-    return {f.name: getattr(options, f.name) for f in fields(options)}
 
 
 class _DWA:
