@@ -3,7 +3,8 @@
 - :func:`make_context`: ``RealVectorStateSpace(2)`` with the problem's bounds, a validity checker
   and an *exact* motion validator over the :class:`~rrtpso_ompl.model.World`, the path-length
   objective, start and goal (:mod:`.context`);
-- :func:`path_to_array`, :func:`array_to_path`: paths as numpy arrays (:mod:`.convert`);
+- :func:`path_to_array`, :func:`array_to_path`, :func:`assign_path`: paths as numpy arrays
+  and back (:mod:`.convert`);
 - :func:`seed_ompl`, :func:`set_ompl_log_level`: OMPL's process-wide seed, once per process
   before any OMPL object exists, and its log level (:mod:`.process`).
 """
@@ -15,7 +16,7 @@ from .context import (
     WorldValidityChecker,
     make_context,
 )
-from .convert import array_to_path, path_to_array
+from .convert import array_to_path, assign_path, path_to_array
 from .process import seed_ompl, set_ompl_log_level
 
 __all__ = [
@@ -24,6 +25,7 @@ __all__ = [
     "PlanningContext",
     "WorldValidityChecker",
     "array_to_path",
+    "assign_path",
     "make_context",
     "path_to_array",
     "seed_ompl",

@@ -6,7 +6,7 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-__all__ = ["array_to_path", "path_to_array"]
+__all__ = ["array_to_path", "assign_path", "path_to_array"]
 
 
 def path_to_array(path: og.PathGeometric) -> np.ndarray:
@@ -17,10 +17,17 @@ def path_to_array(path: og.PathGeometric) -> np.ndarray:
 def array_to_path(si: ob.SpaceInformation, xy: np.ndarray) -> og.PathGeometric:
     """An OMPL geometric path through the waypoints ``xy`` ``(n, 2)``."""
     path = og.PathGeometric(si)
+    assign_path(si, path, xy)
+    return path
+
+
+def assign_path(si: ob.SpaceInformation, path: og.PathGeometric, xy: np.ndarray) -> None:
+    """Replace the states of ``path`` by the waypoints ``xy`` ``(n, 2)``, in place (the caller's
+    object changes: e.g. the problem definition's solution path)."""
+    path.clear()
     # The binding hands ownership of an allocated state to Python (freeing it here would free it
     # twice); append copies it into the path.
     state = si.allocState()
     for x, y in np.asarray(xy, dtype=float):
         state[0], state[1] = float(x), float(y)
         path.append(state)
-    return path

@@ -29,7 +29,7 @@ from ompl import util as ou
 
 from ..errors import ParameterError
 from ..model.geometry import path_length as path_length_of
-from ..ompl_setup import path_to_array
+from ..ompl_setup import assign_path, path_to_array
 from .base import SpaceInformationCollisionModel, collision_model_for
 from .params import ParamSpec, ParamTable
 from .path_optimizer import PathOptimizationResult, PathOptimizerOptions, optimize_path
@@ -189,7 +189,7 @@ class PSOPathOptimizer:
         )
         if not result.improved:
             return False
-        _assign(self.si, path, result.path)
+        assign_path(self.si, path, result.path)
         return True
 
     def optimize_array(
@@ -296,13 +296,3 @@ def _unchanged(xy: np.ndarray) -> PathOptimizationResult:
     return PathOptimizationResult(path=p, length=length, input_length=length, improved=False,
                                   history=np.empty(0), n_iterations=0, n_evaluations=0, rounds=0,
                                   time=0.0)  # fmt: skip
-
-
-def _assign(si: ob.SpaceInformation, path: og.PathGeometric, xy: np.ndarray) -> None:
-    """Replace the states of ``path`` by the waypoints ``xy`` (in place: the caller's object,
-    e.g. the problem definition's solution path, changes)."""
-    path.clear()
-    state = si.allocState()  # owned by Python; append copies it
-    for x, y in np.asarray(xy, dtype=float):
-        state[0], state[1] = float(x), float(y)
-        path.append(state)
