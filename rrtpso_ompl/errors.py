@@ -14,6 +14,7 @@ from __future__ import annotations
 
 __all__ = [
     "GenerationError",
+    "OutputError",
     "ParameterError",
     "PlannerError",
     "ProblemError",
@@ -109,6 +110,32 @@ class UnknownPlannerError(PlannerError, KeyError):
 
 class UsageError(RrtpsoError):
     """A command-line flag, argument or output target that cannot be honoured."""
+
+
+class OutputError(RrtpsoError, OSError):
+    """An output could not be written: the disk is full, the pipe was closed, standard output is
+    closed, the name is too long, ...
+
+    Raised by the writers of :mod:`rrtpso_ompl.outputs` and the results file after the temporary
+    file (or the torn line) has been removed, so the old file is intact and nothing half-written
+    is left. Also an ``OSError``, for callers that catch that.
+
+    Parameters
+    ----------
+    path : str
+        The output as it was named (``-`` for standard output).
+    reason : str
+        Why, as the system says it (``No space left on device``).
+    """
+
+    def __init__(self, path: str, reason: str) -> None:
+        self.path = str(path)
+        self.reason = reason
+        where = "standard output" if self.path == "-" else self.path
+        super().__init__(f"{where}: cannot write: {reason}")
+
+    def __reduce__(self):
+        return (type(self), (self.path, self.reason))
 
 
 class GenerationError(RrtpsoError, ValueError):

@@ -11,10 +11,17 @@ Where a result goes decides how it is written (:func:`publish`):
 
 Everything that writes a file goes through :func:`atomic_path` (for writers that need a file
 name: matplotlib, SQLite) or :func:`write_text_atomic`.
+
+A write that fails (the disk is full, the pipe or standard output is closed, the name is too
+long) raises one :class:`~rrtpso_ompl.errors.OutputError` naming the output and the reason, after
+the temporary file is removed: the old file stays as it was, and nothing half-written or empty
+is left behind. The temporary name is shortened to fit the file system's name limit, so any name
+that may be written may also be written atomically.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -29,19 +36,94 @@ from typing import Any
 
 import numpy as np
 
+from .errors import OutputError
+
 __all__ = [
     "STDOUT",
     "atomic_path",
     "finite",
+    "guard_standard_streams",
     "is_stream",
     "json_line",
+    "make_folders",
+    "name_max",
+    "os_reason",
     "publish",
+    "remove_folders",
+    "stdout_closed",
     "write_json_atomic",
+    "write_stdout",
     "write_text_atomic",
 ]
 
 #: The output name that means standard output.
 STDOUT = "-"
+#: Longest file name when the file system does not say (NAME_MAX of Linux, macOS, Windows), bytes.
+DEFAULT_NAME_MAX = 255
+#: Characters of randomness ``tempfile.mkstemp`` puts in a name.
+_RANDOM_CHARS = 8
+
+_stdout_closed = False
+
+
+def guard_standard_streams() -> None:
+    """Make a closed standard input, output or error harmless (``rrtpso ... >&-``).
+
+    A closed descriptor 0, 1 or 2 is pointed at the null device, so that no file this process
+    opens later takes its number (OMPL's messages to standard output would land in a results
+    file). A closed standard output is remembered: writing to it (``--json -``) is then refused
+    (:func:`stdout_closed`). A closed standard error becomes the null device, so messages are
+    dropped instead of falling through to standard output.
+    """
+    global _stdout_closed
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+        except OSError:
+            null = os.open(os.devnull, os.O_RDWR)
+            if null != fd:
+                os.dup2(null, fd)
+                os.close(null)
+            if fd == 1:
+                _stdout_closed = True
+                sys.stdout = None  # type: ignore[assignment]
+            elif fd == 2:
+                sys.stderr = open(fd, "w", closefd=False)  # noqa: SIM115 - for the process
+    if sys.stdout is None:
+        _stdout_closed = True
+
+
+def stdout_closed() -> bool:
+    """Whether the process was started with standard output closed (nothing can go there)."""
+    return _stdout_closed or sys.stdout is None
+
+
+def os_reason(exc: BaseException) -> str:
+    """Why an OS call failed, in the system's words (``No space left on device``)."""
+    if isinstance(exc, OutputError):
+        return exc.reason
+    if isinstance(exc, OSError) and exc.strerror:
+        return exc.strerror
+    return str(exc) or type(exc).__name__
+
+
+def write_stdout(text: str) -> None:
+    """Write ``text`` to standard output and flush it; OutputError when that fails."""
+    if stdout_closed():
+        raise OutputError(STDOUT, "it is closed")
+    try:
+        sys.stdout.write(text)
+        sys.stdout.flush()
+    except OSError as exc:
+        raise OutputError(STDOUT, os_reason(exc)) from None
+
+
+def name_max(folder: str | Path) -> int:
+    """The longest file name (bytes) the file system holding ``folder`` allows."""
+    try:
+        return int(os.pathconf(folder, "PC_NAME_MAX"))
+    except (OSError, ValueError, AttributeError):
+        return DEFAULT_NAME_MAX
 
 
 def is_stream(path: str | Path) -> bool:
@@ -64,6 +146,8 @@ def _resolved(path: str | Path) -> Path:
 def publish(tmp: str | Path, path: str | Path) -> None:
     """Move a finished temporary file to ``path`` by the rules of the module docstring."""
     if str(path) == STDOUT:
+        if stdout_closed():
+            raise OutputError(STDOUT, "it is closed")
         with open(tmp, "rb") as src:
             sys.stdout.flush()
             shutil.copyfileobj(src, sys.stdout.buffer)
@@ -93,23 +177,70 @@ def atomic_path(path: str | Path, suffix: str | None = None) -> Iterator[str]:
 
     The temporary file lies beside the (resolved) target, so the final rename is atomic; for a
     stream target it lies in the system's temporary folder. Its name ends in ``suffix`` (default:
-    ``path``'s), for writers that choose the format by it (matplotlib, Pillow).
+    ``path``'s), for writers that choose the format by it (matplotlib, Pillow), and is cut to the
+    file system's name limit.
+
+    Raises
+    ------
+    OutputError
+        When the temporary file cannot be made, written or published (an ``OSError`` of the
+        block included: the block only writes ``tmp``); ``tmp`` is removed first.
     """
     name = Path(path)
-    if is_stream(path):
-        folder = None
-    else:
-        folder = _resolved(path).parent
-        folder.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{name.stem or 'out'}.",
-                               suffix=suffix or name.suffix or ".tmp", dir=folder)  # fmt: skip
-    os.close(fd)
+    tmp = None
+    made: list[Path] = []
     try:
+        if is_stream(path):
+            folder = Path(tempfile.gettempdir())
+        else:
+            folder = _resolved(path).parent
+            made = make_folders(folder)
+        prefix, end = _temp_affixes(name, suffix, name_max(folder))
+        fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=end, dir=folder)
+        os.close(fd)
         yield tmp
         publish(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+    except BaseException as exc:
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        remove_folders(made)
+        if isinstance(exc, OSError) and not isinstance(exc, OutputError):
+            raise OutputError(str(path), os_reason(exc)) from None
         raise
+
+
+def make_folders(folder: str | Path) -> list[Path]:
+    """Create ``folder`` and its missing parents; the ones created, deepest first (for
+    :func:`remove_folders` when what was to go into them could not be written)."""
+    made = []
+    p = Path(folder)
+    while not os.path.lexists(p) and p.parent != p:
+        made.append(p)
+        p = p.parent
+    Path(folder).mkdir(parents=True, exist_ok=True)
+    return made
+
+
+def remove_folders(made: list[Path]) -> None:
+    """Remove the folders :func:`make_folders` created, if still empty (nothing empty is left
+    behind by a write that failed)."""
+    for p in made:
+        try:
+            os.rmdir(p)
+        except OSError:
+            return  # not empty (something else was written there) or gone: keep the rest
+
+
+def _temp_affixes(name: Path, suffix: str | None, limit: int) -> tuple[str, str]:
+    """The prefix and suffix of a temporary name for ``name``: ``.<stem>.`` and its suffix, the
+    stem cut so that the whole (with mkstemp's random characters) fits in ``limit`` bytes."""
+    end = suffix or name.suffix or ".tmp"
+    if len(os.fsencode(end)) > limit // 4:  # a suffix that long names no format: drop it
+        end = ".tmp"
+    room = limit - _RANDOM_CHARS - len(os.fsencode(end)) - 2
+    stem = os.fsencode(name.stem or "out")[: max(room, 0)]
+    return f".{os.fsdecode(stem)}.", end
 
 
 def write_text_atomic(text: str, path: str | Path) -> Path:

@@ -12,6 +12,7 @@ from .common import (
     Output,
     RunProgress,
     add_run_options,
+    batch_inputs,
     check_outputs,
     check_planners,
     check_run_options,
@@ -59,10 +60,7 @@ def run(args: argparse.Namespace) -> int:
     check_run_options(args)
     planners = planner_list(args.planner, "RRTstarPSO")
     params = check_planners(planners, args.param, "--planner")
-    from ..evaluation import expand_inputs
-
-    inputs = [path for path, error in expand_inputs(args.inputs) if error is None]
-    check_outputs([Output("--out", args.out)], inputs)
+    check_outputs([Output("--out", args.out)], batch_inputs(args.inputs))
     tasks = make_tasks(
         args.inputs,
         planners,

@@ -15,6 +15,7 @@ from .common import (
     Output,
     RunProgress,
     add_run_options,
+    batch_inputs,
     check_outputs,
     check_planners,
     check_positive_seconds,
@@ -74,10 +75,8 @@ def run(args: argparse.Namespace) -> int:
     check_run_options(args)
     planners = planner_list(args.planner, "")
     params = check_planners(planners, args.param, "--planner")
-    from ..evaluation import expand_inputs
-
     out = Path(args.out)
-    inputs = [path for path, error in expand_inputs(args.inputs) if error is None]
+    inputs = batch_inputs(args.inputs)
     check_outputs([Output("--out", args.out, "folder")], inputs)
     # No input may be one of the files the bench writes into the folder.
     written = ["runs.jsonl", *OUTPUT_FILES]

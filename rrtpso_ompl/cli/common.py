@@ -9,7 +9,9 @@ file and its key, or the flag); :func:`rrtpso_ompl.cli.main` turns it into exit 
 from __future__ import annotations
 
 import argparse
+import errno
 import os
+import stat
 import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -18,7 +20,8 @@ from typing import Any
 
 from ..errors import ParameterError, UnknownPlannerError, UsageError
 from ..model import Problem, load_problem
-from ..outputs import STDOUT
+from ..model.yamlfile import file_kind
+from ..outputs import STDOUT, is_stream, name_max, os_reason, stdout_closed
 from ..validation import check_seconds, check_seed
 
 __all__ = [
@@ -31,6 +34,7 @@ __all__ = [
     "RunProgress",
     "add_run_options",
     "add_shared_flags",
+    "batch_inputs",
     "check_output",
     "check_outputs",
     "check_planners",
@@ -230,10 +234,13 @@ class Output:
 def check_outputs(outputs: Sequence[Output], inputs: Sequence[str | Path] = ()) -> None:
     """Refuse outputs that cannot be written, before any time is spent planning.
 
-    Refused: an empty name; standard output (``-``) for an image or folder, or for two outputs;
-    a folder where a file goes (or a file where a folder goes); a parent that is a file or not
-    writable; an image suffix matplotlib cannot write; an output that is one of the inputs (it
-    would be destroyed) or the same file as another output (one would be lost).
+    Refused: an empty name; standard output (``-``) for an image or folder, for two outputs, or
+    when it is closed; a folder where a file goes (or a file where a folder goes); a parent that
+    is a file, not writable, or a symbolic link loop; a name longer than the file system allows;
+    an existing target that is neither a regular file nor a stream (a socket, a block device);
+    an image suffix matplotlib cannot write; an output that is one of the inputs (it would be
+    destroyed: pass every file a problem reads, :attr:`~rrtpso_ompl.model.Problem.inputs`) or the
+    same file as another output (one would be lost).
     """
     given = [o for o in outputs if o.path is not None]
     targets: dict[str, str] = {}
@@ -259,16 +266,31 @@ def _check_one(out: Output) -> None:
     if path == STDOUT:
         if out.kind != "text":
             raise UsageError(f"{flag}: '-' (standard output) is only for text outputs")
+        if stdout_closed():
+            raise UsageError(f"{flag}: standard output is closed; nothing can be written there")
         return
-    target = Path(path)
-    if out.kind == "folder":
-        if target.exists() and not target.is_dir():
-            raise UsageError(f"{flag}: '{path}' exists and is not a directory")
-    elif target.is_dir():
-        raise UsageError(f"{flag}: '{path}' is a directory")
-    parent = Path(os.path.realpath(target)).parent
-    while not parent.exists():
-        parent = parent.parent  # missing folders are created when the file is written
+    try:
+        _check_place(out)
+    except OSError as exc:  # a loop of links, a parent that is a file, ...
+        raise UsageError(f"{flag}: cannot write '{path}': {os_reason(exc)}") from None
+
+
+def _check_place(out: Output) -> None:
+    """The checks of :func:`_check_one` on the file system (they may raise OSError)."""
+    path, flag = out.path, out.flag
+    target = Path(os.path.realpath(path))  # where it is written: links are written through
+    parent = _nearest_existing(target)
+    _check_names(target, parent, flag, path)
+    if parent == target:
+        mode = os.stat(target).st_mode
+        if out.kind == "folder":
+            if not stat.S_ISDIR(mode):
+                raise UsageError(f"{flag}: '{path}' exists and is not a directory")
+        elif stat.S_ISDIR(mode):
+            raise UsageError(f"{flag}: '{path}' is a directory")
+        elif not (stat.S_ISREG(mode) or is_stream(target)):
+            raise UsageError(f"{flag}: '{path}' is {file_kind(mode)}; it is left as it is")
+        parent = target.parent if out.kind != "folder" else target
     if not parent.is_dir():
         raise UsageError(f"{flag}: cannot write '{path}': '{parent}' is a file, not a directory")
     if not os.access(parent, os.W_OK):
@@ -277,13 +299,53 @@ def _check_one(out: Output) -> None:
         from ..plotting import image_formats
 
         kinds = image_formats()
-        if target.suffix.lower().lstrip(".") not in kinds:
+        if Path(path).suffix.lower().lstrip(".") not in kinds:
             raise UsageError(
                 f"{flag}: cannot draw '{path}': use one of the suffixes "
                 f"{', '.join('.' + k for k in sorted(kinds))}"
             )
-    if out.kind == "gif" and target.suffix.lower() != ".gif":
+    if out.kind == "gif" and Path(path).suffix.lower() != ".gif":
         raise UsageError(f"{flag}: '{path}' must end in .gif")
+
+
+def _nearest_existing(path: Path) -> Path:
+    """``path`` or its nearest ancestor that exists (missing folders are created when the file is
+    written); OSError when one cannot be looked at (a loop of links, a file as a folder)."""
+    while True:
+        try:
+            os.stat(path)
+            return path
+        except OSError as exc:
+            # Missing, below a file (said below), or a name too long to exist (_check_names).
+            if exc.errno not in (errno.ENOENT, errno.ENOTDIR, errno.ENAMETOOLONG):
+                raise
+            if path.parent == path:
+                raise
+            path = path.parent
+
+
+def _check_names(target: Path, existing: Path, flag: str, path: str) -> None:
+    """Every name still to be made (the file, missing folders) fits the file system's limit, and
+    the whole path fits the system's; checked here so that nothing fails after planning."""
+    limit = name_max(existing if existing.is_dir() else existing.parent)
+    for part in target.relative_to(existing).parts:
+        size = len(os.fsencode(part))
+        if size > limit:
+            short = part if len(part) <= 40 else f"{part[:20]}...{part[-12:]}"
+            raise UsageError(
+                f"{flag}: cannot write '{short}': the name is {size} bytes long, and the file "
+                f"system allows at most {limit}"
+            )
+    try:
+        path_max = int(os.pathconf(existing if existing.is_dir() else existing.parent,
+                                   "PC_PATH_MAX"))  # fmt: skip
+    except (OSError, ValueError):
+        path_max = 4096
+    if len(os.fsencode(str(target))) >= path_max:
+        raise UsageError(
+            f"{flag}: cannot write '{path[:40]}...': the path is longer than the system allows "
+            f"({path_max} bytes)"
+        )
 
 
 def _same_file(a: str | Path, b: str | Path) -> bool:
@@ -389,6 +451,16 @@ def check_run_options(args: argparse.Namespace) -> None:
             raise UsageError(
                 "--executor dask: Dask is not installed: pip install 'rrtpso-ompl[dask]'"
             ) from None
+
+
+def batch_inputs(items: Sequence[str]) -> list[str]:
+    """Every file the problems of a batch or bench read (:func:`check_outputs`' ``inputs``): the
+    problem files and their maps' YAML and images, found without loading the problems."""
+    from ..evaluation import expand_inputs
+    from ..model.problem import input_files
+
+    files = (input_files(path) for path, error in expand_inputs(items) if error is None)
+    return list(dict.fromkeys(f for group in files for f in group))
 
 
 def check_planners(names: list[str], items: list[str], flag: str) -> dict[str, dict[str, str]]:

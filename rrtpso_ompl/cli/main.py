@@ -1,7 +1,9 @@
 """The ``rrtpso`` command line: one module per subcommand over the package's public API.
 
 Exit status: 0 success, 1 no valid path (or the subcommand's own "not achieved"), 2 bad input or
-usage (one message on stderr, no traceback, nothing written), 130 interrupted.
+usage (one message on stderr, no traceback, nothing written) or an output that could not be
+written (the disk is full, standard output or its pipe is closed: one message naming the output
+and the reason; the old file is intact), 130 interrupted.
 """
 
 from __future__ import annotations
@@ -13,7 +15,8 @@ import os
 import sys
 from collections.abc import Sequence
 
-from ..errors import RrtpsoError
+from ..errors import OutputError, RrtpsoError
+from ..outputs import STDOUT, guard_standard_streams, os_reason, stdout_closed
 from . import batch, bench, generate, optimum, planners, simulate, solve
 from .common import EXIT_BAD_INPUT, EXIT_INTERRUPTED, add_shared_flags, set_quiet
 
@@ -39,6 +42,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
+    guard_standard_streams()  # before any file is opened: `rrtpso ... >&-`
     args = build_parser().parse_args(argv)
     args.argv = list(sys.argv[1:] if argv is None else argv)
     set_quiet(args.quiet)
@@ -47,8 +51,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         format="%(levelname)s: %(name)s: %(message)s",
     )
     try:
-        return args.func(args)
+        status = args.func(args)
+        _flush_stdout()
+        return status
     except RrtpsoError as exc:  # bad input of any kind: its message names where it came from
+        if isinstance(exc, OutputError) and exc.path == STDOUT:
+            _silence_stdout()  # what is still buffered for it cannot be written either
         return _fail(f"rrtpso: error: {exc}", EXIT_BAD_INPUT)
     except KeyboardInterrupt:
         return _fail("rrtpso: interrupted", EXIT_INTERRUPTED)
@@ -71,10 +79,20 @@ def _fail(message: str, status: int) -> int:
     return status
 
 
+def _flush_stdout() -> None:
+    """Flush standard output now, so that a failure is one message, not Python's at exit."""
+    if stdout_closed():
+        return
+    try:
+        sys.stdout.flush()
+    except OSError as exc:
+        raise OutputError(STDOUT, os_reason(exc)) from None
+
+
 def _silence_stdout() -> None:
     """Point stdout at /dev/null, so that Python's final flush does not raise again."""
     devnull = os.open(os.devnull, os.O_WRONLY)
-    os.dup2(devnull, sys.stdout.fileno())
+    os.dup2(devnull, 1)
     os.close(devnull)
 
 

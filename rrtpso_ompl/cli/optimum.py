@@ -30,9 +30,9 @@ def run(args: argparse.Namespace) -> int:
     from ..evaluation import shortest_path
     from ..model import load_problem
 
-    check_outputs([Output("--json", args.json), Output("--plot", args.plot, "image")],
-                  inputs=[args.problem])  # fmt: skip
     problem = load_problem(args.problem)
+    check_outputs([Output("--json", args.json), Output("--plot", args.plot, "image")],
+                  inputs=problem.inputs)  # fmt: skip
     result = shortest_path(problem)
     if args.plot:
         from ..plotting import plot_optimum, save_figure

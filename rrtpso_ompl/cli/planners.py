@@ -6,6 +6,7 @@ import argparse
 import json
 from typing import Any
 
+from ..outputs import write_stdout
 from .common import EXIT_OK
 
 __all__ = ["add_parser", "run"]
@@ -29,19 +30,21 @@ def run(args: argparse.Namespace) -> int:
     registry = default_registry()
     entries = [registry.get(args.name)] if args.name else registry.entries()
     if args.json:
-        print(json.dumps([_entry_dict(e) for e in entries], indent=2))
+        write_stdout(json.dumps([_entry_dict(e) for e in entries], indent=2) + "\n")
         return EXIT_OK
+    lines = []
     for e in entries:
         aliases = f"  (also: {', '.join(e.aliases)})" if e.aliases else ""
-        print(f"{e.name}{aliases}\n    {e.description}  [{e.source}]")
+        lines.append(f"{e.name}{aliases}\n    {e.description}  [{e.source}]")
         for p in e.params:
             unit = f" {p.unit}" if p.unit else ""
-            print(
+            lines.append(
                 f"    {p.name:<28} {p.type.__name__:<5} default {p.default!s:<8}{unit} "
                 f"in {p.range_text()}"
             )
             if args.name:
-                print(f"        {p.doc}")
+                lines.append(f"        {p.doc}")
+    write_stdout("".join(f"{line}\n" for line in lines))  # one message if it cannot be written
     return EXIT_OK
 
 

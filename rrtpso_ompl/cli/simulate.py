@@ -106,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
         Output("--plot", args.plot, "image"),
         Output("--gif", args.gif, "gif"),
     ]
-    check_outputs(outputs, inputs=[args.problem])
+    check_outputs(outputs, inputs=problem.inputs)
 
     from ..dynamic import DynamicOptions, simulate
 

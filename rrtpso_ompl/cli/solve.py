@@ -110,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
         Output("--trajectory", args.trajectory),
         Output("--plot-velocities", args.plot_velocities, "image"),
     ]
-    check_outputs(outputs, inputs=[args.problem])
+    check_outputs(outputs, inputs=problem.inputs)
     wants_motion = bool(args.trajectory or args.plot_velocities)
     if wants_motion:
         _check_drive_keys(args, problem)

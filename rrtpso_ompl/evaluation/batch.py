@@ -14,6 +14,7 @@ by the parent as they finish, one whole line per write, to a locked results file
 from __future__ import annotations
 
 import glob
+import hashlib
 import time
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -22,11 +23,14 @@ from typing import Any
 
 from ..errors import ProblemError, RrtpsoError
 from ..model.occupancy import is_map_yaml
-from .results_file import ResultsFile, latest_rows, read_rows, row_key
+from ..model.problem import input_files
+from ..model.yamlfile import open_input
+from .results_file import ResultsFile, latest_rows, read_rows, resolved_source, row_key
 
 __all__ = [
     "Task",
     "expand_inputs",
+    "inputs_digest",
     "make_tasks",
     "read_rows",
     "run_batch",
@@ -54,11 +58,15 @@ class Task:
     keep_path: bool = True
     progress: bool = False
     error: str | None = None
+    source: str | None = None
+    digest: str | None = None
 
     @property
     def key(self) -> tuple[str, str, int, float | None]:
-        """Identifies the row in a results file (for resuming)."""
-        return (self.file, self.planner, self.seed, self.time_limit)
+        """Identifies the row in a results file (for resuming): the problem file resolved
+        (:func:`~rrtpso_ompl.evaluation.results_file.row_key`), however it was spelled."""
+        source = self.source if self.source is not None else resolved_source(self.file)
+        return (source, self.planner, self.seed, self.time_limit)
 
 
 def expand_inputs(items: Sequence[str]) -> list[tuple[str, str | None]]:
@@ -67,15 +75,17 @@ def expand_inputs(items: Sequence[str]) -> list[tuple[str, str | None]]:
     Returns
     -------
     list of (path, error)
-        In the order given, without repeats; ``error`` says why an item gave no file (it becomes an
-        error row, so a batch never stops for one bad argument).
+        In the order given, without repeats (one file named twice, however spelled or linked,
+        comes once, as first named); ``error`` says why an item gave no file (it becomes an error
+        row, so a batch never stops for one bad argument).
     """
     out: list[tuple[str, str | None]] = []
     seen: set[str] = set()
 
     def add(path: str, error: str | None = None) -> None:
-        if path not in seen:
-            seen.add(path)
+        key = resolved_source(path) if error is None else path  # one file, however spelled
+        if key not in seen:
+            seen.add(key)
             out.append((path, error))
 
     for item in items:
@@ -121,6 +131,8 @@ def make_tasks(
     """
     tasks = []
     for path, error in expand_inputs(items):
+        source = resolved_source(path) if error is None else None
+        digest = inputs_digest(path) if error is None else None
         for planner in planners:
             for r in range(runs):
                 tasks.append(
@@ -135,9 +147,36 @@ def make_tasks(
                         keep_path=keep_path,
                         progress=progress,
                         error=error,
+                        source=source,
+                        digest=digest,
                     )
                 )
     return tasks
+
+
+#: Most bytes of one input file hashed by :func:`inputs_digest`: more than any reader reads.
+_DIGEST_BYTES = 1 << 30
+
+
+def inputs_digest(path: str) -> str:
+    """SHA-256 of a problem file and the map files it reads (its ``inputs_sha256``): a resumed
+    batch runs again the runs of a file whose content changed since its rows were written.
+
+    A file that cannot be read counts as such (its run reports why).
+    """
+    h = hashlib.sha256()
+    for file in input_files(path):
+        size = 0
+        try:
+            with open_input(file) as fh:
+                while size < _DIGEST_BYTES and (chunk := fh.read(min(_DIGEST_BYTES - size,
+                                                                    1 << 20))):  # fmt: skip
+                    h.update(chunk)
+                    size += len(chunk)
+        except (ValueError, OSError) as exc:
+            h.update(f"unreadable: {exc}".encode())
+        h.update(f"\0{size}\0".encode())  # where one file ends and the next begins
+    return h.hexdigest()
 
 
 # ----------------------------------------------------------------------------------------------
@@ -202,7 +241,8 @@ def run_task(task: Task) -> dict[str, Any]:
 
 def _base_row(task: Task) -> dict[str, Any]:
     return {"file": task.file, "planner": task.planner, "seed": task.seed, "run": task.run,
-            "budget": task.time_limit}  # fmt: skip
+            "budget": task.time_limit, "source": task.key[0],
+            "inputs_sha256": task.digest}  # fmt: skip
 
 
 def error_row(task: Task, message: str) -> dict[str, Any]:
@@ -346,8 +386,8 @@ def run_batch(
         raise ValueError("the dask executor needs a scheduler address")
     with ResultsFile(out, resume=resume, overwrite=overwrite) as results:
         kept = [r for r in results.kept if not r.get("error")]
-        done = {row_key(r) for r in kept}
-        todo = [t for t in tasks if t.key not in done]
+        done = {row_key(r): r.get("inputs_sha256") for r in kept}
+        todo = [t for t in tasks if not _done(t, done)]
         if on_start is not None:
             on_start(len(todo), len(tasks) - len(todo))
         rows = list(kept)
@@ -367,6 +407,15 @@ def run_batch(
         finally:
             stream.close()  # on Ctrl-C: stop the workers before the file is released
     return latest_rows(rows)
+
+
+def _done(task: Task, done: Mapping[tuple[Any, ...], str | None]) -> bool:
+    """Whether a kept row is the task's run, of the same problem content (rows written before
+    rows had ``inputs_sha256`` match on the key alone)."""
+    if task.key not in done:
+        return False
+    digest = done[task.key]
+    return digest is None or task.digest is None or digest == task.digest
 
 
 class _Optima:

@@ -47,7 +47,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import UsageError
-from ..outputs import atomic_path, write_text_atomic
+from ..outputs import atomic_path, make_folders, remove_folders, write_text_atomic
 from ..planners.result import BenchmarkRun
 from .batch import Task, make_tasks, run_batch
 from .ompl_log import Experiment, PlannerRuns, build_database, write_log
@@ -209,12 +209,16 @@ def run_bench(
         writing it, or it holds an earlier bench and neither ``resume`` nor ``overwrite`` is given.
     """
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     _check_out_dir(out)
     tasks = bench_tasks(items, planners, runs, times, seed, params, simplify)
-    rows = run_batch(tasks, out / "runs.jsonl", jobs=jobs, resume=resume, overwrite=overwrite,
-                     executor=executor, scheduler=scheduler, progress=progress,
-                     on_start=on_start)  # fmt: skip
+    made = make_folders(out)
+    try:
+        rows = run_batch(tasks, out / "runs.jsonl", jobs=jobs, resume=resume,
+                         overwrite=overwrite, executor=executor, scheduler=scheduler,
+                         progress=progress, on_start=on_start)  # fmt: skip
+    except BaseException:
+        remove_folders(made)  # a folder made for a bench that wrote nothing
+        raise
     errors = sorted({r["error"] for r in rows if r.get("error")})
     good = [r for r in rows if not r.get("error")]
     experiments = to_experiments(good, planners, runs, seed)
@@ -306,8 +310,13 @@ def _planner_properties(rows: Iterable[Mapping[str, Any]]) -> list[tuple[str, st
     return RUN_PROPERTIES + [(n, own[n]) for n in sorted(own) if n not in _COMMON_NAMES]
 
 
+#: Longest problem part of an experiment's name (ASCII): its log file's name, with the budget, a
+#: ``_2`` suffix and ``.log``, stays within the 255 bytes file systems allow.
+_NAME_CHARS = 200
+
+
 def _experiment_name(problem: str, budget: float) -> str:
-    word = re.sub(r"[^A-Za-z0-9_.-]+", "_", problem or "problem")
+    word = re.sub(r"[^A-Za-z0-9_.-]+", "_", problem or "problem")[:_NAME_CHARS]
     return f"{word}_{budget:g}s"
 
 
@@ -319,12 +328,14 @@ def to_experiments(
 ) -> list[Experiment]:
     """Group rows (not error rows) into one experiment per problem and budget."""
     groups: dict[tuple[str, float], list[Mapping[str, Any]]] = defaultdict(list)
-    for r in rows:
-        groups[(r["file"], float(r.get("budget") or r.get("time_limit") or 0.0))].append(r)
+    for r in rows:  # one problem file, however its rows spelled it (``source``: resolved)
+        file = r.get("source") or r["file"]
+        groups[(file, float(r.get("budget") or r.get("time_limit") or 0.0))].append(r)
     names: dict[str, int] = {}
     experiments = []
     host = re.sub(r"\s+", "_", socket.gethostname()) or "localhost"
-    for (file, budget), group in sorted(groups.items(), key=lambda kv: (kv[0][1], kv[0][0])):
+    for (_, budget), group in sorted(groups.items(), key=lambda kv: (kv[0][1], kv[0][0])):
+        file = group[0]["file"]  # as the command line named it
         name = _experiment_name(group[0].get("problem") or Path(file).stem, budget)
         names[name] = names.get(name, 0) + 1
         if names[name] > 1:  # two files with the same problem name

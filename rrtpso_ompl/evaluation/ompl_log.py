@@ -71,6 +71,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import OutputError
 from ..outputs import atomic_path, write_text_atomic
 
 __all__ = [
@@ -609,6 +610,8 @@ def build_database(
         If a log does not exist.
     RuntimeError
         If the converter fails (the message holds the end of its stderr).
+    OutputError
+        If the database cannot be written (SQLite says so: the disk is full, ...).
     """
     if isinstance(logs, (str, os.PathLike)):
         logs = [logs]
@@ -627,6 +630,9 @@ def build_database(
             check=False,
         )
         if proc.returncode != 0:
+            failed = re.search(r"^sqlite3\.OperationalError: (.+)$", proc.stderr, re.MULTILINE)
+            if failed:  # the database could not be written (a full disk): not the logs' fault
+                raise OutputError(str(db), failed.group(1).strip())
             raise RuntimeError(
                 f"OMPL's benchmark log converter failed (exit code {proc.returncode}) on "
                 f"{', '.join(map(str, log_paths))}:\n{_stderr_tail(proc.stderr)}"

@@ -7,14 +7,22 @@
   runs still to do (an error row is retried, and the retry's row comes later: the last row of a
   run counts, :func:`latest_rows`). A torn last line (a batch killed mid-write) is cut off.
 - **Only ours.** A file that is not empty is continued only with ``resume`` and started afresh
-  only with ``overwrite``, and either only when every line is a row of this package; anything
-  else (notes, another program's output, a stray ``{"keep": 1}``) is refused, never touched.
+  only with ``overwrite``, and either only when it is a results file: every line a row of this
+  package, and an unterminated last line only when it is the beginning of one (rows are written
+  ``file`` first: :data:`ROW_START`). Anything else (notes, another program's output, a stray
+  ``{"keep": 1}``, binary data, a file of blank lines) is refused, never touched. ``overwrite``
+  empties the file only when the first new row is ready, and puts the earlier rows back if that
+  row cannot be written, so a batch that fails before its first row leaves them as they were.
+- **Nothing left behind.** A row that cannot be written (the disk is full) is cut back off, so
+  the file stays valid line by line, and the batch ends with an
+  :class:`~rrtpso_ompl.errors.OutputError`; a file the batch created and left empty is removed.
 - **Streams.** ``-`` (standard output), a fifo or a character device is written as a stream: no
   lock, nothing to resume.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import sys
@@ -22,18 +30,41 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any, BinaryIO
 
-from ..errors import UsageError
-from ..outputs import STDOUT, is_stream, json_line
+from ..errors import OutputError, UsageError
+from ..outputs import (
+    STDOUT,
+    is_stream,
+    json_line,
+    make_folders,
+    os_reason,
+    remove_folders,
+    stdout_closed,
+)
 
 try:  # advisory locks; absent on Windows, where a second writer is not detected
     import fcntl
 except ImportError:  # pragma: no cover - platform dependent
     fcntl = None  # type: ignore[assignment]
 
-__all__ = ["ROW_KEYS", "ResultsFile", "is_row", "latest_rows", "read_rows", "row_key"]
+__all__ = [
+    "ROW_KEYS",
+    "ROW_START",
+    "ResultsFile",
+    "is_row",
+    "is_torn_row",
+    "latest_rows",
+    "read_rows",
+    "resolved_source",
+    "row_key",
+]
 
 #: Keys every row of a batch has (error rows included): what makes a line recognisably ours.
 ROW_KEYS = ("file", "planner", "seed", "run", "status")
+#: How every row's line begins (:meth:`ResultsFile.append` puts ``file`` first): an unterminated
+#: last line is a row cut short only when it begins so, or is a beginning of this.
+ROW_START = b'{"file": '
+#: Attempts at opening and locking the file while other batches create and remove it.
+_OPEN_ATTEMPTS = 10
 
 
 def is_row(obj: Any) -> bool:
@@ -41,9 +72,34 @@ def is_row(obj: Any) -> bool:
     return isinstance(obj, dict) and all(k in obj for k in ROW_KEYS)
 
 
+def is_torn_row(tail: bytes) -> bool:
+    """Whether an unterminated last line is a row of this package cut short (by a kill)."""
+    try:
+        obj = json.loads(tail)
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        return tail.startswith(ROW_START) or ROW_START.startswith(tail)
+    return is_row(obj)  # a whole row whose newline was not written
+
+
+def resolved_source(file: str) -> str:
+    """A problem file's path resolved: absolute, links followed (the ``source`` of its rows)."""
+    try:
+        return os.path.realpath(file)
+    except (OSError, ValueError):
+        return file
+
+
 def row_key(row: Mapping[str, Any]) -> tuple[Any, ...]:
-    """What identifies a run: ``(file, planner, seed, budget)``."""
-    return (row.get("file"), row.get("planner"), row.get("seed"), row.get("budget"))
+    """What identifies a run: ``(source, planner, seed, budget)``.
+
+    ``source`` is the problem file resolved (:func:`resolved_source`), so that ``probs/p.yaml``
+    and ``/abs/probs/p.yaml`` name the same run; a row written before rows had ``source`` is
+    resolved from its ``file`` (relative to the working directory).
+    """
+    source = row.get("source")
+    if source is None and isinstance(row.get("file"), str):
+        source = resolved_source(row["file"])
+    return (source, row.get("planner"), row.get("seed"), row.get("budget"))
 
 
 def latest_rows(rows: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
@@ -89,6 +145,14 @@ class ResultsFile:
         How the command line names the file (``--out``), for messages.
 
     Use as a context manager; :attr:`kept` holds the rows kept from the file (with ``resume``).
+
+    Raises
+    ------
+    UsageError
+        On entering: the file is being written by another batch, is not a results file, or holds
+        rows and neither ``resume`` nor ``overwrite`` is given.
+    OutputError
+        The file cannot be opened, or (:meth:`append`) a row cannot be written.
     """
 
     def __init__(self, path: str | Path, *, resume: bool = False, overwrite: bool = False,
@@ -100,6 +164,11 @@ class ResultsFile:
         self.kept: list[dict[str, Any]] = []
         self._fh: BinaryIO | None = None
         self._fd: int | None = None
+        self._target: Path | None = None
+        self._created = False  # the file did not exist before this batch
+        self._made: list[Path] = []  # the folders made for it
+        self._empty_first = False  # --overwrite: empty the file before the first new row
+        self._earlier = b""  # --overwrite: what the file held, until a new row is written
 
     # -- opening -------------------------------------------------------------------------------
     def __enter__(self) -> ResultsFile:
@@ -107,21 +176,56 @@ class ResultsFile:
             if self.resume:
                 raise UsageError(f"{self.flag} {self.path}: a stream cannot be resumed")
             if self.path == STDOUT:
+                if stdout_closed():
+                    raise OutputError(STDOUT, "it is closed")
                 self._fh = sys.stdout.buffer
-            else:
-                self._fh = open(os.path.realpath(self.path), "wb")
+                return self
+            try:
+                self._fh = open(os.path.realpath(self.path), "wb")  # closed on exit
+            except OSError as exc:
+                raise OutputError(self.path, os_reason(exc)) from None
             return self
         target = Path(os.path.realpath(self.path))
-        target.parent.mkdir(parents=True, exist_ok=True)
-        self._fd = os.open(target, os.O_RDWR | os.O_CREAT | os.O_APPEND, 0o666)
         try:
-            self._lock()
+            self._made = make_folders(target.parent)
+            self._open(target)
+        except OSError as exc:  # OutputError included
+            remove_folders(self._made)
+            raise OutputError(self.path, os_reason(exc)) from None
+        try:
             self.kept = self._take_over()
-        except BaseException:
-            os.close(self._fd)
-            self._fd = None
+        except BaseException as exc:
+            self._close()
+            if isinstance(exc, OSError) and not isinstance(exc, OutputError):
+                raise OutputError(self.path, os_reason(exc)) from None
             raise
         return self
+
+    def _open(self, target: Path) -> None:
+        """Open and lock ``target``, creating it when absent (and remembering that we did)."""
+        flags = os.O_RDWR | os.O_APPEND | getattr(os, "O_CLOEXEC", 0)
+        for _ in range(_OPEN_ATTEMPTS):
+            try:
+                self._fd = os.open(target, flags | os.O_CREAT | os.O_EXCL, 0o666)
+                self._created = True
+            except FileExistsError:
+                try:
+                    self._fd = os.open(target, flags)
+                except FileNotFoundError:
+                    continue  # removed in between (another batch's empty file): create it
+                self._created = False
+            self._target = target
+            try:
+                self._lock()
+            except BaseException:
+                self._created = False  # not ours to remove: another batch holds it
+                self._close()
+                raise
+            if self._names_our_file():
+                return
+            self._created = False
+            self._close()  # removed or replaced before we held the lock: open it again
+        raise OSError(0, "other batches keep creating and removing this file")
 
     def _lock(self) -> None:
         if fcntl is None:
@@ -134,25 +238,45 @@ class ResultsFile:
                 "wait for it to finish or choose another file"
             ) from None
 
+    def _names_our_file(self) -> bool:
+        """Whether the path still names the file we hold (not one removed meanwhile)."""
+        try:
+            ours, now = os.fstat(self._fd), os.stat(self._target)
+        except OSError:
+            return False
+        return (ours.st_dev, ours.st_ino) == (now.st_dev, now.st_ino)
+
     def _take_over(self) -> list[dict[str, Any]]:
         """Check what the file holds and prepare it for appending; the rows to keep."""
         content = self._read()
-        if not content.strip():
-            os.ftruncate(self._fd, 0)
-            return []
+        if not content:
+            return []  # a new or empty file: nothing to lose
         complete, _, torn = content.rpartition(b"\n")
-        rows = self._rows(complete.split(b"\n") if complete else [])
+        lines = complete.split(b"\n") if complete else []
+        rows = self._rows(lines)
+        if torn and not is_torn_row(torn):
+            self._refuse(f"its last line, {len(lines) + 1}, is not one of its rows")
+        if not rows and not torn:
+            self._refuse("it holds blank lines only")
         if not (self.resume or self.overwrite):
+            cut = " (and a row cut short)" if torn else ""
             raise UsageError(
-                f"{self.flag} {self.path}: the file already holds {len(rows)} rows of an earlier "
-                "run; continue them with --resume or start afresh with --overwrite"
+                f"{self.flag} {self.path}: the file already holds {len(rows)} rows{cut} of an "
+                "earlier run; continue them with --resume or start afresh with --overwrite"
             )
         if self.overwrite:
-            os.ftruncate(self._fd, 0)
+            self._empty_first = True  # when the first new row is ready, not before
+            self._earlier = content  # put back if that row cannot be written
             return []
         if torn:  # a batch killed mid-write: drop the half line, its run runs again
-            os.ftruncate(self._fd, len(complete) + 1 if complete else 0)
+            os.ftruncate(self._fd, len(content) - len(torn))
         return latest_rows(rows)
+
+    def _refuse(self, why: str) -> None:
+        raise UsageError(
+            f"{self.flag} {self.path}: not a results file of rrtpso batch or bench ({why}); it is "
+            "left as it is: choose another file"
+        )
 
     def _read(self) -> bytes:
         chunks = []
@@ -172,29 +296,71 @@ class ResultsFile:
             except (json.JSONDecodeError, UnicodeDecodeError):
                 obj = None
             if not is_row(obj):
-                raise UsageError(
-                    f"{self.flag} {self.path}: not a results file of rrtpso batch or bench (line "
-                    f"{number} is not one of its rows); it is left as it is: choose another file"
-                )
+                self._refuse(f"line {number} is not one of its rows")
             rows.append(obj)
         return rows
 
     # -- writing -------------------------------------------------------------------------------
     def append(self, row: Mapping[str, Any]) -> None:
-        """Write one row as one whole line."""
+        """Write one row as one whole line, ``file`` first (:data:`ROW_START`).
+
+        Raises
+        ------
+        OutputError
+            When the line cannot be written (the disk is full, the reader of a stream went away);
+            a file is cut back to the rows before it, so it stays valid line by line.
+        """
+        if "file" in row and next(iter(row)) != "file":
+            row = {"file": row["file"], **row}
         data = json_line(row).encode("utf-8")
         if self._fh is not None:
-            self._fh.write(data)
-            self._fh.flush()
+            try:
+                self._fh.write(data)
+                self._fh.flush()
+            except OSError as exc:
+                raise OutputError(self.path, os_reason(exc)) from None
             return
+        start, earlier = None, b""
+        try:
+            if self._empty_first:  # --overwrite: the earlier rows go now that a new one is here
+                earlier, self._earlier = self._earlier, b""
+                self._empty_first = False
+                os.ftruncate(self._fd, 0)
+            start = os.fstat(self._fd).st_size
+            self._write(data)
+        except OSError as exc:
+            with contextlib.suppress(OSError):
+                if start is not None:
+                    os.ftruncate(self._fd, start)  # no torn line left behind
+                if earlier:  # the first new row failed: the earlier rows stay after all
+                    try:
+                        self._write(earlier)
+                    except OSError:
+                        os.ftruncate(self._fd, 0)  # valid, if empty
+            raise OutputError(self.path, os_reason(exc)) from None
+
+    def _write(self, data: bytes) -> None:
         view = memoryview(data)
         while view:
             view = view[os.write(self._fd, view) :]
 
     def __exit__(self, *exc: Any) -> None:
-        if self._fd is not None:
-            os.close(self._fd)  # closing releases the lock
-            self._fd = None
-        if self._fh is not None and self._fh is not sys.stdout.buffer:
-            self._fh.close()
+        self._close()
+        if self._fh is not None and self._fh is not getattr(sys.stdout, "buffer", None):
+            with contextlib.suppress(OSError):  # a failed write has said so already
+                self._fh.close()
         self._fh = None
+
+    def _close(self) -> None:
+        """Release the file (closing releases the lock); one we created and left empty goes."""
+        if self._fd is None:
+            return
+        try:
+            if self._created and os.fstat(self._fd).st_size == 0 and self._names_our_file():
+                os.unlink(self._target)
+                remove_folders(self._made)
+        except OSError:
+            pass  # the file stays, empty and valid
+        finally:
+            os.close(self._fd)
+            self._fd = None

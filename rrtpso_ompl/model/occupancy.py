@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 import re
 import warnings
 from dataclasses import dataclass, field
@@ -46,7 +47,7 @@ import numpy as np
 
 from ..errors import ProblemError
 from ..validation import MAX_COORDINATE, describe
-from .yamlfile import read_yaml_file
+from .yamlfile import open_input, read_yaml_file
 
 __all__ = [
     "MAX_CELLS",
@@ -54,6 +55,7 @@ __all__ = [
     "OccupancyMap",
     "is_map_yaml",
     "load_map",
+    "map_image_path",
     "merge_cells",
     "read_pgm",
 ]
@@ -269,7 +271,9 @@ def load_map(path: str | Path, unknown_blocks: bool = True) -> OccupancyMap:
         raise ProblemError(
             source, "mode", f"must be one of {', '.join(MODES)}, got {describe(mode)}"
         )
-    image_path = (path.parent / image).resolve() if not Path(image).is_absolute() else Path(image)
+    if "\0" in image:
+        raise ProblemError(source, "image", "the file name holds a NUL byte")
+    image_path = map_image_path(path, image)
     grey, alpha, maxval = _read_image(source, image_path)
     state = _states(grey, alpha, maxval, mode, bool(negate), occ, free)
     return OccupancyMap(
@@ -284,6 +288,14 @@ def load_map(path: str | Path, unknown_blocks: bool = True) -> OccupancyMap:
         occupied_thresh=occ,
         free_thresh=free,
     )
+
+
+def map_image_path(map_yaml: str | Path, image: str) -> Path:
+    """The image a map YAML's ``image`` names: relative to the YAML's folder, resolved (absolute,
+    links followed; a symbolic link loop stays as written, for the reader to report)."""
+    if Path(image).is_absolute():
+        return Path(image)
+    return Path(os.path.realpath(Path(map_yaml).parent / image))
 
 
 def _get(doc: dict, key: str) -> Any:
@@ -322,11 +334,12 @@ def _states(grey, alpha, maxval: int, mode: str, negate: bool, occ: float, free:
 # ----------------------------------------------------------------------------------------------
 def _read_image(source: str, path: Path) -> tuple[np.ndarray, np.ndarray | None, int]:
     """Grey values (H, W), alpha (H, W) or None, and the grey maxval, of a map image."""
-    if not path.is_file():
-        raise ProblemError(source, "image", f"no such image file: {path}")
     try:
-        with path.open("rb") as fh:
+        with open_input(path) as fh:  # a regular file, or why not
             head = fh.read(2)
+    except ValueError as exc:
+        what = f"no such image file: {path}" if str(exc) == "no such file" else f"{path} {exc}"
+        raise ProblemError(source, "image", what) from None
     except OSError as exc:
         raise ProblemError(source, "image", f"cannot read {path}: {exc.strerror or exc}") from None
     if head in (b"P2", b"P5"):

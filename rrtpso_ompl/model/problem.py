@@ -13,6 +13,7 @@ from __future__ import annotations
 import difflib
 import math
 import numbers
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,7 +33,7 @@ from ..validation import (
     describe,
 )
 from .format import MAP, MOVING, OBSTACLES, PLANNER, ROBOT, TOP
-from .occupancy import OccupancyMap, load_map
+from .occupancy import OccupancyMap, load_map, map_image_path
 from .yamlfile import read_yaml_file
 
 #: Why coordinates and lengths are bounded (for messages).
@@ -48,7 +49,9 @@ __all__ = [
     "ProblemError",
     "Robot",
     "clearance_threshold",
+    "input_files",
     "load_problem",
+    "map_file_path",
     "problem_from_dict",
     "touch_tolerance",
 ]
@@ -173,6 +176,16 @@ class Problem:
         outside = _outside(self.bounds, self.map.extent)
         return np.vstack([boxes, outside]) if len(outside) else boxes
 
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        """The files the problem was read from, resolved (absolute, links followed): the problem
+        file, and its map's YAML and image; none for a problem built from a mapping. No output
+        may be one of them (the command line refuses it before planning)."""
+        files = [] if self.source.startswith("<") else [self.source]
+        if self.map is not None:
+            files += [self.map.source, self.map.image]
+        return tuple(dict.fromkeys(os.path.realpath(f) for f in files))
+
 
 def load_problem(path: str | Path) -> Problem:
     """Read and validate a problem file.
@@ -198,6 +211,34 @@ def load_problem(path: str | Path) -> Problem:
     path = Path(path)
     data = read_yaml_file(path)
     return problem_from_dict(data, source=str(path), name=path.stem, base=path.parent)
+
+
+def input_files(path: str | Path) -> tuple[str, ...]:
+    """The files a problem file reads, resolved (as :attr:`Problem.inputs`), found without
+    loading it: the file, and the map YAML and image it names.
+
+    Best effort and quick (no image is decoded, nothing is validated): it stops at the first file
+    that cannot be read, which loading the problem reports.
+    """
+    files = [Path(path)]
+    try:
+        doc = read_yaml_file(path)
+        value = doc.get("map") if isinstance(doc, Mapping) else None
+        file = value.get("file") if isinstance(value, Mapping) else value
+        if isinstance(file, str) and file.strip() and "\0" not in file:
+            map_yaml = map_file_path(file, Path(path).parent)
+            files.append(map_yaml)
+            image = read_yaml_file(map_yaml).get("image")
+            if isinstance(image, str) and image.strip() and "\0" not in image:
+                files.append(map_image_path(map_yaml, image))
+    except (ProblemError, AttributeError):
+        pass  # an unreadable file or map, or not a mapping: its run reports it
+    return tuple(dict.fromkeys(os.path.realpath(f) for f in files))
+
+
+def map_file_path(file: str, base: Path) -> Path:
+    """The map YAML a problem's ``map`` names: relative to ``base``, the problem's folder."""
+    return Path(file) if Path(file).is_absolute() else base / file
 
 
 def problem_from_dict(
@@ -479,12 +520,14 @@ class _Validator:
             doc: Mapping[str, Any] = {"file": value}
         else:
             doc = self.mapping(value, key, _MAP_KEYS, required=MAP.required())
-        file = self.string(doc["file"], f"{key}.file" if not isinstance(value, str) else key)
+        doc_key = f"{key}.file" if not isinstance(value, str) else key
+        file = self.string(doc["file"], doc_key)
         unknown = _get(doc, "unknown", "obstacle")
         if unknown not in ("obstacle", "free"):
             raise self.error(f"{key}.unknown", f"must be obstacle or free, got {describe(unknown)}")
-        path = Path(file) if Path(file).is_absolute() else base / file
-        return load_map(path, unknown_blocks=unknown == "obstacle")
+        if "\0" in file:
+            raise self.error(doc_key, "the file name holds a NUL byte")
+        return load_map(map_file_path(file, base), unknown_blocks=unknown == "obstacle")
 
     def moving(self, value: Any, key: str) -> MovingObstacle:
         doc = self.mapping(value, key, _MOVING_KEYS, required=_MOVING_KEYS)

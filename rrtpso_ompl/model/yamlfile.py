@@ -12,19 +12,33 @@ Caps, so that no input can make the reader run out of time or memory:
 - aliases may expand the document to at most :data:`MAX_EXPANDED_NODES` values (a "billion
   laughs" file of ten nested aliases would expand to 10**10); recursive aliases are refused;
 - messages echo at most a few dozen characters of a value.
+
+Only regular files are read (:func:`open_input`, also for map images): a fifo would block the
+reader forever, a device such as ``/dev/zero`` never ends, and a directory cannot be read; each
+is refused with a message that says what it is.
 """
 
 from __future__ import annotations
 
+import errno
+import os
+import stat
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import yaml
 
 from ..errors import ProblemError
 from ..validation import short_repr
 
-__all__ = ["MAX_EXPANDED_NODES", "MAX_FILE_BYTES", "load_yaml", "read_yaml_file"]
+__all__ = [
+    "MAX_EXPANDED_NODES",
+    "MAX_FILE_BYTES",
+    "file_kind",
+    "load_yaml",
+    "open_input",
+    "read_yaml_file",
+]
 
 #: Largest YAML file read, bytes.
 MAX_FILE_BYTES = 64 * 2**20
@@ -38,15 +52,64 @@ MAX_DEPTH = 100
 _BaseLoader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
+def file_kind(mode: int) -> str:
+    """What a file of ``st_mode`` is, in words (``a fifo``, ``a directory``, ...)."""
+    for test, kind in (
+        (stat.S_ISREG, "a regular file"),
+        (stat.S_ISDIR, "a directory"),
+        (stat.S_ISFIFO, "a fifo (named pipe)"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    ):
+        if test(mode):
+            return kind
+    return "not a regular file"
+
+
+def open_input(path: str | Path) -> BinaryIO:
+    """Open an input file for reading, if it is a regular file.
+
+    Opened without blocking, then checked: a fifo is refused without waiting for a writer, a
+    device or a directory without reading it.
+
+    Raises
+    ------
+    ValueError
+        Saying why not, in words for a message after the file's name: ``no such file``, ``is a
+        fifo (named pipe), not a regular file``, ``is a symbolic link loop``, ``its name holds a
+        NUL byte``, ``cannot read it: Permission denied``.
+    """
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    except ValueError:  # os.open's "embedded null byte"
+        raise ValueError("its name holds a NUL byte") from None
+    except FileNotFoundError:
+        raise ValueError("no such file") from None
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise ValueError("is a symbolic link loop") from None
+        if exc.errno == errno.EISDIR:
+            raise ValueError("is a directory, not a regular file") from None
+        raise ValueError(f"cannot read it: {exc.strerror or exc}") from None
+    mode = os.fstat(fd).st_mode
+    if not stat.S_ISREG(mode):
+        os.close(fd)
+        raise ValueError(f"is {file_kind(mode)}, not a regular file")
+    if hasattr(os, "set_blocking"):
+        os.set_blocking(fd, True)
+    return os.fdopen(fd, "rb")
+
+
 def read_yaml_file(path: str | Path) -> Any:
     """The parsed document of a YAML file (UTF-8); ProblemError for anything unreadable."""
     path = Path(path)
     source = str(path)
     try:
-        with path.open("rb") as fh:
+        with open_input(path) as fh:
             raw = fh.read(MAX_FILE_BYTES + 1)
-    except FileNotFoundError:
-        raise ProblemError(source, "", "no such file") from None
+    except ValueError as exc:
+        raise ProblemError(source, "", str(exc)) from None
     except OSError as exc:
         raise ProblemError(source, "", f"cannot read the file: {exc.strerror or exc}") from None
     if len(raw) > MAX_FILE_BYTES:

@@ -29,10 +29,19 @@ def _limit() -> None:
     resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
 
 
-def run(*args, cwd: Path, timeout: float = 120, **kwargs) -> subprocess.CompletedProcess:
-    proc = subprocess.run([*rrtpso_exe(), *map(str, args)], cwd=cwd, capture_output=True,
-                          text=True, timeout=timeout, preexec_fn=_limit, **kwargs)  # fmt: skip
-    assert "Traceback" not in proc.stderr, proc.stderr
+def run(*args, cwd: Path, timeout: float = 120, before=None,
+        **kwargs) -> subprocess.CompletedProcess:  # fmt: skip
+    """``rrtpso *args`` in a child; ``before`` runs in the child before the command starts."""
+
+    def setup() -> None:
+        _limit()
+        if before is not None:
+            before()
+
+    kwargs.setdefault("capture_output", True)
+    proc = subprocess.run([*rrtpso_exe(), *map(str, args)], cwd=cwd, text=True, timeout=timeout,
+                          preexec_fn=setup, **kwargs)  # fmt: skip
+    assert "Traceback" not in (proc.stderr or ""), proc.stderr
     return proc
 
 
@@ -317,3 +326,429 @@ def test_generate_never_replaces_a_file_unasked(folder):
     assert (folder / "p.yaml").read_text() == before
     proc = run("generate", "circles", "--seed", "1", "--out", "p.yaml", "--overwrite", cwd=folder)
     assert proc.returncode == 0 and (folder / "p.yaml").read_text() != before
+
+
+# ----------------------------------------------------------------------------------------------
+# Never touch what is the user's (issue 22)
+# ----------------------------------------------------------------------------------------------
+def snapshot(folder: Path) -> dict[str, bytes | str]:
+    """Every entry under ``folder``: a file's bytes, a link's target, or what else it is."""
+    out: dict[str, bytes | str] = {}
+    for p in sorted(folder.rglob("*")):
+        key = str(p.relative_to(folder))
+        if p.is_symlink():
+            out[key] = "-> " + os.readlink(p)
+        elif p.is_fifo():
+            out[key] = "fifo"
+        elif p.is_dir():
+            out[key] = "dir"
+        else:
+            out[key] = p.read_bytes()
+    return out
+
+
+@pytest.fixture
+def maps(folder: Path) -> Path:
+    """``folder`` with the map problems (maps/) and a moving-obstacle problem on a map
+    (dynamic/office_people.yaml, whose map is ../maps/grids/office.yaml)."""
+    import shutil
+
+    shutil.copytree(PROBLEMS / "maps", folder / "maps")
+    (folder / "dynamic").mkdir()
+    shutil.copy(PROBLEMS / "dynamic" / "office_people.yaml", folder / "dynamic")
+    (folder / "image-link.pgm").symlink_to("maps/grids/office.pgm")
+    os.link(folder / "maps/grids/office.pgm", folder / "hard-link.pgm")
+    return folder
+
+
+MAP_AS_OUTPUT = [
+    ("solve", "maps/office_corridor.yaml", "--json", "maps/grids/office.pgm"),
+    ("solve", "maps/office_corridor.yaml", "--json", "maps/grids/office.yaml"),
+    ("solve", "maps/office_corridor.yaml", "--path-out", "maps/grids/office.yaml"),
+    ("solve", "maps/office_corridor.yaml", "--trajectory", "image-link.pgm"),
+    ("solve", "maps/office_corridor.yaml", "--json", "hard-link.pgm"),
+    ("solve", "maps/lab_clutter.yaml", "--plot", "maps/grids/lab.png"),
+    ("optimum", "maps/office_corridor.yaml", "--json", "maps/grids/office.yaml"),
+    ("optimum", "maps/lab_clutter.yaml", "--plot", "maps/grids/lab.png"),
+    ("simulate", "dynamic/office_people.yaml", "--json", "maps/grids/office.yaml"),
+    ("simulate", "dynamic/office_people.yaml", "--plot", "image-link.pgm.png"),
+]
+
+
+@pytest.mark.parametrize("args", MAP_AS_OUTPUT, ids=lambda a: f"{a[0]} {a[2]} {a[3]}")
+def test_map_files_are_inputs_and_never_outputs(maps, args):
+    if args[-1] == "image-link.pgm.png":  # a link named like an image, to the map's image
+        (maps / "image-link.pgm.png").symlink_to("maps/grids/office.pgm")
+    before = snapshot(maps)
+    extra = ["--time", "0.1"] if args[0] != "optimum" else []
+    proc = run(*args, *extra, cwd=maps)
+    assert proc.returncode == 2 and f"{args[2]}: '{args[3]}' is an input" in proc.stderr, (
+        proc.stderr
+    )
+    assert snapshot(maps) == before
+
+
+def test_batch_and_bench_refuse_map_files_as_outputs(maps):
+    before = snapshot(maps)
+    proc = run("batch", "maps/office_corridor.yaml", "--out", "image-link.pgm", cwd=maps)
+    assert proc.returncode == 2 and "is an input" in proc.stderr, proc.stderr
+    # The bench writes report.md and others into --out: a map image of one of those names.
+    (maps / "b").mkdir()
+    (maps / "b/runs.jsonl").write_text("")
+    (maps / "b/ratio.png").symlink_to("../maps/grids/lab.png")
+    before = snapshot(maps)
+    proc = run("bench", "maps/lab_clutter.yaml", "--planner", "RRTConnect", "--runs", "1",
+               "--time", "0.1", "--out", "b", cwd=maps)  # fmt: skip
+    assert proc.returncode == 2 and "'b/ratio.png' is an input" in proc.stderr, proc.stderr
+    assert snapshot(maps) == before
+
+
+#: Files that are not results files of this program (item 2 of issue 22).
+ROW = b'{"file": "p.yaml", "planner": "RRTConnect", "seed": 1, "run": 0, "status": "exact"}\n'
+FOREIGN = {
+    "notes": b"my notes",
+    "keep": b'{"keep": 1}',
+    "binary": bytes(b for b in range(256) if b != 10),
+    "blank-lines": b"\n\n",
+    "rows-then-foreign": ROW + b'{"foreign": 2',
+    "row-then-text": ROW + b"total: 1 run",
+    "notes-with-newline": b"my notes\n",
+}
+
+
+@pytest.mark.parametrize("flag", ["--resume", "--overwrite", None])
+@pytest.mark.parametrize("name", list(FOREIGN))
+def test_files_that_are_not_results_files_are_never_continued_or_replaced(folder, name, flag):
+    (folder / "r.jsonl").write_bytes(FOREIGN[name])
+    before = snapshot(folder)
+    proc = run("batch", "p.yaml", "--planner", "RRTConnect", "--time", "0.05", "--out",
+               "r.jsonl", *([flag] if flag else []), cwd=folder)  # fmt: skip
+    assert proc.returncode == 2 and "not a results file" in proc.stderr, proc.stderr
+    assert snapshot(folder) == before
+
+
+def test_a_bench_never_takes_over_a_runs_file_it_did_not_write(folder):
+    (folder / "b").mkdir()
+    for content in (b"my notes", b'{"keep": 1}\n', ROW + b"garbage"):
+        (folder / "b/runs.jsonl").write_bytes(content)
+        before = snapshot(folder)
+        for flag in ("--resume", "--overwrite"):
+            proc = run("bench", "p.yaml", "--planner", "RRTConnect", "--runs", "1", "--time",
+                       "0.05", "--out", "b", flag, cwd=folder)  # fmt: skip
+            assert proc.returncode == 2 and "not a results file" in proc.stderr, proc.stderr
+            assert snapshot(folder) == before
+
+
+def test_a_results_file_of_ours_cut_short_is_continued(folder):
+    # A batch killed in its first write: the start of one row, no newline.
+    (folder / "r.jsonl").write_bytes(ROW[:30])
+    proc = run("batch", "p.yaml", "--planner", "RRTConnect", "--time", "0.05", "--out", "r.jsonl",
+               cwd=folder)  # fmt: skip
+    assert proc.returncode == 2 and "0 rows (and a row cut short)" in proc.stderr, proc.stderr
+    proc = run("batch", "p.yaml", "--planner", "RRTConnect", "--time", "0.05", "--out", "r.jsonl",
+               "--resume", cwd=folder)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert len(rows_of(folder / "r.jsonl")) == 1
+
+
+def test_resume_knows_a_file_however_it_is_spelled(folder):
+    (folder / "probs").mkdir()
+    (folder / "probs/p.yaml").write_text(CIRCLE)
+    (folder / "link.yaml").symlink_to("probs/p.yaml")
+    common = ["--planner", "RRTConnect", "--runs", "2", "--time", "0.05", "--out", "r.jsonl"]
+    assert run("batch", "probs/p.yaml", *common, cwd=folder).returncode == 0
+    spellings = (folder / "probs/p.yaml", "./probs/p.yaml", "link.yaml", "probs/../probs/p.yaml")
+    for spelling in spellings:
+        proc = run("batch", spelling, *common, "--resume", cwd=folder)
+        assert proc.returncode == 0 and "2 rows already done" in proc.stderr, proc.stderr
+        assert len(rows_of(folder / "r.jsonl")) == 2
+    # One file named twice is one set of runs.
+    proc = run("batch", "probs/p.yaml", str(folder / "probs/p.yaml"), "link.yaml", *common[:-1],
+               "twice.jsonl", cwd=folder)  # fmt: skip
+    assert proc.returncode == 0 and len(rows_of(folder / "twice.jsonl")) == 2
+
+
+def test_resume_runs_again_what_an_edited_problem_file_would_change(folder):
+    common = ["--planner", "RRTConnect", "--runs", "2", "--time", "0.05", "--out", "r.jsonl"]
+    assert run("batch", "p.yaml", *common, cwd=folder).returncode == 0
+    first = rows_of(folder / "r.jsonl")
+    assert len({r["inputs_sha256"] for r in first}) == 1
+    (folder / "p.yaml").write_text(CIRCLE.replace("radius: 80", "radius: 60"))
+    proc = run("batch", "p.yaml", *common, "--resume", cwd=folder)
+    assert proc.returncode == 0 and "already done" not in proc.stderr, proc.stderr
+    rows = rows_of(folder / "r.jsonl")
+    assert len(rows) == 4 and rows[2]["inputs_sha256"] != first[0]["inputs_sha256"]
+    from rrtpso_ompl.evaluation import read_rows
+
+    assert [r["inputs_sha256"] for r in read_rows(folder / "r.jsonl")] == [
+        rows[2]["inputs_sha256"]
+    ] * 2
+
+
+# -- writes that fail -------------------------------------------------------------------------
+def _close_stdout() -> None:
+    os.close(1)
+
+
+def _close_stderr() -> None:
+    os.close(2)
+
+
+def _file_size_limit(size: int = 64):
+    """Files of the child may not grow past ``size`` bytes: a write beyond fails (EFBIG), as on a
+    full disk (which only a real file system can be, not /dev/full)."""
+
+    def limit() -> None:
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (size, size))
+
+    return limit
+
+
+TO_STDOUT = [
+    ["solve", "p.yaml", "--time", "0.05", "--json", "-"],
+    ["optimum", "p.yaml", "--json", "-"],
+    ["generate", "circles", "--seed", "1", "--n", "3", "--out", "-"],
+    ["batch", "p.yaml", "--planner", "RRTConnect", "--time", "0.05", "--out", "-"],
+    ["planners"],
+]
+
+
+@pytest.mark.parametrize("args", TO_STDOUT, ids=lambda a: a[0])
+def test_a_full_or_closed_standard_output_is_one_message(folder, args):
+    before = snapshot(folder)
+    with open("/dev/full", "w") as full:
+        proc = run(*args, cwd=folder, stdout=full, stderr=subprocess.PIPE, capture_output=False)
+    assert proc.returncode == 2, proc.stderr
+    assert "standard output: cannot write: No space left on device" in proc.stderr
+    assert proc.stderr.count("\n") == 1  # one message, not Python's at exit too
+    proc = run(*args, cwd=folder, before=_close_stdout)
+    assert proc.returncode == 2 and "standard output" in proc.stderr and "closed" in proc.stderr
+    assert proc.stderr.count("\n") == 1, proc.stderr
+    assert snapshot(folder) == before
+
+
+@pytest.mark.parametrize("args", TO_STDOUT[:4], ids=lambda a: a[0])
+def test_a_reader_that_went_away_is_one_message(folder, args):
+    proc = subprocess.Popen([*rrtpso_exe(), *args], cwd=folder, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, preexec_fn=_limit)  # fmt: skip
+    proc.stdout.close()  # before the command has imported anything, let alone written
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) == 2 and "Traceback" not in err, err
+    assert err == "rrtpso: error: standard output: cannot write: Broken pipe\n"
+
+
+def test_closed_standard_streams_change_nothing_else(folder):
+    # stdout closed: the results file must not take its place (OMPL writes to descriptor 1).
+    proc = run("batch", "-v", "p.yaml", "--planner", "RRTConnect", "--time", "0.05", "--out",
+               "r.jsonl", cwd=folder, before=_close_stdout)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert len(rows_of(folder / "r.jsonl")) == 1
+    proc = run("solve", "p.yaml", "--time", "0.05", "--json", "s.json", cwd=folder,
+               before=_close_stdout)  # fmt: skip
+    assert proc.returncode == 0 and json.loads((folder / "s.json").read_text())["solved"]
+    # stderr closed: the summary line must not fall through into the JSON on stdout.
+    proc = run("solve", "p.yaml", "--time", "0.05", "--json", "-", cwd=folder,
+               before=_close_stderr)  # fmt: skip
+    assert proc.returncode == 0 and json.loads(proc.stdout)["solved"]
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["solve", "p.yaml", "--time", "0.05", "--json", "/dev/full"],
+        ["solve", "p.yaml", "--time", "0.05", "--trajectory", "/dev/full"],
+        ["optimum", "p.yaml", "--json", "/dev/full"],
+        ["batch", "p.yaml", "--planner", "RRTConnect", "--time", "0.05", "--out", "/dev/full"],
+    ],
+    ids=lambda a: f"{a[0]} {a[-2]}",
+)
+def test_a_full_device_is_one_message(folder, args):
+    proc = run(*args, cwd=folder)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.strip() == "rrtpso: error: /dev/full: cannot write: No space left on device"
+
+
+SHORT_DYNAMIC = DYNAMIC.replace("goal: [470, 250]", "goal: [90, 250]")
+#: Commands whose one output cannot be written; the second item: whether an old file is there.
+WRITES = [
+    (["solve", "p.yaml", "--json", "out.json"], True),
+    (["solve", "p.yaml", "--plot", "out.png"], True),
+    (["solve", "p.yaml", "--trajectory", "out.csv"], True),
+    (["solve", "p.yaml", "--path-out", "out.yaml"], True),
+    (["simulate", "s.yaml", "--gif", "out.gif"], True),
+    (["optimum", "p.yaml", "--json", "out.json"], True),
+    (["generate", "circles", "--seed", "1", "--overwrite", "--out", "out.yaml"], True),
+    (["solve", "p.yaml", "--json", "new/folder/out.json"], False),
+    (["batch", "p.yaml", "--planner", "RRTConnect", "--out", "new.jsonl"], False),
+    (["batch", "p.yaml", "--planner", "RRTConnect", "--out", "new/r.jsonl"], False),
+    (["bench", "p.yaml", "--planner", "RRTConnect", "--runs", "1", "--out", "nb"], False),
+]
+
+
+@pytest.mark.parametrize(("args", "old"), WRITES, ids=[f"{a[0]} {a[-1]}" for a, _ in WRITES])
+def test_a_write_that_fails_leaves_the_old_file_and_nothing_else(folder, args, old):
+    (folder / "s.yaml").write_text(SHORT_DYNAMIC)
+    if old:  # an existing file: it must survive whole
+        (folder / args[-1]).write_text("old\n")
+    if args[0] in ("solve", "simulate", "batch", "bench"):
+        args = [*args, "--time", "0.05"]
+    before = snapshot(folder)
+    proc = run(*args, cwd=folder, before=_file_size_limit())
+    assert proc.returncode == 2, proc.stderr
+    assert "cannot write: File too large" in proc.stderr and proc.stderr.count("\n") == 1
+    assert snapshot(folder) == before  # no temporary file, no empty file or folder
+
+
+def test_a_resumed_or_replaced_results_file_survives_a_failed_write(folder):
+    common = ["batch", "p.yaml", "--planner", "RRTConnect", "--time", "0.05", "--out", "r.jsonl"]
+    assert run(*common, "--no-path", cwd=folder).returncode == 0
+    before = snapshot(folder)
+    # Room for the rows there are, not for a row with a path: the first new row fails.
+    room = _file_size_limit(len(before["r.jsonl"]) + 16)
+    for flag in ("--resume", "--overwrite"):
+        proc = run(*common, "--runs", "3", flag, cwd=folder, before=room)
+        assert proc.returncode == 2 and "r.jsonl: cannot write: File too large" in proc.stderr
+        assert snapshot(folder) == before, flag
+
+
+def test_a_bench_whose_database_cannot_be_written_keeps_its_runs(folder):
+    args = ["bench", "p.yaml", "--planner", "RRTConnect", "--runs", "1", "--time", "0.05",
+            "--out", "b"]  # fmt: skip
+    # Room for the runs and the log (about 1 kB each), not for the database (about 37 kB).
+    proc = run(*args, cwd=folder, before=_file_size_limit(20_000))
+    assert proc.returncode == 2, proc.stderr
+    assert "b/benchmark.db: cannot write: " in proc.stderr and proc.stderr.count("\n") == 1
+    assert sorted(p.name for p in (folder / "b").iterdir()) == [
+        "runs.jsonl",
+        "single_circle_0.05s.log",
+    ]  # no temporary database
+    proc = run(*args, "--resume", cwd=folder)
+    assert proc.returncode == 0 and "1 runs already done" in proc.stderr, proc.stderr
+    assert (folder / "b" / "benchmark.db").exists()
+
+
+def test_a_full_disk_is_one_message(folder):
+    """A real full file system: a 64 KiB tmpfs (in a user namespace, where one may be mounted)."""
+    import shlex
+    import shutil
+
+    unshare = shutil.which("unshare")
+    small = folder / "small"
+    small.mkdir()
+    exe = shlex.join(rrtpso_exe())
+    script = (
+        f"mount -t tmpfs -o size=64k tmpfs {shlex.quote(str(small))} || exit 77; "
+        f"cd {shlex.quote(str(folder))}; echo old > small/r.json; "
+        "head -c 100000 /dev/zero > small/fill; "
+        f"{exe} solve p.yaml --time 0.05 --json small/r.json; echo status=$?; "
+        f"{exe} batch p.yaml --planner RRTConnect --time 0.05 --out small/b.jsonl; echo status=$?;"
+        f" {exe} bench p.yaml --planner RRTConnect --time 0.05 --runs 1 --out small/b; "
+        "echo status=$?; cat small/r.json; ls -A small"
+    )
+    if unshare is None:
+        pytest.skip("no unshare")
+    proc = subprocess.run([unshare, "--user", "--map-root-user", "--mount", "sh", "-c", script],
+                          capture_output=True, text=True, timeout=300)  # fmt: skip
+    if proc.returncode == 77 or "unshare:" in proc.stderr:
+        pytest.skip(f"cannot mount a tmpfs here: {proc.stderr.strip()[:200]}")
+    assert "Traceback" not in proc.stderr, proc.stderr
+    assert proc.stdout.split() == ["status=2", "status=2", "status=2", "old", "fill", "r.json"]
+    assert "small/r.json: cannot write: No space left on device" in proc.stderr
+    assert "small/b.jsonl: cannot write: No space left on device" in proc.stderr
+
+
+# -- names too long for the file system ------------------------------------------------------
+@pytest.mark.parametrize("size", [246, 250, 255])
+def test_the_longest_names_are_written(folder, size):
+    name = "a" * (size - 5) + ".json"
+    proc = run("solve", "p.yaml", "--time", "0.05", "--json", name, cwd=folder)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads((folder / name).read_text())["solved"]
+    assert sorted(p.name for p in folder.iterdir()) == sorted([name, "p.yaml", "d.yaml"])
+
+
+@pytest.mark.parametrize(
+    ("flag", "out"),
+    [
+        ("--json", "a" * 256 + ".json"),
+        ("--plot", "b" * 300 + ".png"),
+        ("--trajectory", "new/" + "c" * 256 + "/t.csv"),
+        ("--out", "d" * 256 + ".jsonl"),
+    ],
+    ids=["json", "plot", "folder", "batch"],
+)
+def test_names_too_long_are_refused_before_planning(folder, flag, out):
+    command = "batch" if flag == "--out" else "solve"
+    before = snapshot(folder)
+    proc = run(command, "p.yaml", "--time", "0.05", flag, out, cwd=folder)
+    # "--json: ..." is the check before planning (a failed write after it names the file).
+    assert proc.returncode == 2 and f"{flag}: cannot write" in proc.stderr, proc.stderr
+    assert "bytes long, and the file system allows at most 255" in proc.stderr
+    assert snapshot(folder) == before
+
+
+def test_a_bench_of_a_problem_with_a_long_name_writes_its_log(folder):
+    _problem(folder, "long.yaml", CIRCLE.replace("name: single_circle", "name: " + "n" * 300))
+    proc = run("bench", "long.yaml", "--planner", "RRTConnect", "--runs", "1", "--time", "0.05",
+               "--out", "b", cwd=folder)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    (log,) = (folder / "b").glob("*.log")
+    assert log.name.startswith("nnnn") and len(log.name) <= 255
+
+
+# -- inputs that are not regular files -------------------------------------------------------
+MAP_YAML = "image: {image}\nresolution: 1.0\norigin: [0, 0, 0]\n"
+MAP_PROBLEM = "map: m.yaml\nstart: [1, 1]\ngoal: [2, 2]\nrobot: {radius: 0.1}\n"
+
+
+@pytest.mark.parametrize(
+    ("image", "words"),
+    [
+        ("loop.png", "loop.png is a symbolic link loop"),
+        ('"a\\0b.png"', "the file name holds a NUL byte"),
+        ("sub", "sub is a directory, not a regular file"),
+        ("fifo.pgm", "fifo.pgm is a fifo (named pipe), not a regular file"),
+        ("/dev/zero", "/dev/zero is a character device, not a regular file"),
+        ("absent.png", "no such image file"),
+    ],
+    ids=["loop", "nul", "dir", "fifo", "dev-zero", "absent"],
+)
+def test_map_images_that_are_not_files_are_named_for_what_they_are(folder, image, words):
+    (folder / "loop.png").symlink_to("loop.png")
+    (folder / "sub").mkdir()
+    os.mkfifo(folder / "fifo.pgm")
+    (folder / "m.yaml").write_text(MAP_YAML.format(image=image))
+    (folder / "mp.yaml").write_text(MAP_PROBLEM)
+    for command in ("solve", "optimum"):
+        proc = run(command, "mp.yaml", cwd=folder, timeout=60)
+        assert proc.returncode == 2 and "m.yaml: image: " in proc.stderr, proc.stderr
+        assert words in proc.stderr, proc.stderr
+
+
+def test_inputs_that_are_fifos_are_refused_at_once(folder):
+    os.mkfifo(folder / "fifo.yaml")
+    for command in ("solve", "optimum", "simulate"):
+        proc = run(command, "fifo.yaml", cwd=folder, timeout=60)
+        assert proc.returncode == 2, proc.stderr
+        assert "fifo.yaml: is a fifo (named pipe), not a regular file" in proc.stderr
+    # A map YAML that is a fifo, and a batch with a fifo among its files.
+    os.mkfifo(folder / "m.yaml")
+    (folder / "mp.yaml").write_text(MAP_PROBLEM)
+    proc = run("solve", "mp.yaml", cwd=folder, timeout=60)
+    assert proc.returncode == 2 and "m.yaml: is a fifo" in proc.stderr, proc.stderr
+    proc = run("batch", "fifo.yaml", "p.yaml", "--planner", "RRTConnect", "--time", "0.05",
+               "--out", "r.jsonl", cwd=folder, timeout=120)  # fmt: skip
+    assert proc.returncode == 1
+    rows = rows_of(folder / "r.jsonl")
+    assert [bool(r["error"]) for r in rows] == [True, False]
+    assert "is a fifo" in rows[0]["error"]
+
+
+def test_an_output_inside_a_loop_of_links_is_refused(folder):
+    (folder / "loop").symlink_to("loop")
+    proc = run("solve", "p.yaml", "--time", "0.05", "--json", "loop/x.json", cwd=folder)
+    assert proc.returncode == 2, proc.stderr
+    assert "--json: cannot write 'loop/x.json': Too many levels of symbolic links" in proc.stderr
+    proc = run("batch", "p.yaml", "--time", "0.05", "--out", "loop/r.jsonl", cwd=folder)
+    assert proc.returncode == 2 and "Too many levels of symbolic links" in proc.stderr

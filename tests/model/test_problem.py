@@ -403,7 +403,7 @@ def test_missing_binary_and_directory_files(tmp_path):
     blob.write_bytes(b"\xff\xfe\x00\x01")
     with pytest.raises(ProblemError, match="cannot read"):
         load_problem(blob)
-    with pytest.raises(ProblemError, match="cannot read"):
+    with pytest.raises(ProblemError, match="is a directory, not a regular file"):
         load_problem(tmp_path)
 
 
@@ -738,3 +738,30 @@ def test_generated_yaml_documents_only_raise_problem_error(tmp_path_factory, doc
         load_problem(path)
     except ProblemError as err:
         assert str(err).startswith(f"{path}") and len(str(err)) < 600
+
+
+def test_a_problem_knows_every_file_it_was_read_from(tmp_path):
+    """Problem.inputs (after loading) and input_files (without loading) name the problem file,
+    its map YAML and the map's image, resolved through links: the outputs must avoid them all."""
+    import os
+    import shutil
+
+    from rrtpso_ompl.model.problem import input_files
+
+    shutil.copytree(PROBLEMS / "maps", tmp_path / "maps")
+    (tmp_path / "maps/link.yaml").symlink_to("office_corridor.yaml")
+    grids = tmp_path / "maps" / "grids"
+    (grids / "office.pgm").rename(grids / "real.pgm")
+    (grids / "office.pgm").symlink_to("real.pgm")
+    want = tuple(
+        os.path.realpath(p)
+        for p in (tmp_path / "maps/office_corridor.yaml", grids / "office.yaml", grids / "real.pgm")
+    )
+    assert load_problem(tmp_path / "maps/link.yaml").inputs == want
+    assert input_files(tmp_path / "maps/link.yaml") == want
+    assert load_problem(PROBLEMS / "static" / "single_circle.yaml").inputs == (
+        str(PROBLEMS / "static" / "single_circle.yaml"),
+    )
+    # Best effort: what cannot be read is left out (loading the problem reports it).
+    (tmp_path / "bad.yaml").write_text("map: [")
+    assert input_files(tmp_path / "bad.yaml") == (str(tmp_path / "bad.yaml"),)
