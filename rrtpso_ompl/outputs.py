@@ -36,6 +36,7 @@ __all__ = [
     "is_stream",
     "json_line",
     "publish",
+    "silence_stdout",
     "write_json_atomic",
     "write_text_atomic",
 ]
@@ -56,6 +57,19 @@ def is_stream(path: str | Path) -> bool:
     return stat.S_ISFIFO(mode) or stat.S_ISCHR(mode)
 
 
+def silence_stdout() -> None:
+    """Point standard output at /dev/null once its reader went away (a closed pipe).
+
+    What is still buffered or written later is dropped instead of raising BrokenPipeError again,
+    also in Python's own flush at exit (the way Python's documentation of SIGPIPE advises).
+    """
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, sys.stdout.fileno())
+    finally:
+        os.close(devnull)
+
+
 def _resolved(path: str | Path) -> Path:
     """``path`` with symbolic links followed (also a dangling link's target)."""
     return Path(os.path.realpath(path))
@@ -65,9 +79,14 @@ def publish(tmp: str | Path, path: str | Path) -> None:
     """Move a finished temporary file to ``path`` by the rules of the module docstring."""
     if str(path) == STDOUT:
         with open(tmp, "rb") as src:
-            sys.stdout.flush()
-            shutil.copyfileobj(src, sys.stdout.buffer)
-            sys.stdout.buffer.flush()
+            try:
+                sys.stdout.flush()
+                shutil.copyfileobj(src, sys.stdout.buffer)
+                sys.stdout.buffer.flush()
+            except BrokenPipeError:
+                # The reader left (`--json - | head -c 100`): its choice, not an error; the
+                # command goes on and exits with its own status (0 solved, 1 unsolved).
+                silence_stdout()
         Path(tmp).unlink(missing_ok=True)
         return
     target = _resolved(path)
