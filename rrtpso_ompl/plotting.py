@@ -530,12 +530,11 @@ def simulation_frames(
         Line2D([], [], ls=":", color="tab:blue", lw=0.8, label="sensor range"),
         trace,
         plan_line,
-        cross,
     ]  # fmt: skip
     if sim.tracks:
         key.append(Patch(color=MOVING, alpha=0.7, label="moving obstacle"))
-    if sim.replans:
-        key.append(Line2D([], [], color=DETOUR, lw=1.3, label="detour"))
+    if sim.replans:  # only what the animation will show
+        key += [cross, Line2D([], [], color=DETOUR, lw=1.3, label="detour")]
     world_legend(ax, key)
     # The longest title, so that the layout leaves room for every frame's.
     title = ax.set_title(f"{problem.name}: t = {traj[-1, 0]:5.1f} s, replans {len(sim.replans)}")

@@ -171,7 +171,15 @@ def test_every_gif_frame_has_a_legend_that_hides_nothing(simulated, tmp_path):
             draw(int(i))
             assert_legend_hides_nothing(fig, ax)
         labels = " | ".join(legend_labels(ax))
-        for words in ("robot", "sensor range", "moving obstacle", "plan ahead", "detour", "goal"):
+        for words in (
+            "robot",
+            "sensor range",
+            "moving obstacle",
+            "plan ahead",
+            "detour",
+            "goal",
+            "predicted cross point",
+        ):
             assert words in labels, labels
     finally:
         _close(fig)
