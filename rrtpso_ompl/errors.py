@@ -12,6 +12,9 @@ working for code written before the family existed.
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Iterable
+
 __all__ = [
     "GenerationError",
     "OutputError",
@@ -21,7 +24,22 @@ __all__ = [
     "RrtpsoError",
     "UnknownPlannerError",
     "UsageError",
+    "did_you_mean",
 ]
+
+
+def did_you_mean(word: str, choices: Iterable[str]) -> str:
+    """`` (did you mean 'x'?)`` for a misspelt or shortened name among ``choices``, else empty.
+
+    The one suggestion rule for keys and parameters (a problem file's ``robot.raduis``, a
+    ``--param swarm_siz=3``).
+    """
+    choices = list(choices)
+    close = difflib.get_close_matches(word, choices, n=1)
+    if not close and len(word) >= 3:
+        # difflib misses abbreviations such as `time` for `time_limit`.
+        close = [c for c in choices if c.startswith(word)][:1]
+    return f" (did you mean '{close[0]}'?)" if close else ""
 
 
 class RrtpsoError(Exception):

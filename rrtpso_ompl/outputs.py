@@ -50,6 +50,7 @@ __all__ = [
     "os_reason",
     "publish",
     "remove_folders",
+    "silence_stdout",
     "stdout_closed",
     "write_json_atomic",
     "write_stdout",
@@ -108,14 +109,30 @@ def os_reason(exc: BaseException) -> str:
 
 
 def write_stdout(text: str) -> None:
-    """Write ``text`` to standard output and flush it; OutputError when that fails."""
+    """Write ``text`` to standard output and flush it; OutputError when that fails (but a reader
+    that went away raises BrokenPipeError: the command line stops quietly then)."""
     if stdout_closed():
         raise OutputError(STDOUT, "it is closed")
     try:
         sys.stdout.write(text)
         sys.stdout.flush()
+    except BrokenPipeError:
+        raise
     except OSError as exc:
         raise OutputError(STDOUT, os_reason(exc)) from None
+
+
+def silence_stdout() -> None:
+    """Point standard output at /dev/null once its reader went away (a closed pipe).
+
+    What is still buffered or written later is dropped instead of raising BrokenPipeError again,
+    also in Python's own flush at exit (the way Python's documentation of SIGPIPE advises).
+    """
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+    finally:
+        os.close(devnull)
 
 
 def name_max(folder: str | Path) -> int:
@@ -149,9 +166,14 @@ def publish(tmp: str | Path, path: str | Path) -> None:
         if stdout_closed():
             raise OutputError(STDOUT, "it is closed")
         with open(tmp, "rb") as src:
-            sys.stdout.flush()
-            shutil.copyfileobj(src, sys.stdout.buffer)
-            sys.stdout.buffer.flush()
+            try:
+                sys.stdout.flush()
+                shutil.copyfileobj(src, sys.stdout.buffer)
+                sys.stdout.buffer.flush()
+            except BrokenPipeError:
+                # The reader left (`--json - | head -c 100`): its choice, not an error; the
+                # command goes on and exits with its own status (0 solved, 1 unsolved).
+                silence_stdout()
         Path(tmp).unlink(missing_ok=True)
         return
     target = _resolved(path)

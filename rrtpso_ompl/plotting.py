@@ -6,6 +6,7 @@ failed or interrupted plot never leaves half an image behind.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -16,10 +17,16 @@ matplotlib.use("Agg")  # files only; never open a window (CI, SSH, batch workers
 import matplotlib.pyplot as plt
 import numpy as np
 import shapely
+from matplotlib import ticker
 from matplotlib.axes import Axes
+from matplotlib.collections import PatchCollection
 from matplotlib.figure import Figure
+from matplotlib.legend import Legend
+from matplotlib.lines import Line2D
 from matplotlib.patches import Circle as CirclePatch
+from matplotlib.patches import Patch
 from matplotlib.patches import Polygon as PolygonPatch
+from matplotlib.transforms import ScaledTranslation
 
 from .model.problem import Circle, Polygon, Problem
 from .outputs import atomic_path
@@ -35,6 +42,9 @@ __all__ = [
     "plot_solution",
     "plot_velocities",
     "save_figure",
+    "simulation_frames",
+    "world_legend",
+    "world_width",
 ]
 
 OBSTACLE = "#5b6770"
@@ -43,46 +53,68 @@ RRT_COLOUR = "#8c8c8c"
 PATH_COLOUR = "#d62728"
 MOVING = "#7b3294"
 DETOUR = "#1a9641"
+START = "tab:green"
+GOAL = "tab:blue"
+#: Map cells: unknown space drawn blocked, or free (``unknown: free``).
+UNKNOWN_BLOCKED, UNKNOWN_FREE = "0.62", "0.85"
+#: One marker per planner in the benchmark figures (with its colour, so that planners whose
+#: lines coincide stay apart).
+MARKERS = ("o", "s", "^", "D", "v", "P", "X", "<", ">", "h")
 
 
-def draw_world(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> None:
+def draw_world(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> list[Any]:
     """Obstacles (filled), their safety zones (the obstacles grown by the robot radius, dashed:
-    the robot's centre must stay outside them), bounds, start and goal."""
+    the robot's centre must stay outside them), bounds, start and goal.
+
+    Returns
+    -------
+    list
+        The legend handles of what was drawn (the world's key), for :func:`world_legend`.
+    """
     r = problem.robot.radius
+    key: list[Any] = []
     if problem.map is not None:
-        draw_map(ax, problem, safety_zones=safety_zones)
+        key += draw_map(ax, problem, safety_zones=safety_zones)
+    # One collection per kind (not a patch per obstacle): 10,000 obstacles draw in a second.
+    shapes, zones = [], []
     for obs in problem.obstacles:
         if isinstance(obs, Circle):
-            ax.add_patch(CirclePatch(obs.center, obs.radius, color=OBSTACLE, zorder=2))
+            shapes.append(CirclePatch(obs.center, obs.radius))
             if safety_zones and r > 0:
-                ax.add_patch(
-                    CirclePatch(
-                        obs.center, obs.radius + r, fill=False, ls="--", lw=0.9, ec=SAFETY, zorder=1
-                    )
-                )
+                zones.append(CirclePatch(obs.center, obs.radius + r))
         elif isinstance(obs, Polygon):
-            ax.add_patch(
-                PolygonPatch(np.asarray(obs.points), closed=True, color=OBSTACLE, zorder=2)
-            )
+            shapes.append(PolygonPatch(np.asarray(obs.points), closed=True))
             if safety_zones and r > 0:
                 # Drawing only: the checks use exact distances, never this buffered outline.
                 grown = shapely.Polygon(obs.points).buffer(r, quad_segs=32)
-                ax.plot(*grown.exterior.xy, ls="--", lw=0.9, color=SAFETY, zorder=1)
+                zones.append(PolygonPatch(np.column_stack(grown.exterior.xy), closed=True))
+    if shapes:
+        ax.add_collection(PatchCollection(shapes, fc=OBSTACLE, ec=OBSTACLE, lw=1.0, zorder=2),
+                          autolim=False)  # fmt: skip
+    if zones:
+        ax.add_collection(PatchCollection(zones, fc="none", ec=SAFETY, ls="--", lw=0.9, zorder=1),
+                          autolim=False)  # fmt: skip
+    if problem.obstacles:
+        key.append(Patch(color=OBSTACLE, label="obstacle"))
+        if safety_zones and r > 0:
+            key.append(Line2D([], [], ls="--", lw=0.9, color=SAFETY,
+                              label="safety zone (robot centre stays out)"))  # fmt: skip
     (xmin, ymin), (xmax, ymax) = problem.bounds
     ax.plot([xmin, xmax, xmax, xmin, xmin], [ymin, ymin, ymax, ymax, ymin], color="k", lw=0.8)
-    ax.add_patch(CirclePatch(problem.start, r, fill=False, ec="tab:green", lw=1.0, zorder=4))
-    ax.add_patch(
-        CirclePatch(
-            problem.goal,
-            max(r, problem.goal_tolerance),
-            fill=False,
-            ec="tab:blue",
-            lw=1.0,
-            zorder=4,
-        )
-    )
-    ax.plot(*problem.start, "o", color="tab:green", zorder=5, label="start")
-    ax.plot(*problem.goal, "*", color="tab:blue", ms=11, zorder=5, label="goal")
+    goal_r = max(r, problem.goal_tolerance)
+    ax.add_patch(CirclePatch(problem.start, r, fill=False, ec=START, lw=1.0, zorder=4))
+    ax.add_patch(CirclePatch(problem.goal, goal_r, fill=False, ec=GOAL, lw=1.0, zorder=4))
+    ax.plot(*problem.start, "o", color=START, zorder=5)
+    ax.plot(*problem.goal, "*", color=GOAL, ms=11, zorder=5)
+    # A marker inside a circle, as drawn; the circle is the robot (or the goal's tolerance).
+    ring = {"ls": "", "marker": "o", "ms": 13, "mfc": "none", "mew": 1.0}
+    goal_ring = "goal tolerance" if problem.goal_tolerance > r else "robot at the goal"
+    key += [
+        (Line2D([], [], color=START, marker="o", ls="", label="start (circle: the robot)"),
+         Line2D([], [], mec=START, **ring)),
+        (Line2D([], [], color=GOAL, marker="*", ms=9, ls="", label=f"goal (circle: {goal_ring})"),
+         Line2D([], [], mec=GOAL, **ring)),
+    ]  # fmt: skip
     pad = 0.02 * max(xmax - xmin, ymax - ymin)
     ax.set_xlim(xmin - pad, xmax + pad)
     ax.set_ylim(ymin - pad, ymax + pad)
@@ -90,30 +122,66 @@ def draw_world(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> None
     unit = f" [{problem.units}]" if problem.units else ""
     ax.set_xlabel(f"x{unit}")
     ax.set_ylabel(f"y{unit}")
+    return key
 
 
-def draw_map(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> None:
+#: Room for :func:`world_legend` beside a world (inches).
+LEGEND_WIDTH = 3.0
+
+
+def world_width(problem: Problem, height: float) -> float:
+    """Width in inches of a world's panel with its legend beside it, in a figure ``height``
+    inches tall: the world keeps its aspect (a tall warehouse is narrow), within limits."""
+    (xmin, ymin), (xmax, ymax) = problem.bounds
+    aspect = (xmax - xmin) / max(ymax - ymin, 1e-12)
+    return float(np.clip((height - 1.2) * aspect, 2.5, 9.0)) + 1.0 + LEGEND_WIDTH
+
+
+def world_legend(ax: Axes, handles: list[Any], fontsize: float = 8) -> Legend:
+    """The legend of a world's axes, beside them (right, top-aligned), so that it hides nothing:
+    not the start, not the path, not an obstacle, however the world is filled.
+
+    ``handles`` are artists with labels, or tuples of artists drawn on top of each other (the
+    first one's label is used), as :func:`draw_world` returns them.
+    """
+    labels = [(h[0] if isinstance(h, tuple) else h).get_label() for h in handles]
+    return ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.02, 1.0),
+                     borderaxespad=0.0, fontsize=fontsize)  # fmt: skip
+
+
+def draw_map(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> list[Any]:
     """The occupancy grid under everything: occupied cells dark, unknown cells grey (light grey
     when ``unknown: free``), free cells white; the robot's clearance zone around the blocked
-    cells shaded.
+    cells shaded. Returns the legend handles of the kinds of cells the map has.
 
     The shading is drawing only (cells whose centre lies within the robot radius of a blocked
     cell's centre, from a Euclidean distance transform); the checks use the exact squares.
     """
+    from matplotlib.colors import to_rgb
     from scipy.ndimage import distance_transform_edt
 
     grid = problem.map
     (x0, y0), (x1, y1) = grid.extent
+    unknown = UNKNOWN_BLOCKED if grid.unknown_blocks else UNKNOWN_FREE
     rgb = np.ones((*grid.state.shape, 3))
-    rgb[grid.state == -1] = 0.62 if grid.unknown_blocks else 0.85
-    rgb[grid.state == 1] = np.array([0x5B, 0x67, 0x70]) / 255.0  # OBSTACLE
+    rgb[grid.state == -1] = to_rgb(unknown)
+    rgb[grid.state == 1] = to_rgb(OBSTACLE)
+    key: list[Any] = []
+    if (grid.state == 1).any():
+        key.append(Patch(color=OBSTACLE, label="occupied cells"))
+    if (grid.state == -1).any():
+        what = "blocked" if grid.unknown_blocks else "treated as free"
+        key.append(Patch(color=unknown, label=f"unknown space ({what})"))
     r = problem.robot.radius
     if safety_zones and r > 0 and grid.blocked.any() and not grid.blocked.all():
         near = distance_transform_edt(~grid.blocked, sampling=grid.resolution) <= r
         zone = near & ~grid.blocked
-        rgb[zone] = 0.55 * rgb[zone] + 0.45 * np.array([0xE0, 0xA0, 0x30]) / 255.0  # SAFETY
+        shade = 0.55 + 0.45 * np.asarray(to_rgb(SAFETY))  # over white, as most of the zone lies
+        rgb[zone] = 0.55 * rgb[zone] + 0.45 * np.asarray(to_rgb(SAFETY))
+        key.append(Patch(color=tuple(shade), label="clearance zone (robot centre stays out)"))
     # Image row 0 is the top of the map, as in the file.
     ax.imshow(rgb, extent=(x0, x1, y0, y1), origin="upper", interpolation="nearest", zorder=0)
+    return key
 
 
 def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> Figure:
@@ -122,14 +190,15 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
     :class:`~rrtpso_ompl.kinematics.ReferenceCurve`) adds the smooth reference the robot drives."""
     stages: dict[str, Any] = result.stages or {}
     history = stages.get("pso_history") or []
-    fig, axes = plt.subplots(
-        1, 2 if history else 1, figsize=(12 if history else 6.5, 6), squeeze=False
-    )
+    width = world_width(problem, 6.0)
+    widths = [width, 5.5] if history else [width]
+    fig, axes = plt.subplots(1, len(widths), figsize=(sum(widths), 6), squeeze=False,
+                             gridspec_kw={"width_ratios": widths})  # fmt: skip
     ax = axes[0, 0]
-    draw_world(ax, problem)
+    key = draw_world(ax, problem)
     raw = np.asarray(stages.get("rrt_path") or [], dtype=float).reshape(-1, 2)
     if len(raw):
-        ax.plot(
+        key += ax.plot(
             raw[:, 0],
             raw[:, 1],
             "o--",
@@ -141,7 +210,7 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
         )
     path = np.asarray(result.path, dtype=float).reshape(-1, 2)
     if len(path):
-        ax.plot(
+        key += ax.plot(
             path[:, 0],
             path[:, 1],
             "o-",
@@ -152,7 +221,7 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
             label=f"{result.planner} path ({result.length:.1f})",
         )
     if curve is not None:
-        ax.plot(
+        key += ax.plot(
             curve.x,
             curve.y,
             "-",
@@ -165,13 +234,16 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
     if result.length is not None:
         title += f", length {result.length:.2f}"
     ax.set_title(title)
-    ax.legend(loc="best", fontsize=8)
+    world_legend(ax, key)
     if history:
         bx = axes[0, 1]
         h = np.asarray(history, dtype=float)
         bx.plot(np.arange(len(h)), h, color=PATH_COLOUR)
+        bx.xaxis.set_major_locator(ticker.MaxNLocator(integer=True))
         bx.set_xlabel("PSO iteration (all rounds)")
-        bx.set_ylabel("best cost")
+        # The swarm's best is always collision-free, so its cost is the path length plus the
+        # turning penalty (smoothness_weight, 0 by default): a length.
+        bx.set_ylabel(f"best cost: length + turning penalty [{problem.units or 'length units'}]")
         bx.set_title("PSO best cost per iteration")
         bx.grid(alpha=0.3)
     fig.tight_layout()
@@ -181,15 +253,16 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
 def plot_optimum(problem: Problem, result: Any) -> Figure:
     """The world with the exact shortest path (an :class:`~rrtpso_ompl.evaluation.OptimumResult`):
     its tangent segments and its arcs around the inflated obstacles."""
-    fig, ax = plt.subplots(figsize=(6.5, 6))
-    draw_world(ax, problem)
+    fig, ax = plt.subplots(figsize=(world_width(problem, 6.0), 6))
+    key = draw_world(ax, problem)
     path = result.polyline(np.radians(0.5))
     if len(path):
-        ax.plot(path[:, 0], path[:, 1], "-", color=PATH_COLOUR, lw=1.8, zorder=4,
-                label=f"shortest path ({result.length:.2f})")  # fmt: skip
+        key += ax.plot(path[:, 0], path[:, 1], "-", color=PATH_COLOUR, lw=1.8, zorder=4,
+                       label=f"shortest path ({result.length:.2f})")  # fmt: skip
         bends = np.array([p.end for p in result.pieces[:-1]]).reshape(-1, 2)
-        ax.plot(bends[:, 0], bends[:, 1], "o", color=PATH_COLOUR, ms=3, zorder=5)
-        ax.legend(loc="best", fontsize=8)
+        key += ax.plot(bends[:, 0], bends[:, 1], "o", color=PATH_COLOUR, ms=3, zorder=5,
+                       label="bends (tangent points)")  # fmt: skip
+    world_legend(ax, key)
     found = f"length {result.length:.4f}" if result.found else "no path"
     ax.set_title(f"{problem.name}: exact optimum, {found}")
     fig.tight_layout()
@@ -200,27 +273,41 @@ def plot_optimum(problem: Problem, result: Any) -> Figure:
 EXCESS_FLOOR = 1e-3
 
 
+#: Horizontal offset between neighbouring planners' markers in :func:`plot_bench` (points), so
+#: that planners with equal values (all at 100 % success) do not hide each other.
+DODGE_PT = 7.0
+
+
 def plot_bench(summary: Any, what: str = "ratio") -> Figure:
     """Benchmark summary (:class:`~rrtpso_ompl.evaluation.SummaryRow` list) against the time budget:
     ``what="ratio"`` the median excess length over the optimum, ``100 (length / optimum - 1)``
     in percent on a log axis (quartiles shaded), ``"success"`` the success rate; one panel per
-    problem, one line per planner."""
+    problem, one line and marker per planner.
+
+    Each planner's points are shifted sideways by a few points (``DODGE_PT``, in display space,
+    the same at every budget), so equal values stay distinguishable; the budgets are the ticks.
+    """
     problems = list(dict.fromkeys(s.problem for s in summary))
     planners = list(dict.fromkeys(s.planner for s in summary))
     cols = min(4, max(1, len(problems)))
     rows = -(-len(problems) // cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(3.6 * cols, 3.0 * rows), squeeze=False)
+    fig, axes = plt.subplots(rows, cols, figsize=(3.6 * cols, 3.0 * rows + 0.3), squeeze=False)
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    style = {p: {"color": colours[i % len(colours)], "marker": MARKERS[i % len(MARKERS)]}
+             for i, p in enumerate(planners)}  # fmt: skip
+    budgets = sorted({s.budget for s in summary})
     for ax, problem in zip(axes.flat, problems, strict=False):
         for i, planner in enumerate(planners):
             mine = sorted(
                 (s for s in summary if s.problem == problem and s.planner == planner),
                 key=lambda s: s.budget,
             )
-            c = colours[i % len(colours)]
-            t = [s.budget for s in mine]
+            shift = ScaledTranslation((i - (len(planners) - 1) / 2) * DODGE_PT / 72, 0,
+                                      fig.dpi_scale_trans)  # fmt: skip
+            moved = {"transform": ax.transData + shift, **style[planner]}
             if what == "success":
-                ax.plot(t, [100 * s.success for s in mine], "o-", color=c, ms=3, label=planner)
+                ax.plot([s.budget for s in mine], [100 * s.success for s in mine], "-", ms=4,
+                        label=planner, **moved)  # fmt: skip
                 continue
             pts = [(s.budget, s.median_ratio, s.q1_ratio, s.q3_ratio) for s in mine
                    if s.median_ratio is not None]  # fmt: skip
@@ -229,26 +316,69 @@ def plot_bench(summary: Any, what: str = "ratio") -> Figure:
                 # readable in the same panel. The floor keeps exact optima on the axis.
                 b, m, lo, hi = (np.asarray(v, dtype=float) for v in zip(*pts, strict=True))
                 m, lo, hi = (np.maximum(100 * (v - 1), EXCESS_FLOOR) for v in (m, lo, hi))
-                ax.plot(b, m, "o-", color=c, ms=3, label=planner)
-                ax.fill_between(b, lo, hi, color=c, alpha=0.15)
+                ax.plot(b, m, "-", ms=4, label=planner, **moved)
+                ax.fill_between(b, lo, hi, color=style[planner]["color"], alpha=0.15, lw=0)
+                # A shifted line is not in the data limits by itself.
+                ax.update_datalim(np.column_stack([b, m]))
         ax.set_xscale("log")
-        budgets = sorted({s.budget for s in summary})
         ax.set_xticks(budgets, [f"{b:g}" for b in budgets])
         ax.minorticks_off()
+        # Room for the shifted markers beside the first and last budgets.
+        ax.set_xlim(budgets[0] / 1.4, budgets[-1] * 1.4)
         ax.set_title(problem, fontsize=9)
         ax.grid(alpha=0.3)
-        ax.set_ylabel("success (%)" if what == "success" else "over optimum (%)", fontsize=8)
-        ax.set_xlabel("time budget (s)", fontsize=8)
+        ax.set_xlabel("time budget [s]", fontsize=8)
         if what == "success":
+            ax.set_ylabel("success [%]", fontsize=8)
             ax.set_ylim(-5, 105)
         else:
-            ax.set_yscale("log")
+            ax.set_ylabel("length over optimum [%]", fontsize=8)
+            _plain_log_yaxis(ax)
+            ax.autoscale_view()
+        ax.tick_params(labelsize=8)
     for ax in axes.flat[len(problems) :]:
         ax.axis("off")
-    handles, labels = axes.flat[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=len(planners), fontsize=8)
-    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    # Every planner in the key, also one that no panel could draw (no solved run anywhere).
+    handles = [Line2D([], [], ms=4, label=p, **style[p]) for p in planners]
+    fig.legend(handles=handles, loc="lower center", ncol=min(len(planners), 5), fontsize=8)
+    key_rows = -(-len(planners) // 5)
+    fig.tight_layout(rect=(0, (0.1 + 0.22 * key_rows) / fig.get_figheight(), 1, 1))
     return fig
+
+
+def _plain_log_yaxis(ax: Axes) -> None:
+    """A log y scale labelled with plain numbers, ``0.1, 0.2, 0.5, 1, 2, 5, 10``, not matplotlib's
+    ``10^-1`` (nor ``8.95x10^0``, which it writes when the range spans less than a decade).
+
+    Within one step of the ticks it falls back to linear ticks (``8.9, 8.92, ...``), labelled the
+    same way; over many decades only the powers of ten are labelled, so the labels stay apart.
+    """
+    ax.set_yscale("log")
+    axis = ax.yaxis
+    lo, hi = axis.get_data_interval()
+    decades = np.log10(hi / lo) if lo > 0 and hi > lo else 0.0
+    subs = (1.0, 2.0, 3.0, 5.0) if decades < 1 else (1.0, 2.0, 5.0) if decades <= 3 else (1.0,)
+    axis.set_major_locator(_LogTicks(subs=subs))
+    axis.set_major_formatter(ticker.FuncFormatter(_plain_number))
+    axis.set_minor_locator(ticker.LogLocator(subs="auto"))
+    axis.set_minor_formatter(ticker.NullFormatter())
+
+
+class _LogTicks(ticker.LogLocator):
+    """LogLocator, or linear ticks when fewer than two of its ticks fall in the view (a panel
+    whose values lie within one step of ``subs``, such as 8.4-11.7 %)."""
+
+    def tick_values(self, vmin: float, vmax: float) -> np.ndarray:
+        ticks = super().tick_values(vmin, vmax)
+        lo, hi = sorted((vmin, vmax))
+        if ((ticks >= lo) & (ticks <= hi)).sum() < 2:
+            return ticker.AutoLocator().tick_values(vmin, vmax)
+        return ticks
+
+
+def _plain_number(x: float, pos: int | None = None) -> str:
+    """``0.001``, ``0.5``, ``10``, ``8.95``: three significant digits, never an exponent."""
+    return np.format_float_positional(float(f"{x:.3g}"), trim="-")
 
 
 def plot_velocities(traj: Any, units: str = "") -> Figure:
@@ -301,24 +431,29 @@ def plot_simulation(problem: Problem, sim: Any) -> Figure:
     the static path, the driven path with its detours and each moving obstacle's track from its
     first position (grey) to its position at the end (black); (b) the centre distance to each
     moving obstacle over time against the contact distance ``SR + SO``."""
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(13, 6), gridspec_kw={"width_ratios": [1.1, 1]})
-    draw_world(ax, problem)
+    widths = [world_width(problem, 6.0), 6.0]
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(sum(widths), 6),
+                                 gridspec_kw={"width_ratios": widths})  # fmt: skip
+    key = draw_world(ax, problem)
     static = np.asarray(sim.static_path, dtype=float).reshape(-1, 2)
     if len(static):
-        ax.plot(*static.T, "--", color=RRT_COLOUR, lw=1.2, zorder=3, label="static path")
+        key += ax.plot(*static.T, "--", color=RRT_COLOUR, lw=1.2, zorder=3, label="static path")
     traj = sim.trajectory
     t_end = float(traj[-1, 0]) if len(traj) else 0.0
     if len(traj):
-        ax.plot(traj[:, 1], traj[:, 2], "-", color=PATH_COLOUR, lw=1.8, zorder=4,
-                label=f"driven path ({sim.path_length:.1f})")  # fmt: skip
-    for i, rep in enumerate(sim.replans):
-        label = "detours" if i == 0 else None
+        key += ax.plot(traj[:, 1], traj[:, 2], "-", color=PATH_COLOUR, lw=1.8, zorder=4,
+                       label=f"driven path ({sim.path_length:.1f})")  # fmt: skip
+    for rep in sim.replans:
         if rep.detour is not None:
-            ax.plot(*np.asarray(rep.detour).T, "-", color=DETOUR, lw=1.2, zorder=5, label=label)
-        ax.plot(*rep.cross_point, "x", color="k", ms=8, zorder=6,
-                label="predicted cross point" if i == 0 else None)  # fmt: skip
+            ax.plot(*np.asarray(rep.detour).T, "-", color=DETOUR, lw=1.2, zorder=5)
+        ax.plot(*rep.cross_point, "x", color="k", ms=8, zorder=6)
         side = f" {rep.side}" if rep.side else ""
         ax.annotate(f"{rep.kind}{side} @ {rep.t:.1f}s", rep.start, fontsize=7, zorder=6)
+    if any(rep.detour is not None for rep in sim.replans):
+        key.append(Line2D([], [], color=DETOUR, lw=1.2, label="detours"))
+    if sim.replans:
+        key.append(Line2D([], [], ls="", marker="x", color="k", ms=8,
+                          label="predicted cross point"))  # fmt: skip
     for k, tr in enumerate(sim.tracks):
         ts = np.linspace(0.0, t_end, 200)
         q = tr.position(ts)
@@ -326,9 +461,15 @@ def plot_simulation(problem: Problem, sim: Any) -> Figure:
         ax.add_patch(CirclePatch(q[0], tr.radius, color="0.7", alpha=0.8, zorder=3))
         ax.add_patch(CirclePatch(q[-1], tr.radius, color="k", alpha=0.8, zorder=3))
         ax.annotate(f"M{k}", q[0], ha="center", va="center", fontsize=7, color="k", zorder=4)
+    if sim.tracks:
+        key += [
+            Patch(color="0.7", alpha=0.8, label="moving obstacle at t = 0"),
+            Patch(color="k", alpha=0.8, label=f"... at the end (t = {t_end:.1f} s)"),
+            Line2D([], [], ls=":", color=MOVING, lw=1.0, label="its track"),
+        ]
     verdict = "goal reached" if sim.reached_goal else "goal NOT reached"
     ax.set_title(f"{problem.name}: {sim.strategy}, {verdict}, {sim.collisions} collisions")
-    ax.legend(loc="best", fontsize=7)
+    world_legend(ax, key, fontsize=7)
     for k, tr in enumerate(sim.tracks):
         if not len(traj):
             break
@@ -348,19 +489,26 @@ def plot_simulation(problem: Problem, sim: Any) -> Figure:
     return fig
 
 
-def animate_simulation(
-    problem: Problem, sim: Any, path: str | Path, *, max_frames: int = 150, fps: int = 10
-) -> None:
-    """Write a GIF of the simulation: static and moving obstacles, the robot and its sensor range,
-    the plan it is driving, the predicted cross points and the detours (atomically)."""
-    from matplotlib.animation import FuncAnimation, PillowWriter
+def simulation_frames(
+    problem: Problem, sim: Any, max_frames: int = 150
+) -> tuple[Figure, Callable[[int], list[Any]], np.ndarray]:
+    """The figure of :func:`animate_simulation`, with its legend beside the world.
 
+    Returns
+    -------
+    fig : Figure
+        The figure; each frame redraws its moving parts.
+    draw : callable
+        ``draw(i)`` moves everything to trajectory sample ``i``; returns the changed artists.
+    frames : ndarray of int
+        The trajectory samples shown, at most ``max_frames``, evenly spread.
+    """
     traj = sim.trajectory
     if not len(traj):
         raise ValueError("nothing to animate: the simulation has no trajectory")
     frames = np.unique(np.linspace(0, len(traj) - 1, min(max_frames, len(traj))).astype(int))
-    fig, ax = plt.subplots(figsize=(6.5, 6.5))
-    draw_world(ax, problem, safety_zones=False)
+    fig, ax = plt.subplots(figsize=(world_width(problem, 6.5), 6.5))
+    key = draw_world(ax, problem, safety_zones=False)
     r = problem.robot.radius
     sensor = CirclePatch((0, 0), problem.robot.sensor_range or 0.0, fill=False, ls=":",
                          ec="tab:blue", lw=0.8, zorder=3)  # fmt: skip
@@ -368,18 +516,31 @@ def animate_simulation(
     ax.add_patch(sensor)
     ax.add_patch(body)
     (heading,) = ax.plot([], [], "-", color="k", lw=1.2, zorder=7)
-    (trace,) = ax.plot([], [], "-", color=PATH_COLOUR, lw=1.5, zorder=4)
-    (plan_line,) = ax.plot([], [], "--", color=RRT_COLOUR, lw=1.0, zorder=3)
-    (cross,) = ax.plot([], [], "x", color="k", ms=9, zorder=7)
+    (trace,) = ax.plot([], [], "-", color=PATH_COLOUR, lw=1.5, zorder=4, label="driven path")
+    (plan_line,) = ax.plot([], [], "--", color=RRT_COLOUR, lw=1.0, zorder=3, label="plan ahead")
+    (cross,) = ax.plot([], [], "x", color="k", ms=9, zorder=7, label="predicted cross point")
     obstacles = [CirclePatch((0, 0), tr.radius, color=MOVING, alpha=0.7, zorder=5)
                  for tr in sim.tracks]  # fmt: skip
     for patch in obstacles:
         ax.add_patch(patch)
     detour_lines = [ax.plot([], [], "-", color=DETOUR, lw=1.3, zorder=5)[0] for _ in sim.replans]
-    title = ax.set_title("")
+    key += [
+        (Patch(color=PATH_COLOUR, alpha=0.6, label="robot (line: heading)"),
+         Line2D([], [], color="k", lw=1.2)),
+        Line2D([], [], ls=":", color="tab:blue", lw=0.8, label="sensor range"),
+        trace,
+        plan_line,
+    ]  # fmt: skip
+    if sim.tracks:
+        key.append(Patch(color=MOVING, alpha=0.7, label="moving obstacle"))
+    if sim.replans:  # only what the animation will show
+        key += [cross, Line2D([], [], color=DETOUR, lw=1.3, label="detour")]
+    world_legend(ax, key)
+    # The longest title, so that the layout leaves room for every frame's.
+    title = ax.set_title(f"{problem.name}: t = {traj[-1, 0]:5.1f} s, replans {len(sim.replans)}")
     switch_times = np.array([t for t, _ in sim.plans])
 
-    def update(i: int) -> list[Any]:
+    def draw(i: int) -> list[Any]:
         t, x, y, th = traj[i]
         body.center = sensor.center = (x, y)
         heading.set_data([x, x + r * np.cos(th)], [y, y + r * np.sin(th)])
@@ -402,9 +563,32 @@ def animate_simulation(
         )
         return [body, sensor, heading, trace, plan_line, cross, title, *obstacles, *detour_lines]
 
-    anim = FuncAnimation(fig, update, frames=frames, blit=False)
+    fig.tight_layout()
+    return fig, draw, frames
+
+
+def animate_simulation(
+    problem: Problem, sim: Any, path: str | Path, *, max_frames: int = 150, fps: int = 10
+) -> None:
+    """Write a GIF of the simulation (:func:`simulation_frames`): static and moving obstacles,
+    the robot and its sensor range, the plan it is driving, the predicted cross points and the
+    detours, with a legend beside the world (atomically).
+
+    Each frame is drawn once and grabbed from the canvas (matplotlib's animation writers draw a
+    frame three times).
+    """
+    from PIL import Image
+
+    fig, draw, frames = simulation_frames(problem, sim, max_frames)
     try:
+        fig.set_dpi(80)
+        images = []
+        for i in frames:
+            draw(int(i))
+            fig.canvas.draw()
+            images.append(Image.fromarray(np.asarray(fig.canvas.buffer_rgba())[..., :3]))
         with atomic_path(path, suffix=".gif") as tmp:
-            anim.save(tmp, writer=PillowWriter(fps=fps), dpi=80)
+            images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
+                           duration=int(1000 / fps), loop=0)  # fmt: skip
     finally:
         plt.close(fig)

@@ -65,3 +65,35 @@ def test_the_published_json_schema_is_the_declared_format_and_accepts_the_librar
            "robot": {"radius": -1}, "colour": "red"}  # fmt: skip
     messages = " ".join(e.message for e in validator.iter_errors(bad))
     assert "colour" in messages and "-1" in messages
+
+
+def test_the_readme_python_snippet_prints_only_its_result():
+    """The README's Python example, run as a user would (a fresh process in the checkout): its
+    one print is all that appears; OMPL's Info and Debug lines stay quiet unless asked for."""
+    import re
+    import subprocess
+    import sys
+
+    readme = (ROOT / "README.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", readme, flags=re.S)
+    assert len(blocks) == 1
+    proc = subprocess.run([sys.executable, "-c", blocks[0]], cwd=ROOT, capture_output=True,
+                          text=True, timeout=120)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert re.fullmatch(r"\d+\.\d+\n", proc.stdout), proc.stdout[:500]
+    assert proc.stderr == "", proc.stderr[:500]
+    assert 600 < float(proc.stdout) < 700  # paper_static's optimum is 620.72
+
+
+def test_ompl_messages_come_back_when_asked_for():
+    import subprocess
+    import sys
+
+    code = ("from rrtpso_ompl.ompl_setup import set_ompl_log_level\n"
+            "from ompl import util as ou\n"
+            "assert ou.getLogLevel() == ou.LOG_WARN\n"
+            "set_ompl_log_level(1)\n"
+            "assert ou.getLogLevel() == ou.LOG_INFO\n")  # fmt: skip
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr

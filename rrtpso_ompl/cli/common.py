@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ..errors import ParameterError, UnknownPlannerError, UsageError
+from ..errors import ParameterError, UnknownPlannerError, UsageError, did_you_mean
 from ..model import Problem, load_problem
 from ..model.yamlfile import file_kind
 from ..outputs import STDOUT, is_stream, name_max, os_reason, stdout_closed
@@ -168,14 +168,23 @@ def post_steps(args: argparse.Namespace, src: str = "") -> tuple[str, ...]:
         raise UsageError(f"{src}: --post: {exc}" if src else f"--post: {exc}") from None
 
 
-def parse_params(items: list[str], src: str) -> dict[str, str]:
-    """``--param NAME=VALUE`` items as a mapping (values stay text: the planner converts them)."""
+def parse_params(items: list[str], src: str = "") -> dict[str, str]:
+    """``--param NAME=VALUE`` items as a mapping (values stay text: the planner converts them).
+
+    A name given twice is refused (which one was meant cannot be known), naming both values.
+    ``src`` (the problem file, when there is one) prefixes the messages.
+    """
+    where = f"{src}: --param" if src else "--param"
     params: dict[str, str] = {}
     for item in items:
         key, sep, value = item.partition("=")
-        if not sep or not key.strip():
-            raise UsageError(f"{src}: --param: expected NAME=VALUE, got '{item}'")
-        params[key.strip()] = value.strip()
+        key, value = key.strip(), value.strip()
+        if not sep or not key:
+            raise UsageError(f"{where}: expected NAME=VALUE, got '{item}'")
+        if key in params:
+            raise UsageError(f"{where} {key}: given twice ({key}={params[key]} and {key}={value}); "
+                             "give it once")  # fmt: skip
+        params[key] = value
     return params
 
 
@@ -472,7 +481,7 @@ def check_planners(names: list[str], items: list[str], flag: str) -> dict[str, d
     from ..planners.post import POST_PARAMS, split_spec
 
     registry = default_registry()
-    params = parse_params(items, flag)
+    params = parse_params(items)
     out = {}
     for name in names:
         try:
@@ -494,5 +503,17 @@ def check_planners(names: list[str], items: list[str], flag: str) -> dict[str, d
         out[name] = mine
     for key in params:
         if not any(key in p for p in out.values()):
-            raise UsageError(f"--param {key}: none of the planners {', '.join(names)} has it")
+            known = {n for name in names for n in _param_names(registry, name)}
+            raise UsageError(f"--param {key}: none of the planners {', '.join(names)} has it"
+                             f"{did_you_mean(key, sorted(known))}")  # fmt: skip
     return out
+
+
+def _param_names(registry: Any, spec: str) -> list[str]:
+    """The parameters a planner spec (``BITstar+pso``) takes: the planner's and its post-passes'."""
+    from ..planners import PathOptimizerOptions
+    from ..planners.post import POST_PARAMS, split_spec
+
+    base, steps = split_spec(spec)
+    post = (POST_PARAMS + PathOptimizerOptions.PARAMS).names() if steps else []
+    return [*registry.get(base).params.names(), *post]

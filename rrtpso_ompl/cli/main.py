@@ -2,8 +2,10 @@
 
 Exit status: 0 success, 1 no valid path (or the subcommand's own "not achieved"), 2 bad input or
 usage (one message on stderr, no traceback, nothing written) or an output that could not be
-written (the disk is full, standard output or its pipe is closed: one message naming the output
-and the reason; the old file is intact), 130 interrupted.
+written (the disk is full, standard output was closed when the command started: one message
+naming the output and the reason; the old file is intact), 130 interrupted. A pipe whose reader
+went away (``rrtpso planners | head -1``) is not an error: nothing is said and the status is 0,
+or the command's own when it had finished its work (``solve --json -``).
 """
 
 from __future__ import annotations
@@ -11,14 +13,13 @@ from __future__ import annotations
 import argparse
 import contextlib
 import logging
-import os
 import sys
 from collections.abc import Sequence
 
 from ..errors import OutputError, RrtpsoError
-from ..outputs import STDOUT, guard_standard_streams, os_reason, stdout_closed
+from ..outputs import STDOUT, guard_standard_streams, os_reason, silence_stdout, stdout_closed
 from . import batch, bench, generate, optimum, planners, simulate, solve
-from .common import EXIT_BAD_INPUT, EXIT_INTERRUPTED, add_shared_flags, set_quiet
+from .common import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK, add_shared_flags, set_quiet
 
 __all__ = ["main"]
 
@@ -46,8 +47,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     args.argv = list(sys.argv[1:] if argv is None else argv)
     set_quiet(args.quiet)
+    if args.quiet:
+        args.verbose = -1  # -q wins over -v: only errors, from Python's logging and from OMPL
     logging.basicConfig(
-        level=logging.INFO if getattr(args, "verbose", 0) else logging.WARNING,
+        level={-1: logging.ERROR, 0: logging.WARNING}.get(args.verbose, logging.INFO),
         format="%(levelname)s: %(name)s: %(message)s",
     )
     try:
@@ -56,15 +59,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         return status
     except RrtpsoError as exc:  # bad input of any kind: its message names where it came from
         if isinstance(exc, OutputError) and exc.path == STDOUT:
-            _silence_stdout()  # what is still buffered for it cannot be written either
+            silence_stdout()  # what is still buffered for it cannot be written either
         return _fail(f"rrtpso: error: {exc}", EXIT_BAD_INPUT)
     except KeyboardInterrupt:
         return _fail("rrtpso: interrupted", EXIT_INTERRUPTED)
     except BrokenPipeError:
-        # The reader went away (`rrtpso planners | head -1`): nothing more can be said to it.
-        _silence_stdout()
-        return _fail("rrtpso: error: the output pipe was closed before everything was written",
-                     EXIT_BAD_INPUT)  # fmt: skip
+        # The reader of standard output went away (`rrtpso planners | head -1`, a batch's
+        # `--out - | head -3`): it chose to stop reading, which is no error of ours. Like other
+        # command-line tools, stop quietly; 0, so that the status does not depend on whether
+        # the reader left before or after the last write. (A single result written to `-`, as
+        # `solve --json -` does, is finished first and keeps its own status: outputs.publish.)
+        silence_stdout()
+        return EXIT_OK
     except MemoryError:
         return _fail(
             "rrtpso: error: out of memory: the input is too large for this machine (see the "
@@ -85,15 +91,10 @@ def _flush_stdout() -> None:
         return
     try:
         sys.stdout.flush()
+    except BrokenPipeError:
+        raise  # the reader went away: quiet (main)
     except OSError as exc:
         raise OutputError(STDOUT, os_reason(exc)) from None
-
-
-def _silence_stdout() -> None:
-    """Point stdout at /dev/null, so that Python's final flush does not raise again."""
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    os.dup2(devnull, 1)
-    os.close(devnull)
 
 
 def _version() -> str:

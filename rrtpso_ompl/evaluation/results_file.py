@@ -317,6 +317,10 @@ class ResultsFile:
             try:
                 self._fh.write(data)
                 self._fh.flush()
+            except BrokenPipeError:
+                if self.path == STDOUT:
+                    raise  # the reader went away: the batch stops quietly (cli.main)
+                raise OutputError(self.path, "its reader went away") from None
             except OSError as exc:
                 raise OutputError(self.path, os_reason(exc)) from None
             return

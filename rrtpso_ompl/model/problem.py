@@ -10,7 +10,6 @@ wrong is reported by one :class:`ProblemError` that names the file, the key and 
 
 from __future__ import annotations
 
-import difflib
 import math
 import numbers
 import os
@@ -23,7 +22,7 @@ from typing import Any
 import numpy as np
 import shapely
 
-from ..errors import ProblemError
+from ..errors import ProblemError, did_you_mean
 from ..validation import (
     MAX_COORDINATE,
     MIN_EXTENT,
@@ -356,7 +355,7 @@ class _Validator:
             if not isinstance(k, str) or k not in allowed:
                 raise self.error(
                     _join(key, _key_label(k)),
-                    f"unknown key{what}{_did_you_mean(_key_label(k), allowed)}; "
+                    f"unknown key{what}{did_you_mean(_key_label(k), allowed)}; "
                     f"allowed keys: {', '.join(allowed)}",
                 )
         for k in required:
@@ -465,7 +464,7 @@ class _Validator:
         if kind is None:
             raise self.error(f"{key}.type", f"required key is missing (one of {known})")
         if not isinstance(kind, str) or kind not in _OBSTACLE_KEYS:
-            did = _did_you_mean(str(kind), tuple(_OBSTACLE_KEYS)) if isinstance(kind, str) else ""
+            did = did_you_mean(str(kind), tuple(_OBSTACLE_KEYS)) if isinstance(kind, str) else ""
             raise self.error(
                 f"{key}.type", f"unknown obstacle type {describe(kind)}{did}; known types: {known}"
             )
@@ -674,15 +673,6 @@ def _get(doc: Mapping[str, Any], key: str, default: Any) -> Any:
 
 def _join(prefix: str, key: str) -> str:
     return f"{prefix}.{key}" if prefix else key
-
-
-def _did_you_mean(word: str, choices: tuple[str, ...]) -> str:
-    """`` (did you mean 'x'?)`` for a misspelt or shortened key, else empty."""
-    close = difflib.get_close_matches(word, choices, n=1)
-    if not close and len(word) >= 3:
-        # difflib misses abbreviations such as `time` for `time_limit`.
-        close = [c for c in choices if c.startswith(word)][:1]
-    return f" (did you mean '{close[0]}'?)" if close else ""
 
 
 def _key_label(key: Any) -> str:

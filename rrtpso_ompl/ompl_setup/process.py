@@ -1,4 +1,5 @@
-"""OMPL's process-wide state: its random seed (once per process) and its log level."""
+"""OMPL's process-wide state: its random seed (once per process) and its log level (warnings
+from the moment this package loads OMPL, unless asked for more)."""
 
 from __future__ import annotations
 
@@ -44,6 +45,18 @@ def seed_ompl(seed: int | None) -> bool:
 
 
 def set_ompl_log_level(verbose: int = 0) -> None:
-    """OMPL's own log level: warnings only (0), Info (1) or Debug (2+)."""
-    level = {0: ou.LOG_WARN, 1: ou.LOG_INFO}.get(verbose, ou.LOG_DEBUG)
+    """OMPL's own log level: errors only (-1, the command line's ``-q``), warnings (0, the
+    default from importing this package), Info (1) or Debug (2+)."""
+    if verbose < 0:
+        level = ou.LOG_ERROR
+    else:
+        level = {0: ou.LOG_WARN, 1: ou.LOG_INFO}.get(verbose, ou.LOG_DEBUG)
     ou.setLogLevel(level)
+
+
+# OMPL starts at Debug, so a library user's first solve would print dozens of Info and Debug
+# lines (one per planner setup, per solve, per sampler). Keep it to warnings unless asked: a
+# level the user chose before importing us (anything but OMPL's start level) stays, and
+# set_ompl_log_level(1 or 2) or ompl.util.setLogLevel after the import turns the detail back on.
+if ou.getLogLevel() == ou.LOG_DEBUG:
+    set_ompl_log_level(0)

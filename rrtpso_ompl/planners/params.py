@@ -24,7 +24,7 @@ from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import ParameterError
+from ..errors import ParameterError, did_you_mean
 from ..validation import check_integer, check_number, describe
 
 __all__ = ["ParamSpec", "ParamTable", "Rule"]
@@ -198,7 +198,8 @@ class ParamTable:
             return self._params[name]
         except KeyError:
             known = ", ".join(self._params) or "none"
-            raise ParameterError(f"no parameter '{name}' (known: {known})", name) from None
+            hint = did_you_mean(name, self._params)
+            raise ParameterError(f"no parameter '{name}'{hint} (known: {known})", name) from None
 
     def names(self) -> list[str]:
         """Parameter names in declaration order."""
@@ -250,7 +251,8 @@ class ParamTable:
         for key, value in (values or {}).items():
             if key not in self._params:
                 known = ", ".join(self._params) or "none"
-                raise ParameterError(f"{owner or 'the planner'} has no parameter '{key}' "
+                hint = did_you_mean(str(key), self._params)
+                raise ParameterError(f"{owner or 'the planner'} has no parameter '{key}'{hint} "
                                      f"(known: {known})", key)  # fmt: skip
             converted[key] = self._params[key].convert(value, owner)
         merged = {**self.defaults(), **converted}

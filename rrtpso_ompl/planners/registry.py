@@ -29,7 +29,7 @@ from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
-from ..errors import ParameterError, UnknownPlannerError
+from ..errors import ParameterError, UnknownPlannerError, did_you_mean
 from .params import ParamSpec, ParamTable
 
 __all__ = [
@@ -127,8 +127,9 @@ class PlannerEntry:
         """The spec of parameter ``name``; :class:`~rrtpso_ompl.errors.ParameterError` otherwise."""
         if name not in self.params:
             known = ", ".join(self.params.names()) or "none"
+            hint = did_you_mean(name, self.params.names())
             raise ParameterError(
-                f"planner '{self.name}' has no parameter '{name}' (known: {known})", name
+                f"planner '{self.name}' has no parameter '{name}'{hint} (known: {known})", name
             )
         return self.params[name]
 

@@ -1,0 +1,262 @@
+"""The pictures: legends hide nothing and explain the symbols, axes have units, benchmark figures
+stay readable (issue 22, item 13). Real problems, real planners, real simulations; overlaps are
+measured in display coordinates with matplotlib's window extents."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+from helpers import PROBLEMS
+
+from rrtpso_ompl import load_problem, problem_from_dict, solve
+from rrtpso_ompl.evaluation.bench import SummaryRow
+from rrtpso_ompl.plotting import (  # the Agg backend: files only
+    plot_bench,
+    plot_optimum,
+    plot_simulation,
+    plot_solution,
+    save_figure,
+)
+
+
+def _close(fig):
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+
+
+def assert_legend_hides_nothing(fig, ax):
+    """The world's legend overlaps none of the world's artists (start and goal markers, obstacles,
+    safety zones, map, paths), nor the world's panel, nor another panel, and lies within the
+    figure (not cut off)."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    legend = ax.get_legend()
+    assert legend is not None
+    box = legend.get_window_extent(renderer)
+    artists = [*ax.lines, *ax.patches, *ax.images, *ax.texts]
+    assert len(artists) >= 4
+    hidden = [a for a in artists
+              if _drawn(a) and _overlap(box, a.get_window_extent(renderer), a, ax)]  # fmt: skip
+    assert not hidden, hidden[:5]
+    for collection in ax.collections:  # every obstacle and safety zone, one by one
+        paths = collection.get_paths()
+        assert paths
+        where = collection.get_transform()
+        hidden = [k for k, path in enumerate(paths)
+                  if _overlap(box, path.get_extents(where), collection, ax)]  # fmt: skip
+        assert not hidden, f"{len(hidden)} obstacles under the legend"
+    assert not box.overlaps(ax.get_window_extent(renderer))  # the whole world panel
+    for other in fig.axes:
+        if other is not ax:
+            assert not box.overlaps(other.get_tightbbox(renderer))
+    assert fig.bbox.contains(box.x0, box.y0) and fig.bbox.contains(box.x1, box.y1)
+
+
+def _overlap(box, extent, artist, ax) -> bool:
+    """Whether ``extent`` (display coordinates) overlaps ``box`` where the artist is drawn: an
+    artist clipped to the axes (a safety zone of a wall on the border) only inside them."""
+    from matplotlib.transforms import Bbox
+
+    if artist.get_clip_on():
+        extent = Bbox.intersection(extent, ax.bbox)
+        if extent is None:
+            return False
+    return box.overlaps(extent)
+
+
+def _drawn(artist) -> bool:
+    if hasattr(artist, "get_xydata") and not len(artist.get_xydata()):
+        return False  # an empty line (a GIF's trace before it starts)
+    return artist.get_visible()
+
+
+def legend_labels(ax) -> list[str]:
+    return [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+# ----------------------------------------------------------------------------------------------
+# Worlds
+# ----------------------------------------------------------------------------------------------
+def test_the_legend_of_a_10000_circle_world_hides_nothing_and_explains_the_symbols():
+    from rrtpso_ompl.evaluation.generate import generate
+
+    problem = problem_from_dict(generate("circles", seed=7, n=10000))
+    result = solve(problem, "RRTstarPSO", time_limit=0.5, seed=1)
+    fig = plot_solution(problem, result)
+    try:
+        ax = fig.axes[0]
+        assert_legend_hides_nothing(fig, ax)
+        labels = " | ".join(legend_labels(ax))
+        for words in ("start (circle: the robot)", "goal", "obstacle", "safety zone"):
+            assert words in labels, labels
+    finally:
+        _close(fig)
+
+
+def test_the_legend_of_the_warehouse_map_hides_no_rack_and_explains_unknown_space():
+    problem = load_problem(PROBLEMS / "maps" / "warehouse_aisles.yaml")
+    result = solve(problem, "RRTstarPSO", time_limit=0.5, seed=1)
+    fig = plot_solution(problem, result)
+    try:
+        ax = fig.axes[0]
+        assert_legend_hides_nothing(fig, ax)
+        labels = " | ".join(legend_labels(ax))
+        for words in ("occupied cells", "unknown space (blocked)", "clearance zone", "start"):
+            assert words in labels, labels
+    finally:
+        _close(fig)
+
+
+def test_the_best_cost_axis_has_a_unit():
+    problem = load_problem(PROBLEMS / "static" / "paper_static.yaml")
+    result = solve(problem, "RRTstarPSO", time_limit=0.5, seed=1)
+    assert result.stages["pso_history"]
+    fig = plot_solution(problem, result)
+    try:
+        assert_legend_hides_nothing(fig, fig.axes[0])
+        assert fig.axes[1].get_ylabel().endswith("[cm]")
+    finally:
+        _close(fig)
+
+
+def test_the_optimum_legend_hides_nothing():
+    from rrtpso_ompl.evaluation import shortest_path
+
+    problem = load_problem(PROBLEMS / "static" / "maze.yaml")
+    fig = plot_optimum(problem, shortest_path(problem))
+    try:
+        assert_legend_hides_nothing(fig, fig.axes[0])
+    finally:
+        _close(fig)
+
+
+# ----------------------------------------------------------------------------------------------
+# Simulations
+# ----------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def simulated():
+    from rrtpso_ompl.dynamic import simulate
+
+    problem = load_problem(PROBLEMS / "dynamic" / "paper_dynamic.yaml")
+    return problem, simulate(problem, seed=1)
+
+
+def test_the_simulation_plot_legend_hides_no_obstacle(simulated):
+    problem, sim = simulated
+    assert sim.replans  # the detour and the cross point are in the picture
+    fig = plot_simulation(problem, sim)
+    try:
+        ax = fig.axes[0]
+        assert_legend_hides_nothing(fig, ax)
+        labels = " | ".join(legend_labels(ax))
+        for words in ("detours", "predicted cross point", "moving obstacle", "safety zone"):
+            assert words in labels, labels
+    finally:
+        _close(fig)
+
+
+def test_every_gif_frame_has_a_legend_that_hides_nothing(simulated, tmp_path):
+    from PIL import Image
+
+    from rrtpso_ompl.plotting import animate_simulation, simulation_frames
+
+    problem, sim = simulated
+    fig, draw, frames = simulation_frames(problem, sim, max_frames=30)
+    try:
+        ax = fig.axes[0]
+        for i in (frames[0], frames[len(frames) // 2], frames[-1]):
+            draw(int(i))
+            assert_legend_hides_nothing(fig, ax)
+        labels = " | ".join(legend_labels(ax))
+        for words in (
+            "robot",
+            "sensor range",
+            "moving obstacle",
+            "plan ahead",
+            "detour",
+            "goal",
+            "predicted cross point",
+        ):
+            assert words in labels, labels
+    finally:
+        _close(fig)
+    out = tmp_path / "run.gif"
+    animate_simulation(problem, sim, out, max_frames=12)
+    with Image.open(out) as gif:
+        assert gif.n_frames == 12
+        assert gif.size[0] > gif.size[1] * 1.2  # the world and its legend beside it
+
+
+# ----------------------------------------------------------------------------------------------
+# Benchmarks
+# ----------------------------------------------------------------------------------------------
+def _row(problem, planner, budget, success=1.0, ratio=None):
+    q = None if ratio is None else (ratio - 1e-4, ratio + 1e-4)
+    return SummaryRow(problem=problem, budget=budget, planner=planner, runs=10,
+                      solved=int(10 * success), success=success, optimum=100.0,
+                      median_length=None if ratio is None else 100 * ratio, median_ratio=ratio,
+                      q1_ratio=q and q[0], q3_ratio=q and q[1], best_ratio=ratio,
+                      median_raw_ratio=ratio, median_time=budget)  # fmt: skip
+
+
+def _tick_texts(ax) -> list[str]:
+    lo, hi = ax.get_ylim()
+    ticks = [*ax.yaxis.get_major_ticks(), *ax.yaxis.get_minor_ticks()]
+    return [t.label1.get_text() for t in ticks
+            if t.label1.get_text() and lo <= t.get_loc() <= hi]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "ratios",
+    [(1.0895, 1.0897, 1.0899), (1.0001, 1.01, 1.3), (1.00002, 1.5, 3.0), (1.084, 1.09, 1.115)],
+    ids=["within-a-tenth-of-a-percent", "two-decades", "five-decades", "8-to-12-percent"],
+)
+def test_ratio_axis_labels_are_plain_numbers(ratios):
+    summary = [_row("p", pl, b, ratio=r) for pl, r in zip(("A", "B", "C"), ratios, strict=True)
+               for b in (0.25, 1.0, 4.0)]  # fmt: skip
+    summary.append(_row("p", "Never", 1.0, success=0.0))
+    fig = plot_bench(summary, "ratio")
+    try:
+        fig.canvas.draw()
+        ax = fig.axes[0]
+        texts = _tick_texts(ax)
+        assert len(texts) >= 2, texts
+        for text in texts:
+            assert re.fullmatch(r"\d+(\.\d+)?", text), texts  # no 10^0, no x, no mathtext
+        assert "%" in ax.get_ylabel() and "[s]" in ax.get_xlabel()
+        # every planner is in the key, also one that no panel could draw
+        assert [t.get_text() for t in fig.legends[0].get_texts()] == ["A", "B", "C", "Never"]
+    finally:
+        _close(fig)
+
+
+def test_success_markers_of_planners_at_100_percent_are_distinguishable():
+    planners = ["RRTstarPSO", "RRTstar", "InformedRRTstar", "BITstar", "RRTConnect"]
+    summary = [_row(p, pl, b) for p in ("p1", "p2") for pl in planners for b in (0.25, 1.0, 4.0)]
+    fig = plot_bench(summary, "success")
+    try:
+        fig.canvas.draw()
+        ax = fig.axes[0]
+        lines = [line for line in ax.lines if line.get_label() in planners]
+        assert len(lines) == len(planners)
+        assert len({line.get_marker() for line in lines}) == len(planners)
+        px = {line.get_label(): line.get_transform().transform(line.get_xydata())
+              for line in lines}  # fmt: skip
+        size = max(line.get_markersize() for line in lines) * fig.dpi / 72  # pixels
+        for k in range(3):  # each budget: the markers stand apart, inside the panel
+            xs = sorted(p[k, 0] for p in px.values())
+            assert min(np.diff(xs)) >= size, xs
+            box = ax.get_window_extent()
+            assert all(box.x0 < x < box.x1 for x in xs)
+    finally:
+        _close(fig)
+
+
+def test_bench_figures_are_written(tmp_path):
+    summary = [_row("p", pl, b, ratio=1.01) for pl in ("A", "B") for b in (0.5, 2.0)]
+    for what in ("ratio", "success"):
+        save_figure(plot_bench(summary, what), tmp_path / f"{what}.png")
+        assert (tmp_path / f"{what}.png").stat().st_size > 1000
