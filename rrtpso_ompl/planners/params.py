@@ -8,9 +8,14 @@ parameter (name, type, default, unit, range, documentation and, for OMPL's own p
 setter and getter), gathered in a :class:`ParamTable` with the rules that tie several parameters
 together (``c1 + c2 < 4``).
 
-Everything else is derived from the tables: the options objects the algorithms take
-(:meth:`ParamTable.options_class`), the validation of YAML ``planner.params``, ``--param`` and
-Python keyword arguments (:meth:`ParamTable.validate`, one
+Option sets that algorithms take as one object (the swarm's, the path optimiser's, the dynamic
+simulation's, the DWA's, the generator's) are ordinary frozen, keyword-only dataclasses whose
+fields are declared with :func:`param` and whose class is decorated with :func:`declared`:
+editors and type checkers see their fields, and the decorator derives the :class:`ParamTable`
+(``cls.PARAMS``), validation on construction and ``from_values`` from the same declarations.
+
+Everything else is derived from the tables: the validation of YAML ``planner.params``,
+``--param`` and Python keyword arguments (:meth:`ParamTable.validate`, one
 :class:`~rrtpso_ompl.errors.ParameterError` for every violation, as scikit-learn's
 ``_parameter_constraints`` do), the listing of ``rrtpso planners`` and the tables in
 ``docs/planners.md``. Defaults therefore agree everywhere by construction.
@@ -20,14 +25,15 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import typing
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 from ..errors import ParameterError, did_you_mean
 from ..validation import check_integer, check_number, describe
 
-__all__ = ["ParamSpec", "ParamTable", "Rule"]
+__all__ = ["ParamSpec", "ParamTable", "Rule", "declared", "param"]
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"0", "false", "no", "off"}
@@ -263,39 +269,7 @@ class ParamTable:
                                      " + ".join(rule.names))  # fmt: skip
         return converted
 
-    # -- derived objects ---------------------------------------------------------------------------
-    def options_class(self, name: str, doc: str, module: str) -> type:
-        """A frozen, keyword-only dataclass with one field per parameter (its default too).
-
-        The class validates itself on construction with :meth:`validate` and has a
-        ``from_values(mapping)`` constructor that picks its own fields out of a larger mapping
-        (a planner's values). Its docstring lists every parameter with type, unit, range and doc.
-        """
-        table = self
-        fields = [(p.name, p.type, dataclasses.field(default=p.default)) for p in self]
-
-        def __post_init__(self) -> None:
-            table.validate(dataclasses.asdict(self), owner=name)
-
-        @classmethod
-        def from_values(cls, values: Mapping[str, Any]):
-            return cls(**{k: values[k] for k in table.names() if k in values})
-
-        cls = dataclasses.make_dataclass(
-            name,
-            fields,
-            namespace={
-                "__post_init__": __post_init__,
-                "from_values": from_values,
-                "PARAMS": table,
-            },
-            frozen=True,
-            kw_only=True,
-        )
-        cls.__module__ = module
-        cls.__doc__ = f"{doc}\n\n{self.numpydoc()}"
-        return cls
-
+    # -- derived text ------------------------------------------------------------------------------
     def markdown(self) -> str:
         """The table as markdown (name, type, default, unit, range, meaning), as in the docs."""
         rows = ["| name | type | default | unit | range | meaning |", "|---|---|---|---|---|---|"]
@@ -314,3 +288,90 @@ class ParamTable:
             lines.append(f"{p.name} : {p.type.__name__}, default {p.default!r}")
             lines.append(f"    {p.doc} Range {p.range_text()}{unit}.")
         return "\n".join(lines)
+
+
+# ----------------------------------------------------------------------------------------------
+# Option sets as dataclasses: one declaration per field
+# ----------------------------------------------------------------------------------------------
+_PARAM_KEY = "rrtpso_param"
+_TYPES = {"int": int, "float": float, "bool": bool, "str": str}
+_T = TypeVar("_T")
+
+
+def param(
+    default: Any,
+    doc: str,
+    *,
+    unit: str = "",
+    low: float | None = None,
+    high: float | None = None,
+    choices: tuple[Any, ...] | None = None,
+) -> Any:
+    """Declare one field of an option set (see :func:`declared`): its default, what it does,
+    its unit and its range. The name and type come from the field itself."""
+    spec = {"doc": doc, "unit": unit, "low": low, "high": high, "choices": choices}
+    return dataclasses.field(default=default, metadata={_PARAM_KEY: spec})
+
+
+def _validate_fields(self: Any) -> None:
+    """``__post_init__`` of every option set: its values against its table."""
+    klass = type(self)
+    klass.PARAMS.validate(dataclasses.asdict(self), owner=klass.__name__)
+
+
+def _dataclass_transform(**kwargs: Any) -> Callable[[_T], _T]:
+    """``typing.dataclass_transform`` (Python 3.11+): tells type checkers that :func:`declared`
+    makes a dataclass; a no-op before."""
+    transform = getattr(typing, "dataclass_transform", None)
+    return transform(**kwargs) if transform else (lambda f: f)
+
+
+@_dataclass_transform(kw_only_default=True, frozen_default=True, field_specifiers=(param,))
+def declared(cls: type[_T] | None = None, *, rules: Iterable[Rule] = ()) -> Any:
+    """Make a class of :func:`param` fields a frozen, keyword-only dataclass and an option set.
+
+    Adds ``PARAMS`` (the :class:`ParamTable` of its fields, in order, with ``rules`` and the
+    rules of the option sets it extends), validation on construction (one
+    :class:`~rrtpso_ompl.errors.ParameterError` naming the field), ``from_values(mapping)``
+    (its own fields out of a larger mapping, such as a planner's values) and a numpydoc
+    ``Parameters`` section appended to the docstring. An option set may extend another
+    (subclass it): its table holds the base's fields first.
+
+    Examples
+    --------
+    >>> @declared
+    ... class Options:
+    ...     size: int = param(3, "How many.", low=1)
+    >>> Options(size=4).size
+    4
+    """
+
+    def build(klass: Any) -> Any:
+        if "__post_init__" not in klass.__dict__:
+            klass.__post_init__ = _validate_fields
+        klass = dataclasses.dataclass(frozen=True, kw_only=True)(klass)
+        hints = typing.get_type_hints(klass)
+        inherited: list[Rule] = []
+        for base in klass.__mro__[1:]:
+            table = base.__dict__.get("PARAMS")
+            if isinstance(table, ParamTable):
+                inherited.extend(table.rules)
+        specs = []
+        for f in dataclasses.fields(klass):
+            meta = f.metadata.get(_PARAM_KEY)
+            if meta is None:
+                raise TypeError(f"{klass.__name__}.{f.name}: declare it with param(...)")
+            kind = hints[f.name]
+            kind = _TYPES.get(kind, kind) if isinstance(kind, str) else kind
+            specs.append(ParamSpec(f.name, kind, f.default, **meta))
+        table = ParamTable(*specs, rules=(*dict.fromkeys(inherited), *rules))
+
+        def from_values(k: Any, values: Mapping[str, Any]) -> Any:
+            return k(**{n: values[n] for n in k.PARAMS.names() if n in values})
+
+        klass.PARAMS = table
+        klass.from_values = classmethod(from_values)
+        klass.__doc__ = f"{(klass.__doc__ or '').rstrip()}\n\n{table.numpydoc()}"
+        return klass
+
+    return build if cls is None else build(cls)

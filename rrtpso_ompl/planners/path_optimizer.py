@@ -43,7 +43,7 @@ import numpy as np
 from ..model.geometry import path_length, shortcut, turning_angles
 from ..model.world import World
 from . import swarm as pso
-from .params import ParamSpec, ParamTable
+from .params import declared, param
 from .swarm import SWARM_PARAMS, PSOOptions
 
 __all__ = [
@@ -55,53 +55,79 @@ __all__ = [
 ]
 
 
-#: The path optimiser's own parameters; with the swarm's they make :class:`PathOptimizerOptions`.
-OPTIMIZER_PARAMS = ParamTable(
-    ParamSpec("smoothness_weight", float, 0.0,
-              "Cost per squared radian of turning at a waypoint (0 = shortest path only).",
-              unit="length/rad^2", low=0.0),
-    ParamSpec("violation_weight", float, 10.0,
-              "Penalty per unit of intrusion of a candidate segment into an obstacle's safety "
-              "zone.", low=1e-9),
-    ParamSpec("init_spread", float, 0.05,
-              "Spread of the initial swarm around the seed path, as a fraction of the shorter "
-              "segment next to each waypoint.", low=0.0, high=10.0),
-    ParamSpec("v_max_fraction", float, 0.1,
-              "Velocity clamp per coordinate, as a fraction of the mean segment length of the "
-              "seed path.", low=1e-6, high=10.0),
-    ParamSpec("box_fraction", float, 0.5,
-              "Each PSO round keeps every waypoint within this fraction of its longer segment "
-              "from its seed position (exact obstacle culling).", low=1e-3, high=100.0),
-    ParamSpec("prune", bool, True, "Shortcut the seed path's waypoints (exactly) before the "
-              "swarm runs."),
-    ParamSpec("refine_rounds", int, 4,
-              "Extra PSO rounds with mid-points inserted on segments that run along an obstacle.",
-              low=0, high=20),
-    ParamSpec("refine_margin", float, 0.05,
-              "A segment runs along an obstacle when its clearance is below robot radius + "
-              "refine_margin x max(robot radius, segment length): scale-free, and it fires for "
-              "a point robot too.", low=0.0, high=10.0),
-    ParamSpec("max_waypoints", int, 48, "Most waypoints refinement may create.",
-              low=2, high=10_000),
-    ParamSpec("polish_rounds", int, 20,
-              "With a deadline, further rounds re-centred on the best path while each still "
-              "shortens it by more than `polish_tolerance` and time remains (0 = none).",
-              low=0, high=10_000),
-    ParamSpec("polish_tolerance", float, 1e-5,
-              "Relative shortening a polish round must achieve for the next one to run.",
-              low=0.0, high=1.0),
-)  # fmt: skip
-
-PathOptimizerOptions = (SWARM_PARAMS + OPTIMIZER_PARAMS).options_class(
-    "PathOptimizerOptions",
+@declared
+class PathOptimizerOptions(PSOOptions):
     """Settings of the PSO path optimiser: the swarm's (eqs. 4-5) and the optimiser's own.
 
     Each round confines every waypoint to a square around its seed position, of half-width
     ``box_fraction`` times the longer of its two segments (and the workspace bounds). Only
     obstacles that can reach such a box are checked, which keeps the check exact and makes it
-    several times cheaper in clutter; later rounds re-centre the boxes.""",
-    __name__,
-)
+    several times cheaper in clutter; later rounds re-centre the boxes."""
+
+    smoothness_weight: float = param(
+        0.0,
+        "Cost per squared radian of turning at a waypoint (0 = shortest path only).",
+        unit="length/rad^2",
+        low=0.0,
+    )
+    violation_weight: float = param(
+        10.0,
+        "Penalty per unit of intrusion of a candidate segment into an obstacle's safety zone.",
+        low=1e-9,
+    )
+    init_spread: float = param(
+        0.05,
+        "Spread of the initial swarm around the seed path, as a fraction of the shorter segment "
+        "next to each waypoint.",
+        low=0.0,
+        high=10.0,
+    )
+    v_max_fraction: float = param(
+        0.1,
+        "Velocity clamp per coordinate, as a fraction of the mean segment length of the seed path.",
+        low=1e-6,
+        high=10.0,
+    )
+    box_fraction: float = param(
+        0.5,
+        "Each PSO round keeps every waypoint within this fraction of its longer segment from its "
+        "seed position (exact obstacle culling).",
+        low=1e-3,
+        high=100.0,
+    )
+    prune: bool = param(True, "Shortcut the seed path's waypoints (exactly) before the swarm runs.")
+    refine_rounds: int = param(
+        4,
+        "Extra PSO rounds with mid-points inserted on segments that run along an obstacle.",
+        low=0,
+        high=20,
+    )
+    refine_margin: float = param(
+        0.05,
+        "A segment runs along an obstacle when its clearance is below robot radius + "
+        "refine_margin x max(robot radius, segment length): scale-free, and it fires for a "
+        "point robot too.",
+        low=0.0,
+        high=10.0,
+    )
+    max_waypoints: int = param(48, "Most waypoints refinement may create.", low=2, high=10_000)
+    polish_rounds: int = param(
+        20,
+        "With a deadline, further rounds re-centred on the best path while each still shortens "
+        "it by more than `polish_tolerance` and time remains (0 = none).",
+        low=0,
+        high=10_000,
+    )
+    polish_tolerance: float = param(
+        1e-5,
+        "Relative shortening a polish round must achieve for the next one to run.",
+        low=0.0,
+        high=1.0,
+    )
+
+
+#: The path optimiser's own parameters (:class:`PathOptimizerOptions` without the swarm's).
+OPTIMIZER_PARAMS = PathOptimizerOptions.PARAMS.without(*SWARM_PARAMS.names())
 
 
 @dataclass(frozen=True)

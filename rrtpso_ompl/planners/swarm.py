@@ -25,41 +25,51 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .params import ParamSpec, ParamTable, Rule
+from .params import Rule, declared, param
 
 __all__ = ["SWARM_PARAMS", "PSOOptions", "PSOResult", "minimize"]
 
 CostFunction = Callable[[np.ndarray], np.ndarray]
 
 
-#: The swarm's parameters (paper Table 2, plus early stopping and inertia damping).
-SWARM_PARAMS = ParamTable(
-    ParamSpec("swarm_size", int, 30, "Number of particles (candidate paths) in the swarm.",
-              low=2, high=10_000),
-    ParamSpec("iterations", int, 100, "PSO iterations per optimisation round (eqs. 4-5).",
-              low=0, high=1_000_000),
-    ParamSpec("w", float, 0.7298, "Inertia weight of the particle velocity (eq. 4).",
-              low=0.0, high=1.5),
-    ParamSpec("c1", float, 1.49618,
-              "Cognitive coefficient: pull to the particle's best (eq. 4); c1 + c2 < 4.",
-              low=0.0, high=4.0),
-    ParamSpec("c2", float, 1.49618,
-              "Social coefficient: pull to the swarm's best (eq. 4); c1 + c2 < 4.",
-              low=0.0, high=4.0),
-    ParamSpec("tolerance", float, 1e-6,
-              "End a PSO round early when the best cost improved by less than this (relative) "
-              "over `patience` iterations; 0 = always run all iterations.",
-              low=0.0, high=1.0),
-    ParamSpec("patience", int, 15, "Window of the early stop, in iterations.",
-              low=1, high=1_000_000),
-    ParamSpec("w_damping", float, 1.0, "Factor applied to w after every iteration (1 = constant).",
-              low=1e-6, high=1.0),
-    rules=[Rule(("c1", "c2"), lambda c1, c2: c1 + c2 < 4.0, "c1 + c2 < 4 (paper Table 2)")],
-)  # fmt: skip
+@declared(rules=[Rule(("c1", "c2"), lambda c1, c2: c1 + c2 < 4.0, "c1 + c2 < 4 (paper Table 2)")])
+class PSOOptions:
+    """Settings of the particle swarm (paper Table 2, plus early stopping and inertia damping)."""
 
-PSOOptions = SWARM_PARAMS.options_class(
-    "PSOOptions", "Settings of the particle swarm (paper Table 2).", __name__
-)
+    swarm_size: int = param(
+        30, "Number of particles (candidate paths) in the swarm.", low=2, high=10_000
+    )
+    iterations: int = param(
+        100, "PSO iterations per optimisation round (eqs. 4-5).", low=0, high=1_000_000
+    )
+    w: float = param(0.7298, "Inertia weight of the particle velocity (eq. 4).", low=0.0, high=1.5)
+    c1: float = param(
+        1.49618,
+        "Cognitive coefficient: pull to the particle's best (eq. 4); c1 + c2 < 4.",
+        low=0.0,
+        high=4.0,
+    )
+    c2: float = param(
+        1.49618,
+        "Social coefficient: pull to the swarm's best (eq. 4); c1 + c2 < 4.",
+        low=0.0,
+        high=4.0,
+    )
+    tolerance: float = param(
+        1e-6,
+        "End a PSO round early when the best cost improved by less than this (relative) over "
+        "`patience` iterations; 0 = always run all iterations.",
+        low=0.0,
+        high=1.0,
+    )
+    patience: int = param(15, "Window of the early stop, in iterations.", low=1, high=1_000_000)
+    w_damping: float = param(
+        1.0, "Factor applied to w after every iteration (1 = constant).", low=1e-6, high=1.0
+    )
+
+
+#: The swarm's parameters, as :class:`PSOOptions` declares them.
+SWARM_PARAMS = PSOOptions.PARAMS
 
 
 @dataclass(frozen=True)

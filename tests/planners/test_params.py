@@ -97,3 +97,39 @@ def test_markdown_lists_every_parameter_in_order():
     lines = TABLE.markdown().splitlines()
     assert lines[0].startswith("| name | type | default")
     assert [line.split("`")[1] for line in lines[2:]] == TABLE.names()
+
+
+def test_declared_option_sets_are_dataclasses_with_one_declaration_per_field():
+    from rrtpso_ompl.planners.params import Rule, declared, param
+
+    @declared(rules=[Rule(("lo", "hi"), lambda lo, hi: lo <= hi, "lo <= hi")])
+    class Window:
+        """A window."""
+
+        lo: float = param(0.0, "Lower end.", unit="s", low=0.0)
+        hi: float = param(1.0, "Upper end.", unit="s", low=0.0)
+
+    @declared
+    class Named(Window):
+        """A named window."""
+
+        label: str = param("w", "Its name.")
+
+    assert Window.PARAMS.names() == ["lo", "hi"] and Window.PARAMS["lo"].type is float
+    assert Named.PARAMS.names() == ["lo", "hi", "label"] and Named.PARAMS.rules  # inherited
+    with pytest.raises(ParameterError, match="lo <= hi"):
+        Named(lo=2.0)
+    with pytest.raises(ParameterError, match="'lo' of Window must be in"):
+        Window(lo=-1.0)
+    with pytest.raises(TypeError):
+        Window(0.5, 0.6)  # keyword-only
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        Window().lo = 3.0
+    assert Named.from_values({"hi": 3.0, "label": "x", "other": 1}) == Named(hi=3.0, label="x")
+    assert "lo : float, default 0.0" in Window.__doc__
+
+    with pytest.raises(TypeError, match="param"):
+
+        @declared
+        class Bad:
+            x: int = 3
