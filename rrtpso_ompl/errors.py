@@ -13,6 +13,7 @@ working for code written before the family existed.
 from __future__ import annotations
 
 __all__ = [
+    "ArgumentError",
     "GenerationError",
     "ParameterError",
     "PlannerError",
@@ -114,3 +115,8 @@ class UsageError(RrtpsoError):
 class GenerationError(RrtpsoError, ValueError):
     """The generator's options are invalid, or no problem satisfying them was found within the
     allowed attempts (too many or too large obstacles, too large a robot for the workspace)."""
+
+
+class ArgumentError(RrtpsoError, TypeError):
+    """A Python argument of the wrong kind: a file name where a :class:`~rrtpso_ompl.model.Problem`
+    goes, a string where a mapping of parameters goes, ``None`` where a path goes."""

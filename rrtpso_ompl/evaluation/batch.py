@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..errors import ProblemError, RrtpsoError
+from ..errors import ProblemError, RrtpsoError, UsageError
 from ..model.occupancy import is_map_yaml
 from .results_file import ResultsFile, latest_rows, read_rows, row_key
 
@@ -118,9 +118,16 @@ def make_tasks(
 
     ``params`` maps a planner name to its parameters; ``simplify`` may be a function of the
     planner name.
+
+    Raises
+    ------
+    UsageError
+        For more than :data:`~rrtpso_ompl.validation.MAX_RUNS` tasks.
     """
+    inputs = expand_inputs(items)
+    check_task_count(runs, len(planners), len(inputs))
     tasks = []
-    for path, error in expand_inputs(items):
+    for path, error in inputs:
         for planner in planners:
             for r in range(runs):
                 tasks.append(
@@ -138,6 +145,17 @@ def make_tasks(
                     )
                 )
     return tasks
+
+
+def check_task_count(runs: int, planners: int, files: int, budgets: int = 1) -> None:
+    """Refuse a batch or bench of more than :data:`~rrtpso_ompl.validation.MAX_RUNS` runs
+    before building its tasks (a :class:`UsageError` naming the factors)."""
+    from ..validation import check_run_count
+
+    try:
+        check_run_count(runs, planners, files, budgets)
+    except ValueError as exc:
+        raise UsageError(f"--runs: the number of runs {exc}") from None
 
 
 # ----------------------------------------------------------------------------------------------
