@@ -39,6 +39,7 @@ from .base import (
     PythonPlanner,
     SpaceInformationCollisionModel,
     collision_model_for,
+    refusing_motions_after,
 )
 from .ompl_planners import RRTSTAR_PARAMS
 from .params import ParamSpec, ParamTable
@@ -298,8 +299,9 @@ class RRTstarPSO(PythonPlanner):
         simplifier = og.PathSimplifier(self.getSpaceInformation())
         if budget > 0:
             left = max(0.5 * (t0 + budget - t1), 1e-4)
-            simplifier.simplify(simplified, ob.plannerOrTerminationCondition(
-                ptc, ob.timedPlannerTerminationCondition(left)))  # fmt: skip
+            with refusing_motions_after(self._model, t1 + left):
+                simplifier.simplify(simplified, ob.plannerOrTerminationCondition(
+                    ptc, ob.timedPlannerTerminationCondition(left)))  # fmt: skip
         else:
             simplifier.simplifyMax(simplified)
         candidate = path_to_array(simplified)
@@ -311,9 +313,11 @@ class RRTstarPSO(PythonPlanner):
         """Whether OMPL's simplifier can be trusted to stop within ``left`` seconds.
 
         It polls its termination condition only between whole passes, each of which checks
-        motions along the path many times over (:data:`SIMPLIFIER_PASS_LENGTHS`). With our world
-        a motion check costs microseconds; with a user's checker of a millisecond per state a
-        single pass can take a second, so it only runs when a pass fits."""
+        motions along the path many times over (:data:`SIMPLIFIER_PASS_LENGTHS`). Our world
+        refuses the motions it is asked for after the time is up, which ends a pass at once
+        (:meth:`~rrtpso_ompl.model.World.refusing_motions_after`); with a user's checker of a
+        millisecond per state a single pass can take a second, so it only runs when a pass
+        fits."""
         model = self._model
         if not isinstance(model, SpaceInformationCollisionModel):
             return True
