@@ -327,15 +327,17 @@ class RRTstarPSO(PythonPlanner):
         return SIMPLIFIER_PASS_LENGTHS * per_state * states <= left
 
     def _fine_valid(self, xy: np.ndarray, t0: float) -> bool:
-        """Whether the user's checker, sampled finer than the space's resolution, passes ``xy``
-        (always True with our exact world, whose motion validator OMPL's simplifier used).
+        """Whether ``xy`` passes our exact world's check, or the user's checker sampled finer
+        than the space's resolution.
 
         OMPL's simplifier checks motions at the space's resolution, and a shortcut into the gap
-        between two checked states is exactly what it finds: its path is only kept when the fine
-        check passes, and when that check fits in what is left of the budget."""
+        between two checked states is exactly what it finds; it may also repair a state it
+        finds invalid by moving it without checking the motions to it. Its path is only kept
+        when the check passes (with a user's checker: when that check fits in what is left of
+        the budget)."""
         model = self._model
         if not isinstance(model, SpaceInformationCollisionModel):
-            return True
+            return bool(model.path_valid(xy))
         budget = self._values["budget"]
         if budget > 0:
             rate = model.seconds_per_length() or model.probe(xy[0])
