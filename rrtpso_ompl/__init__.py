@@ -20,7 +20,14 @@ from importlib import import_module
 from importlib.metadata import PackageNotFoundError, version
 from typing import Any
 
-from .errors import ParameterError, PlannerError, ProblemError, RrtpsoError, UnknownPlannerError
+from .errors import (
+    ArgumentError,
+    ParameterError,
+    PlannerError,
+    ProblemError,
+    RrtpsoError,
+    UnknownPlannerError,
+)
 from .model import Problem, World, load_problem, problem_from_dict
 
 try:
@@ -37,6 +44,7 @@ _LAZY = {
 }
 
 __all__ = [
+    "ArgumentError",
     "ParameterError",
     "PlannerError",
     "Problem",

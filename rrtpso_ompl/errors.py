@@ -16,6 +16,7 @@ import difflib
 from collections.abc import Iterable
 
 __all__ = [
+    "ArgumentError",
     "GenerationError",
     "OutputError",
     "ParameterError",
@@ -159,3 +160,8 @@ class OutputError(RrtpsoError, OSError):
 class GenerationError(RrtpsoError, ValueError):
     """The generator's options are invalid, or no problem satisfying them was found within the
     allowed attempts (too many or too large obstacles, too large a robot for the workspace)."""
+
+
+class ArgumentError(RrtpsoError, TypeError):
+    """A Python argument of the wrong kind: a file name where a :class:`~rrtpso_ompl.model.Problem`
+    goes, a string where a mapping of parameters goes, ``None`` where a path goes."""

@@ -14,14 +14,18 @@ from typing import Any
 
 __all__ = [
     "MAX_COORDINATE",
+    "MAX_RUNS",
     "MAX_SECONDS",
+    "MAX_STEPS",
     "MIN_EXTENT",
     "SEED_MAX",
     "check_integer",
     "check_number",
+    "check_run_count",
     "check_seconds",
     "check_seed",
     "describe",
+    "number_hint",
     "short_repr",
 ]
 
@@ -33,12 +37,21 @@ SEED_MAX = 2**32 - 1
 #: workspace's scale (:func:`~rrtpso_ompl.model.problem.touch_tolerance`); beyond 1e9 that
 #: allowance would exceed a unit, and at 1e160 squared distances overflow.
 MAX_COORDINATE = 1e9
-#: Smallest side of the workspace: well above the absolute round-off allowance of 1e-9.
+#: Smallest side of the workspace, absolute and as a share of its coordinates' magnitude: the
+#: round-off allowance, 1e-9 of the workspace's scale (its larger side or coordinate
+#: magnitude), then stays at most a thousandth of a side.
 MIN_EXTENT = 1e-6
 #: Longest time budget, seconds (about 11.6 days). OMPL's timed termination condition holds its
 #: deadline in integer nanoseconds, and a budget near 1e10 s overflows it: the planner then
 #: returns at once with no solution.
 MAX_SECONDS = 1e6
+#: Most runs one batch or bench may make (files x planners x runs x budgets): each is a task,
+#: and later a row, held in memory (about 0.5 kB a task, a few kB a row with its path).
+MAX_RUNS = 100_000
+#: Most control steps (one per ``robot.sample_time``) of a simulation or of the wheel-command
+#: trajectory of ``rrtpso solve --trajectory``: a million rows take about 10 s and 450 MB to
+#: compute and write (docs/problem-format.md).
+MAX_STEPS = 1_000_000
 
 #: Short, bounded reprs: a value may be a huge or self-referencing structure (YAML anchors).
 _REPR = reprlib.Repr()
@@ -140,3 +153,50 @@ def check_seed(value: Any) -> int:
         return check_integer(value, low=0, high=SEED_MAX)
     except ValueError as exc:
         raise ValueError(f"{exc} (seeds are integers from 0 to 2**32 - 1)") from None
+
+
+def check_run_count(runs: int, planners: int = 1, files: int = 1, budgets: int = 1) -> int:
+    """The number of runs of a batch or bench, ``runs x planners x files x budgets``, at most
+    :data:`MAX_RUNS`.
+
+    Raises
+    ------
+    ValueError
+        ``"must be at most 100,000 in one batch or bench, got runs 200,000 x 1 planner x 1
+        file = 200,000 (...)"``.
+    """
+    total = runs * planners * files * budgets
+    if total > MAX_RUNS:
+        factors = [f"runs {runs:,}", _count(planners, "planner"), _count(files, "file")]
+        if budgets != 1:
+            factors.append(_count(budgets, "budget"))
+        raise ValueError(
+            f"must be at most {MAX_RUNS:,} in one batch or bench, got {' x '.join(factors)} = "
+            f"{total:,} (fewer runs, or split the files)"
+        )
+    return total
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n:,} {noun}{'' if n == 1 else 's'}"
+
+
+def number_hint(value: Any) -> str:
+    """Why a number-like string is not a number, for a message: `` (a number in quotes is text:
+    remove the quotes)`` and the like (empty when the value does not look like a number)."""
+    if not isinstance(value, str):
+        return ""
+    try:
+        x = float(value)
+    except ValueError:
+        return ""
+    if not math.isfinite(x):
+        return ""
+    if "e" in value.lower():
+        # PyYAML follows YAML 1.1, where a float needs a point: 1e3 and 1.0e3 are text.
+        fixed = repr(x)
+        mantissa, e, exponent = fixed.partition("e")
+        if e and "." not in mantissa:
+            fixed = f"{mantissa}.0e{exponent}"
+        return f" (YAML reads {value} as text, not a number: write {fixed})"
+    return " (a number in quotes is text: remove the quotes)"

@@ -140,7 +140,7 @@ def choose_planner(args: argparse.Namespace) -> PlannerChoice:
     except ParameterError as exc:
         raise UsageError(f"{src}: --param {exc.name}: {exc}") from None
     for key, value in problem.planner.params.items():
-        _check_param(entry, key, value, f"{src}: planner.params.{key}")
+        _check_param(entry, key, value, f"{src}: planner.params.{key}", text=False)
     for key, value in cli_params.items():
         if key not in post_params:
             _check_param(entry, key, value, f"{src}: --param {key}")
@@ -188,9 +188,9 @@ def parse_params(items: list[str], src: str = "") -> dict[str, str]:
     return params
 
 
-def _check_param(entry: Any, key: str, value: Any, where: str) -> None:
+def _check_param(entry: Any, key: str, value: Any, where: str, text: bool = True) -> None:
     try:
-        entry.param(key).convert(value, entry.name)
+        entry.param(key).convert(value, entry.name, text)
     except ParameterError as exc:
         raise UsageError(f"{where}: {exc}") from None
 
@@ -450,6 +450,15 @@ def check_run_options(args: argparse.Namespace) -> None:
     for flag in ("runs", "jobs"):
         if getattr(args, flag) < 1:
             raise UsageError(f"--{flag}: must be at least 1, got {getattr(args, flag)}")
+    from ..validation import MAX_RUNS
+
+    if args.runs > MAX_RUNS:
+        raise UsageError(f"--runs: must be at most {MAX_RUNS:,} (the runs of one batch or bench), "
+                         f"got {args.runs}")  # fmt: skip
+    max_jobs = 4 * (os.cpu_count() or 1)
+    if args.jobs > max_jobs:
+        raise UsageError(f"--jobs: must be at most {max_jobs} (4 per CPU of this machine; each "
+                         f"worker is a Python process with OMPL), got {args.jobs}")  # fmt: skip
     check_seed_flag(args.seed, runs=args.runs)
     if args.executor == "dask":
         if not args.scheduler:

@@ -3,9 +3,11 @@
 Exit status: 0 success, 1 no valid path (or the subcommand's own "not achieved"), 2 bad input or
 usage (one message on stderr, no traceback, nothing written) or an output that could not be
 written (the disk is full, standard output was closed when the command started: one message
-naming the output and the reason; the old file is intact), 130 interrupted. A pipe whose reader
-went away (``rrtpso planners | head -1``) is not an error: nothing is said and the status is 0,
-or the command's own when it had finished its work (``solve --json -``).
+naming the output and the reason; the old file is intact), 128 + the signal when stopped by a
+signal: 130 Ctrl-C (SIGINT), 129 SIGHUP, 143 SIGTERM. The three end alike: workers stopped,
+temporary files removed, a results file left valid (continue it with ``--resume``). A pipe whose
+reader went away (``rrtpso planners | head -1``) is not an error: nothing is said and the status
+is 0, or the command's own when it had finished its work (``solve --json -``).
 """
 
 from __future__ import annotations
@@ -13,15 +15,16 @@ from __future__ import annotations
 import argparse
 import contextlib
 import logging
+import signal
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 from ..errors import OutputError, RrtpsoError
 from ..outputs import STDOUT, guard_standard_streams, os_reason, silence_stdout, stdout_closed
 from . import batch, bench, generate, optimum, planners, simulate, solve
 from .common import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK, add_shared_flags, set_quiet
 
-__all__ = ["main"]
+__all__ = ["Terminated", "main"]
 
 #: The subcommands, in the order ``rrtpso --help`` lists them.
 COMMANDS = (solve, simulate, batch, generate, optimum, bench, planners)
@@ -41,6 +44,50 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP, raised where Ctrl-C raises ``KeyboardInterrupt`` and handled alike:
+    every ``finally`` and ``except BaseException`` on the way runs (workers are stopped, the
+    temporary files of unfinished outputs removed, the results file released).
+
+    Parameters
+    ----------
+    signum : int
+        The signal; the exit status is ``128 + signum``.
+    """
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+#: The signals that stop a command as Ctrl-C does (SIGHUP: the terminal went away).
+STOP_SIGNALS = tuple(
+    getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name)
+)
+
+
+def _raise_terminated(signum: int, frame: object) -> None:
+    # A second signal must not cut the cleanup of the first short (kill -9 still can).
+    for sig in STOP_SIGNALS:
+        signal.signal(sig, signal.SIG_IGN)
+    raise Terminated(signum)
+
+
+@contextlib.contextmanager
+def _stop_signals_as_interrupts() -> Iterator[None]:
+    """SIGTERM and SIGHUP raise :class:`Terminated` while the block runs (main thread only:
+    Python runs signal handlers there), then the previous handlers are back."""
+    try:
+        saved = {sig: signal.signal(sig, _raise_terminated) for sig in STOP_SIGNALS}
+    except ValueError:  # not the main thread: leave the signals alone
+        saved = {}
+    try:
+        yield
+    finally:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     guard_standard_streams()  # before any file is opened: `rrtpso ... >&-`
@@ -54,13 +101,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         format="%(levelname)s: %(name)s: %(message)s",
     )
     try:
-        status = args.func(args)
-        _flush_stdout()
+        with _stop_signals_as_interrupts():
+            status = args.func(args)
+            _flush_stdout()
         return status
     except RrtpsoError as exc:  # bad input of any kind: its message names where it came from
         if isinstance(exc, OutputError) and exc.path == STDOUT:
             silence_stdout()  # what is still buffered for it cannot be written either
         return _fail(f"rrtpso: error: {exc}", EXIT_BAD_INPUT)
+    except Terminated as exc:
+        return _fail(f"rrtpso: terminated by {signal.Signals(exc.signum).name}", 128 + exc.signum)
     except KeyboardInterrupt:
         return _fail("rrtpso: interrupted", EXIT_INTERRUPTED)
     except BrokenPipeError:

@@ -130,21 +130,36 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _check_drive_keys(args: argparse.Namespace, problem: Any) -> None:
-    """Wheel commands need the drive's parameters: refuse before planning when one is missing."""
-    from ..kinematics import REQUIRED_ROBOT_KEYS
+    """Wheel commands need the drive's parameters, and a bounded number of samples: refuse
+    before planning when one is missing, or when even the straight line from start to goal at
+    the top speed would take too many samples."""
+    import math
+
+    from ..errors import ProblemError
+    from ..kinematics import REQUIRED_ROBOT_KEYS, TrajectoryError, check_samples
 
     robot = problem.robot
     flag = "--trajectory" if args.trajectory else "--plot-velocities"
     for key in REQUIRED_ROBOT_KEYS:
         if getattr(robot, key) is None:
             raise UsageError(f"{args.problem}: robot.{key}: required for {flag}")
+    shortest = max(0.0, math.dist(problem.start, problem.goal) - problem.goal_tolerance)
+    top = max(robot.speed, robot.max_speed or 0.0)  # no profile drives faster
+    try:
+        check_samples(shortest / top, robot.sample_time, "even the straight line to the goal")
+    except TrajectoryError as exc:
+        raise ProblemError(problem.source, "", f"{exc} (for {flag})") from None
 
 
 def _drive(problem: Any, result: Any, profile: str) -> Any:
-    from ..kinematics import drive
+    from ..errors import ProblemError
+    from ..kinematics import TrajectoryError, drive
     from ..model import World
 
-    return drive(result.path, World.from_problem(problem), problem.robot, profile)
+    try:
+        return drive(result.path, World.from_problem(problem), problem.robot, profile)
+    except TrajectoryError as exc:  # the path found is longer than the straight line
+        raise ProblemError(problem.source, "", str(exc)) from None
 
 
 def _write_outputs(args: argparse.Namespace, problem: Any, result: Any, motion: Any) -> None:

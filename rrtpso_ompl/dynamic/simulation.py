@@ -26,6 +26,7 @@ import numpy as np
 from ..errors import RrtpsoError
 from ..model.geometry import path_length
 from ..model.problem import Problem
+from ..validation import MAX_STEPS as _MAX_STEPS
 from .manager import Replan, ReplanningManager
 from .motion import Motion, ObstacleTrack, closest_approach
 from .prediction import predict_threats
@@ -45,8 +46,9 @@ class SimulationError(RrtpsoError):
     """A simulation that cannot be run as asked (the message says why)."""
 
 
-#: Most control steps one simulation may take (simulated time / sample time).
-MAX_STEPS = 1_000_000
+#: Most control steps one simulation may take (simulated time / sample time): the limit every
+#: sampled motion shares.
+MAX_STEPS = _MAX_STEPS
 #: Most reactions (detours and fallbacks) one simulation may make before it gives up: each one
 #: plans or verifies, so this bounds the wall time of a run that can never get through.
 MAX_REPLANS = 500

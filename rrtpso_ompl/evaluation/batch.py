@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..errors import ProblemError, RrtpsoError
+from ..errors import ProblemError, RrtpsoError, UsageError
 from ..model.occupancy import is_map_yaml
 from ..model.problem import input_files
 from ..model.yamlfile import open_input
@@ -128,9 +128,16 @@ def make_tasks(
 
     ``params`` maps a planner name to its parameters; ``simplify`` may be a function of the
     planner name.
+
+    Raises
+    ------
+    UsageError
+        For more than :data:`~rrtpso_ompl.validation.MAX_RUNS` tasks.
     """
+    inputs = expand_inputs(items)
+    check_task_count(runs, len(planners), len(inputs))
     tasks = []
-    for path, error in expand_inputs(items):
+    for path, error in inputs:
         source = resolved_source(path) if error is None else None
         digest = inputs_digest(path) if error is None else None
         for planner in planners:
@@ -177,6 +184,17 @@ def inputs_digest(path: str) -> str:
             h.update(f"unreadable: {exc}".encode())
         h.update(f"\0{size}\0".encode())  # where one file ends and the next begins
     return h.hexdigest()
+
+
+def check_task_count(runs: int, planners: int, files: int, budgets: int = 1) -> None:
+    """Refuse a batch or bench of more than :data:`~rrtpso_ompl.validation.MAX_RUNS` runs
+    before building its tasks (a :class:`UsageError` naming the factors)."""
+    from ..validation import check_run_count
+
+    try:
+        check_run_count(runs, planners, files, budgets)
+    except ValueError as exc:
+        raise UsageError(f"--runs: the number of runs {exc}") from None
 
 
 # ----------------------------------------------------------------------------------------------

@@ -49,7 +49,7 @@ from typing import Any
 from ..errors import UsageError
 from ..outputs import atomic_path, make_folders, remove_folders, write_text_atomic
 from ..planners.result import BenchmarkRun
-from .batch import Task, make_tasks, run_batch
+from .batch import Task, check_task_count, expand_inputs, make_tasks, run_batch
 from .ompl_log import Experiment, PlannerRuns, build_database, write_log
 
 __all__ = [
@@ -106,6 +106,7 @@ def bench_tasks(
     in OMPL's Benchmark); True or False applies to every planner.
     """
     how = _simplified_in_benchmarks if simplify is None else simplify
+    check_task_count(runs, len(planners), len(expand_inputs(items)), len(times))
     tasks = []
     for budget in times:
         tasks += make_tasks(items, planners, runs=runs, seed=seed, time_limit=budget,
@@ -208,9 +209,9 @@ def run_bench(
         When the folder holds files of this bench's names that no bench wrote, another bench is
         writing it, or it holds an earlier bench and neither ``resume`` nor ``overwrite`` is given.
     """
+    tasks = bench_tasks(items, planners, runs, times, seed, params, simplify)  # checked first
     out = Path(out_dir)
     _check_out_dir(out)
-    tasks = bench_tasks(items, planners, runs, times, seed, params, simplify)
     made = make_folders(out)
     try:
         rows = run_batch(tasks, out / "runs.jsonl", jobs=jobs, resume=resume,

@@ -706,7 +706,8 @@ def _arcs_free(world: World, center, rho, a0, sweep) -> np.ndarray:
 
 
 def _edges_of(world: World, arc: np.ndarray, ids: np.ndarray, kind: np.ndarray):
-    """(arc, edge) pairs for the boxes and polygons among the candidates."""
+    """(arc, edge) pairs for the boxes and polygon edges among the candidates (the world indexes
+    a polygon by its edges, and its interior, which :meth:`World.in_polygons` covers)."""
     arcs, edges = [], []
     x = kind == 1
     if x.any():
@@ -716,14 +717,8 @@ def _edges_of(world: World, arc: np.ndarray, ids: np.ndarray, kind: np.ndarray):
             edges.append(e)
     p = kind == 2
     if p.any():
-        poly = ids[p] - world._n_circles - world._n_boxes
-        start = world._edge_start[poly]
-        count = world._edge_start[poly + 1] - start
-        pair = np.repeat(np.arange(len(poly)), count)
-        edge = np.repeat(start, count) + np.arange(count.sum()) - np.repeat(
-            np.cumsum(count) - count, count)  # fmt: skip
-        arcs.append(arc[p][pair])
-        edges.append(world._edges[edge])
+        arcs.append(arc[p])
+        edges.append(world._edges[ids[p] - world._first_edge])
     if not arcs:
         return np.empty(0, dtype=int), np.empty((0, 4))
     return np.concatenate(arcs), np.vstack(edges)

@@ -18,17 +18,32 @@ slower). Inside a Dask worker, which runs threads (forking it is unsafe), each r
 a fork server preloaded with the same imports (:func:`run_spawned` with ``warm=True``). Workers
 and their children ignore Ctrl-C: the parent handles it, stops them and leaves its results file
 valid.
+
+Nothing outlives the process that started it, whatever kills that process (``kill -9``
+included), so no orphan keeps a core busy for a whole time budget:
+
+- on Linux every worker and every forked child asks the kernel to kill it when its parent dies
+  (``prctl(PR_SET_PDEATHSIG, SIGKILL)``; the kernel sends it when the parent *thread* that
+  started the process ends: the workers of :func:`run_local` are started by the thread iterating
+  it, and are stopped before it returns anyway);
+- everywhere a worker also watches its pipe to the parent while a child runs: the pipe closes
+  when the parent dies, and the worker then kills the child and exits;
+- the process a Dask worker starts for a run (its parent is the fork server, not the Dask
+  worker) watches the Dask worker's pid from a thread and exits when it ends.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import faulthandler
+import functools
 import multiprocessing as mp
 import os
 import pickle
 import select
 import signal
+import sys
 import threading
 import time
 import traceback
@@ -40,6 +55,7 @@ __all__ = [
     "GRACE",
     "WARM_MODULES",
     "ChildFailure",
+    "die_with_parent",
     "run_local",
     "run_once_in_child",
     "run_spawned",
@@ -49,15 +65,58 @@ __all__ = [
 #: this covers building the world, the optimum, and a slow machine).
 GRACE = 120.0
 
+#: ``prctl`` option that makes the kernel signal a process when its parent dies
+#: (``<linux/prctl.h>``).
+_PR_SET_PDEATHSIG = 1
 
-def run_once_in_child(fn: Callable[[Any], dict[str, Any]], task: Any, timeout: float) -> Any:
+
+def die_with_parent(parent: int) -> None:
+    """Make this process die with its parent ``parent`` (a pid), whatever kills the parent.
+
+    On Linux the kernel sends SIGKILL to this process when the parent dies
+    (``prctl(PR_SET_PDEATHSIG)``; strictly, when the parent's thread that created this process
+    ends). A parent that died before the request is not seen by the kernel: then this process
+    ends at once. Elsewhere this only does that check; the callers watch a pipe or a pid instead.
+    """
+    prctl = _prctl()
+    if prctl is not None:
+        prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    if os.getppid() != parent:
+        os._exit(1)
+
+
+@functools.cache
+def _prctl() -> Any:
+    """libc's ``prctl`` on Linux (looked up once per process, so forked children inherit it),
+    else None."""
+    if not sys.platform.startswith("linux"):
+        return None
+    try:
+        return ctypes.CDLL(None, use_errno=True).prctl
+    except (OSError, AttributeError):
+        return None
+
+
+class _ParentGone(Exception):
+    """The pipe to the parent closed (or spoke) while a child ran: the parent is gone."""
+
+
+def run_once_in_child(fn: Callable[[Any], dict[str, Any]], task: Any, timeout: float,
+                      watch: Connection | None = None) -> Any:  # fmt: skip
     """``fn(task)`` in a forked child (a spawned process without ``os.fork``); its return value,
-    or an :class:`ChildFailure` describing how the child ended."""
+    or an :class:`ChildFailure` describing how the child ended.
+
+    ``watch``, a worker's pipe to its parent, is watched while the child runs: when it becomes
+    readable (the parent died, or asks the worker to stop) the child is killed and
+    :class:`_ParentGone` raised.
+    """
     if not hasattr(os, "fork"):
         return run_spawned(fn, task, timeout)
     r, w = os.pipe()
+    me = os.getpid()
     pid = os.fork()
     if pid == 0:  # the child: never returns
+        die_with_parent(me)
         os.close(r)
         faulthandler.disable()  # a crash is reported as the task's error row, not as a dump
         code = 0
@@ -74,7 +133,11 @@ def run_once_in_child(fn: Callable[[Any], dict[str, Any]], task: Any, timeout: f
         finally:
             os._exit(code)  # no atexit handlers, no nanobind leak reports, no flushing twice
     os.close(w)
-    data = _read_all(r, timeout)
+    try:
+        data = _read_all(r, timeout, watch.fileno() if watch is not None else None)
+    except _ParentGone:
+        _reap(pid, killed=True)
+        raise
     status = _reap(pid, killed=data is None)
     if data:
         try:
@@ -101,18 +164,23 @@ class ChildFailure:
         return f"ChildFailure({self.message!r})"
 
 
-def _read_all(fd: int, timeout: float) -> bytes | None:
-    """Everything written to the pipe until the writer closes it; None on timeout."""
+def _read_all(fd: int, timeout: float, watch: int | None = None) -> bytes | None:
+    """Everything written to the pipe until the writer closes it; None on timeout.
+
+    Raises :class:`_ParentGone` when the file descriptor ``watch`` becomes readable first."""
     chunks = []
     deadline = time.monotonic() + timeout
+    fds = [fd] if watch is None else [fd, watch]
     try:
         while True:
             left = deadline - time.monotonic()
             if left <= 0:
                 return None
-            ready, _, _ = select.select([fd], [], [], left)
+            ready, _, _ = select.select(fds, [], [], left)
             if not ready:
                 return None
+            if watch in ready:
+                raise _ParentGone
             chunk = os.read(fd, 1 << 20)
             if not chunk:
                 return b"".join(chunks)
@@ -182,7 +250,9 @@ def _children_allowed() -> Iterator[None]:
 def run_spawned(fn: Callable[[Any], Any], task: Any, timeout: float, warm: bool = False) -> Any:
     """``fn(task)`` in a process of its own; ``warm`` forks it from a fork server that has
     imported :data:`WARM_MODULES` (milliseconds instead of half a second of imports, and safe
-    from a threaded parent such as a Dask worker, since the server itself runs no threads)."""
+    from a threaded parent such as a Dask worker, since the server itself runs no threads).
+
+    The run's process ends when this process does, whatever kills it (:func:`_watched_call`)."""
     from concurrent.futures import ProcessPoolExecutor
     from concurrent.futures.process import BrokenProcessPool
 
@@ -190,11 +260,40 @@ def run_spawned(fn: Callable[[Any], Any], task: Any, timeout: float, warm: bool 
     ctx = _forkserver() if warm else mp.get_context("spawn")
     with _children_allowed(), ProcessPoolExecutor(1, mp_context=ctx) as pool:
         try:
-            return pool.submit(fn, task).result(timeout=timeout)
+            return pool.submit(_watched_call, fn, task, os.getpid()).result(timeout=timeout)
         except BrokenProcessPool:
             return ChildFailure("the run's process died")
         except Exception as exc:
             return ChildFailure(f"the run raised {type(exc).__name__}: {exc}")
+
+
+def _watched_call(fn: Callable[[Any], Any], task: Any, owner: int) -> Any:
+    """``fn(task)`` in a process that ends as soon as the process ``owner`` does.
+
+    The process :func:`run_spawned` starts is a child of the fork server (or of the pool), not of
+    ``owner``, so the kernel's parent-death signal cannot tie the two: a thread waits for
+    ``owner`` to end instead (this process never forks, so the thread is safe)."""
+    threading.Thread(target=_exit_when_gone, args=(owner,), daemon=True).start()
+    return fn(task)
+
+
+def _exit_when_gone(pid: int) -> None:
+    """Wait until the process ``pid`` ends (a pidfd where the platform has one, else polling
+    twice a second), then end this process at once."""
+    try:
+        fd = os.pidfd_open(pid)
+    except (AttributeError, OSError):  # not Linux >= 5.3, or already gone
+        fd = None
+    if fd is not None:
+        select.select([fd], [], [])
+    else:
+        while True:
+            try:
+                os.kill(pid, 0)
+            except (ProcessLookupError, PermissionError):  # gone (or its pid another user's)
+                break
+            time.sleep(0.5)
+    os._exit(1)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -202,9 +301,11 @@ def run_spawned(fn: Callable[[Any], Any], task: Any, timeout: float, warm: bool 
 # ----------------------------------------------------------------------------------------------
 def _worker_main(conn: Connection, fn: Callable[[Any], Any], warm: Callable[[], None] | None,
                  prepare: Callable[[Any], None] | None,
-                 timeout_of: Callable[[Any], float]) -> None:  # fmt: skip
+                 timeout_of: Callable[[Any], float], parent: int) -> None:  # fmt: skip
     """A warm worker: imports once, then runs each task it receives in a forked child, after
-    ``prepare(task)`` (loading its problem, which the following runs of it share)."""
+    ``prepare(task)`` (loading its problem, which the following runs of it share). It ends with
+    its parent ``parent`` (a pid), whatever kills that."""
+    die_with_parent(parent)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
     if hasattr(os, "setpgrp"):
         os.setpgrp()  # the worker and its children: one group the parent can stop at once
@@ -221,14 +322,21 @@ def _worker_main(conn: Connection, fn: Callable[[Any], Any], warm: Callable[[], 
         if prepare is not None:
             with contextlib.suppress(Exception):
                 prepare(task)
-        conn.send((index, run_once_in_child(fn, task, timeout_of(task))))
+        try:
+            result = run_once_in_child(fn, task, timeout_of(task), watch=conn)
+        except _ParentGone:
+            return
+        try:
+            conn.send((index, result))
+        except OSError:  # the parent is gone (a closed pipe): so are we, without a traceback
+            return
 
 
 class _Worker:
     def __init__(self, ctx: Any, fn, warm, prepare, timeout_of) -> None:
         self.conn, child = ctx.Pipe()
         self.process = ctx.Process(target=_worker_main,
-                                   args=(child, fn, warm, prepare, timeout_of),
+                                   args=(child, fn, warm, prepare, timeout_of, os.getpid()),
                                    daemon=True)  # fmt: skip
         self.process.start()
         child.close()

@@ -18,7 +18,7 @@ Printed typos and their corrections are listed in ``docs/kinematics.md``.
 from .diffdrive import integrate_wheels, wheel_speeds
 from .drive import REQUIRED_ROBOT_KEYS, DriveResult, drive
 from .nav_path import nav_path, write_nav_path
-from .profile import CSV_HEADER, Trajectory, time_parametrize
+from .profile import CSV_HEADER, Trajectory, TrajectoryError, check_samples, time_parametrize
 from .reference import ReferenceCurve, reference_curve, reference_polynomial
 from .tracking import TrackingResult, track
 
@@ -29,6 +29,8 @@ __all__ = [
     "ReferenceCurve",
     "TrackingResult",
     "Trajectory",
+    "TrajectoryError",
+    "check_samples",
     "drive",
     "integrate_wheels",
     "nav_path",

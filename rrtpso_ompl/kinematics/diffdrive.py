@@ -7,9 +7,11 @@ speeds, like eq. 1; eq. 3 is ``theta(k) = theta(k-1) + (V_right - V_left) / L * 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-__all__ = ["integrate_wheels", "wheel_speeds"]
+__all__ = ["integrate_wheels", "step_wheels", "wheel_speeds"]
 
 
 def wheel_speeds(
@@ -56,3 +58,21 @@ def integrate_wheels(
     x = x0 + np.concatenate([[0.0], np.cumsum(step * np.cos(theta[1:]))])
     y = y0 + np.concatenate([[0.0], np.cumsum(step * np.sin(theta[1:]))])
     return np.column_stack([x, y, theta])
+
+
+def step_wheels(
+    pose: tuple[float, float, float],
+    v_right: float,
+    v_left: float,
+    track_width: float,
+    sample_time: float,
+) -> tuple[float, float, float]:
+    """One step of :func:`integrate_wheels` (the same eqs. 1-3) for scalars: the pose after
+    holding the wheel speeds ``v_right``, ``v_left`` (units/s) for ``sample_time`` seconds.
+
+    A closed loop needs the poses one at a time; this is a hundred times cheaper per step than
+    the vectorised form on arrays of two."""
+    x, y, theta = pose
+    theta = theta + (v_right - v_left) / track_width * sample_time
+    step = 0.5 * (v_right + v_left) * sample_time
+    return x + step * math.cos(theta), y + step * math.sin(theta), theta

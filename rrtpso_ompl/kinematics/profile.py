@@ -14,15 +14,44 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import RrtpsoError
 from ..model.problem import Robot
+from ..validation import MAX_STEPS
 from .diffdrive import wheel_speeds
 from .reference import ReferenceCurve
 
-__all__ = ["CSV_HEADER", "Trajectory", "time_parametrize"]
+__all__ = ["CSV_HEADER", "Trajectory", "TrajectoryError", "check_samples", "time_parametrize"]
 
 CSV_HEADER = (
     "t", "x", "y", "theta", "v", "omega", "v_right", "v_left", "omega_right", "omega_left",
 )  # fmt: skip
+
+
+class TrajectoryError(RrtpsoError, ValueError):
+    """A trajectory that cannot be sampled as asked (more than
+    :data:`~rrtpso_ompl.validation.MAX_STEPS` samples)."""
+
+
+def check_samples(duration: float, sample_time: float, what: str = "the path") -> None:
+    """Refuse to sample ``duration`` seconds every ``sample_time`` seconds in more than
+    :data:`~rrtpso_ompl.validation.MAX_STEPS` samples.
+
+    Raises
+    ------
+    TrajectoryError
+        Naming ``robot.sample_time``, the number of samples and what to change.
+    """
+    samples = duration / sample_time
+    if samples > MAX_STEPS:
+        raise TrajectoryError(
+            f"robot.sample_time {sample_time:g} s would take {samples:.3g} samples to drive "
+            f"{what} ({duration:.3g} s); at most {MAX_STEPS:,}: use a longer sample time or a "
+            "higher speed"
+        )
+
+
+#: Rows formatted at a time when writing the CSV (bounds the memory the text takes).
+_CSV_CHUNK = 10_000
 
 
 @dataclass(frozen=True)
@@ -59,10 +88,13 @@ class Trajectory:
         :func:`rrtpso_ompl.outputs.publish`)."""
         from ..outputs import atomic_path
 
+        columns = self.columns()
         with atomic_path(path) as tmp, open(tmp, "w", newline="") as fh:
             writer = csv.writer(fh)
             writer.writerow(CSV_HEADER)
-            writer.writerows([[f"{v:.9g}" for v in row] for row in self.columns()])
+            for i in range(0, len(columns), _CSV_CHUNK):  # the text of a chunk at a time
+                chunk = columns[i : i + _CSV_CHUNK].tolist()  # floats format faster than numpy's
+                writer.writerows([f"{v:.9g}" for v in row] for row in chunk)
 
     @property
     def path_length(self) -> float:
@@ -94,6 +126,12 @@ def time_parametrize(curve: ReferenceCurve, robot: Robot, profile: str = "auto")
         are the mean velocities from row k to row k + 1, i.e. the commands to hold for one sample.
         Turns in place (the polyline fallback) run at the largest angular speed the wheel limit
         allows.
+
+    Raises
+    ------
+    TrajectoryError
+        When the trajectory would have more than :data:`~rrtpso_ompl.validation.MAX_STEPS`
+        samples.
     """
     for key in ("speed", "sample_time", "track_width", "wheel_radius"):
         if getattr(robot, key) is None:
@@ -114,6 +152,7 @@ def time_parametrize(curve: ReferenceCurve, robot: Robot, profile: str = "auto")
     # Event list: (time, s index, in-place turn progress).
     t_nodes = np.concatenate([[0.0], np.cumsum(turn_dt[:-1] + dt)])
     t_end = t_nodes[-1] + turn_dt[-1]
+    check_samples(t_end, ts)
     n = max(1, math.ceil(t_end / ts - 1e-9))
     t = np.arange(n + 1) * ts
     out = _states_at(curve, v, dt, turn_dt, t_nodes, w_turn, np.minimum(t, t_end))

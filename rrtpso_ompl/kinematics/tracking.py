@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .diffdrive import integrate_wheels
+from .diffdrive import step_wheels
 from .profile import Trajectory
 
 __all__ = ["TrackingResult", "track"]
@@ -54,25 +54,28 @@ def track(
     kth = 2.0 * damping * natural_frequency / v_nom
     n = len(traj.t)
     poses = np.empty((n, 3))
-    poses[0] = pose0 if pose0 is not None else (traj.x[0], traj.y[0], traj.theta[0])
+    pose = pose0 if pose0 is not None else (traj.x[0], traj.y[0], traj.theta[0])
     v_cmd = np.zeros(n)
     w_cmd = np.zeros(n)
     L, ts = traj.track_width, traj.sample_time
-    for k in range(n):
-        x, y, th = poses[k]
-        dx, dy = traj.x[k] - x, traj.y[k] - y
+    # Python floats, not numpy scalars: the loop is sequential (each pose depends on the last).
+    ref = zip(traj.x.tolist(), traj.y.tolist(), traj.theta.tolist(), traj.v.tolist(),
+              traj.omega.tolist(), strict=True)  # fmt: skip
+    for k, (xr, yr, thr, vref, wref) in enumerate(ref):
+        poses[k] = pose
+        x, y, th = pose
+        dx, dy = xr - x, yr - y
         ex = math.cos(th) * dx + math.sin(th) * dy
         ey = -math.sin(th) * dx + math.cos(th) * dy
-        eth = math.atan2(math.sin(traj.theta[k] - th), math.cos(traj.theta[k] - th))
-        v = traj.v[k] * math.cos(eth) + kx * ex
-        w = traj.omega[k] + traj.v[k] * (ky * ey + kth * math.sin(eth))
+        eth = math.atan2(math.sin(thr - th), math.cos(thr - th))
+        v = vref * math.cos(eth) + kx * ex
+        w = wref + vref * (ky * ey + kth * math.sin(eth))
         vr, vl = v + 0.5 * L * w, v - 0.5 * L * w
         if max_wheel_speed is not None:
             scale = max(abs(vr), abs(vl)) / max_wheel_speed
             if scale > 1.0:
                 vr, vl = vr / scale, vl / scale
         v_cmd[k], w_cmd[k] = 0.5 * (vr + vl), (vr - vl) / L
-        if k + 1 < n:
-            poses[k + 1] = integrate_wheels(poses[k], [vr, vr], [vl, vl], L, ts)[1]
+        pose = step_wheels(pose, vr, vl, L, ts)
     err = np.hypot(poses[:, 0] - traj.x, poses[:, 1] - traj.y)
     return TrackingResult(poses=poses, v=v_cmd, omega=w_cmd, position_error=err)

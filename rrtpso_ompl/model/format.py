@@ -208,7 +208,8 @@ def json_schema() -> dict[str, Any]:
         "$defs": defs,
     }
     schema["properties"]["bounds"]["description"] += (
-        f"; each side at least {MIN_EXTENT:g}, xmin < xmax and ymin < ymax"
+        f"; each side at least {MIN_EXTENT:g} and {MIN_EXTENT:g} of the coordinates' magnitude, "
+        "xmin < xmax and ymin < ymax"
     )
     schema["anyOf"] = [{"required": ["bounds"]}, {"required": ["map"]}]
     return schema

@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ProblemError
-from ..validation import MAX_COORDINATE, describe
+from ..validation import MAX_COORDINATE, describe, number_hint
 from .yamlfile import open_input, read_yaml_file
 
 __all__ = [
@@ -231,9 +231,16 @@ def load_map(path: str | Path, unknown_blocks: bool = True) -> OccupancyMap:
     if not isinstance(image, str) or not image.strip():
         raise ProblemError(source, "image", f"must be a file name, got {describe(image)}")
     resolution = _number(source, "resolution", doc["resolution"])
-    if not (0.0 < resolution <= MAX_COORDINATE):
+    if not resolution > 0.0:
         raise ProblemError(
             source, "resolution", f"must be > 0 (metres per cell), got {resolution:g}"
+        )
+    if resolution > MAX_COORDINATE:
+        raise ProblemError(
+            source,
+            "resolution",
+            f"must be at most {MAX_COORDINATE:g} (the largest length: exact checks allow for "
+            f"round-off of 1e-9 of the workspace's scale), got {resolution:g}",
         )
     origin = doc["origin"]
     if not isinstance(origin, list | tuple) or len(origin) not in (2, 3):
@@ -275,6 +282,18 @@ def load_map(path: str | Path, unknown_blocks: bool = True) -> OccupancyMap:
         raise ProblemError(source, "image", "the file name holds a NUL byte")
     image_path = map_image_path(path, image)
     grey, alpha, maxval = _read_image(source, image_path)
+    h, w = grey.shape
+    for i, (corner, cells) in enumerate(((ox, w), (oy, h))):
+        end = corner + cells * resolution
+        if abs(end) > MAX_COORDINATE:
+            axis = "xy"[i]
+            raise ProblemError(
+                source,
+                "resolution",
+                f"{cells} cells of {resolution:g} from origin {corner:g} reach {axis} = {end:g}, "
+                f"beyond +-{MAX_COORDINATE:g} (the coordinate limit: exact checks allow for "
+                "round-off of 1e-9 of the workspace's scale)",
+            )
     state = _states(grey, alpha, maxval, mode, bool(negate), occ, free)
     return OccupancyMap(
         source=source,
@@ -306,7 +325,8 @@ def _get(doc: dict, key: str) -> Any:
 
 def _number(source: str, key: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ProblemError(source, key, f"must be a number, got {describe(value)}")
+        raise ProblemError(source, key, f"must be a number, got {describe(value)}"
+                           f"{number_hint(value)}")  # fmt: skip
     x = float(value)
     if not math.isfinite(x):
         raise ProblemError(source, key, f"must be finite, got {x}")
@@ -407,6 +427,13 @@ def read_pgm(path: str | Path) -> tuple[np.ndarray, int]:
     values_ = raw.astype(np.int64)
     if values_.max(initial=0) > maxval:
         raise ValueError(f"a pixel value exceeds maxval {maxval}")
+    if values_.min(initial=0) < 0:
+        # P2 text can hold "-1"; read as an unsigned byte it would be 255, free space.
+        k = int(np.argmax(values_ < 0))
+        raise ValueError(
+            f"pixel {k} (row {k // width}, column {k % width}) is {values_[k]}: pixel values "
+            f"run from 0 to maxval {maxval}"
+        )
     return values_.reshape(height, width).astype(np.uint16 if maxval > 255 else np.uint8), maxval
 
 

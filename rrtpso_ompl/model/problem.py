@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import shapely
 
-from ..errors import ProblemError, did_you_mean
+from ..errors import ArgumentError, ProblemError, did_you_mean
 from ..validation import (
     MAX_COORDINATE,
     MIN_EXTENT,
@@ -30,6 +30,7 @@ from ..validation import (
     check_seconds,
     check_seed,
     describe,
+    number_hint,
 )
 from .format import MAP, MOVING, OBSTACLES, PLANNER, ROBOT, TOP
 from .occupancy import OccupancyMap, load_map, map_image_path
@@ -206,7 +207,12 @@ def load_problem(path: str | Path) -> Problem:
         For anything wrong with the file: unreadable, malformed YAML, missing, unknown or mistyped
         keys, negative radii, degenerate polygons, start or goal outside ``bounds`` or with the
         robot disc overlapping an obstacle, non-positive time limit.
+    ArgumentError
+        When ``path`` is not a file name (None, a number).
     """
+    if not isinstance(path, str | os.PathLike):
+        raise ArgumentError(f"load_problem: path must be a file name (str or os.PathLike), got "
+                            f"{describe(path)}")  # fmt: skip
     path = Path(path)
     data = read_yaml_file(path)
     return problem_from_dict(data, source=str(path), name=path.stem, base=path.parent)
@@ -268,6 +274,11 @@ def problem_from_dict(
     ProblemError
         For anything that is not a valid problem (the same checks as :func:`load_problem`).
     """
+    if not isinstance(source, str):
+        raise ArgumentError(f"problem_from_dict: source must be a str naming where the data came "
+                            f"from, got {describe(source)}")  # fmt: skip
+    if name is not None and not isinstance(name, str):
+        raise ArgumentError(f"problem_from_dict: name must be a str, got {describe(name)}")
     v = _Validator(source)
     if data is None:
         raise v.error("", "the file is empty; a problem needs at least bounds, start, goal, robot")
@@ -286,6 +297,10 @@ def problem_from_dict(
     bounds = v.bounds(doc["bounds"], "bounds") if doc.get("bounds") is not None else None
     if bounds is None:
         bounds = occupancy.extent
+        small = _too_small(bounds)
+        if small:
+            raise v.error("map", f"its extent (image size x resolution) is {small}; give bounds "
+                          "or a map of larger cells")  # fmt: skip
     robot = v.robot(doc["robot"], "robot")
     obstacles = tuple(
         v.obstacle(o, f"obstacles[{i}]") for i, o in enumerate(v.sequence(doc, "obstacles"))
@@ -375,7 +390,7 @@ class _Validator:
         try:
             return check_number(value, low=low, strict_low=strict)
         except ValueError as exc:
-            raise self.error(key, f"{exc}{_number_hint(value)}") from None
+            raise self.error(key, f"{exc}{number_hint(value)}") from None
 
     def string(self, value: Any, key: str, empty: bool = False) -> str:
         if not isinstance(value, str) or (not empty and not value.strip()):
@@ -409,12 +424,9 @@ class _Validator:
         lo, hi = self.point(value[0], f"{key}[0]"), self.point(value[1], f"{key}[1]")
         if not (lo[0] < hi[0] and lo[1] < hi[1]):
             raise self.error(key, f"needs xmin < xmax and ymin < ymax, got {lo} and {hi}")
-        if min(hi[0] - lo[0], hi[1] - lo[1]) < MIN_EXTENT:
-            raise self.error(
-                key,
-                f"the workspace is too small to plan in: sides {hi[0] - lo[0]:g} x "
-                f"{hi[1] - lo[1]:g}, each must be at least {MIN_EXTENT:g}",
-            )
+        small = _too_small((lo, hi))
+        if small:
+            raise self.error(key, f"the workspace is {small}")
         return lo, hi
 
     def robot(self, value: Any, key: str) -> Robot:
@@ -591,6 +603,13 @@ class _Validator:
             )
             if d == 0.0:
                 raise self.error(key, f"({x:g}, {y:g}) lies in {where}")
+            if d >= r:  # only within the round-off allowance: say so, not "overlaps"
+                tol = touch_tolerance(problem.bounds)
+                raise self.error(
+                    key,
+                    f"the robot disc (radius {r:g}) at ({x:g}, {y:g}) touches {where} within the "
+                    f"round-off allowance {tol:.3g} of this workspace: clearance {d:.6g}",
+                )
             raise self.error(
                 key,
                 f"the robot disc (radius {r:g}) at ({x:g}, {y:g}) overlaps {where}: "
@@ -627,15 +646,33 @@ def _outside(bounds: tuple[Point, Point], extent: tuple[Point, Point]) -> np.nda
     return out.reshape(-1, 4)
 
 
+def _too_small(bounds: tuple[Point, Point]) -> str:
+    """Why a workspace is too small to plan in exactly (empty when it is not): a side under
+    :data:`~rrtpso_ompl.validation.MIN_EXTENT`, or under that share of the coordinates'
+    magnitude (then the round-off allowance, :func:`touch_tolerance`, would exceed a thousandth
+    of the side)."""
+    (xmin, ymin), (xmax, ymax) = bounds
+    side = min(xmax - xmin, ymax - ymin)
+    magnitude = max(abs(xmin), abs(ymin), abs(xmax), abs(ymax))
+    need = max(MIN_EXTENT, MIN_EXTENT * magnitude)
+    if side >= need:
+        return ""
+    why = f"{MIN_EXTENT:g}" if need == MIN_EXTENT else (
+        f"{need:g} ({MIN_EXTENT:g} of its coordinates' magnitude {magnitude:g})")  # fmt: skip
+    return (f"too small to plan in: sides {xmax - xmin:g} x {ymax - ymin:g}, each must be at "
+            f"least {why}")  # fmt: skip
+
+
 def touch_tolerance(bounds: tuple[Point, Point]) -> float:
     """Round-off allowance for "touching is allowed" comparisons in a workspace.
 
-    ``1e-9`` of the workspace's scale: the larger of its sides and of its coordinates' magnitudes
-    (float spacing grows with both), at least ``1e-9``. Far below any physical clearance, well
-    above float round-off in the distance formulas.
+    ``1e-9`` of the workspace's scale: the larger of its sides and of its coordinates'
+    magnitudes (float spacing grows with both). Relative at every scale, so a workspace 1e-6
+    wide is checked as exactly as one of 500 cm; far below any physical clearance, well above
+    float round-off in the distance formulas.
     """
     (xmin, ymin), (xmax, ymax) = bounds
-    scale = max(xmax - xmin, ymax - ymin, abs(xmin), abs(ymin), abs(xmax), abs(ymax), 1.0)
+    scale = max(xmax - xmin, ymax - ymin, abs(xmin), abs(ymin), abs(xmax), abs(ymax))
     return 1e-9 * scale
 
 
@@ -682,23 +719,3 @@ def _key_label(key: Any) -> str:
     if isinstance(key, bool):
         return "true" if key else "false"
     return str(key) or "''"
-
-
-def _number_hint(value: Any) -> str:
-    """Explain why a number-like string is not a number (empty when it does not look like one)."""
-    if not isinstance(value, str):
-        return ""
-    try:
-        x = float(value)
-    except ValueError:
-        return ""
-    if not math.isfinite(x):
-        return ""
-    if "e" in value.lower():
-        # PyYAML follows YAML 1.1, where a float needs a point: 1e3 and 1.0e3 are text.
-        fixed = repr(x)
-        mantissa, e, exponent = fixed.partition("e")
-        if e and "." not in mantissa:
-            fixed = f"{mantissa}.0e{exponent}"
-        return f" (YAML reads {value} as text, not a number: write {fixed})"
-    return " (a number in quotes is text: remove the quotes)"

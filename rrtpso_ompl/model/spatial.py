@@ -27,8 +27,10 @@ __all__ = ["Grid"]
 
 #: Most grid cells (memory: two ints per cell plus the registrations).
 MAX_CELLS = 4_000_000
-#: Most (cell, obstacle) registrations before the cells are made coarser.
-MAX_REGISTRATIONS = 20_000_000
+#: Most (cell, obstacle) registrations before the cells are made coarser: about 100 MB of index
+#: while it is built (a polygon of 100,000 vertices with a robot much wider than its edges needs
+#: them coarser; a world of 10,000 circles has some 40,000).
+MAX_REGISTRATIONS = 4_000_000
 
 
 class Grid:
@@ -63,6 +65,8 @@ class Grid:
             cell *= 2.0  # huge obstacles over a fine grid: fewer, larger cells
         self.n_items = len(boxes)
         self.offsets, self.ids = _csr(i0, i1, j0, j1, counts, self.nx, self.nx * self.ny)
+        #: The most items one cell holds (sizes the chunks of the vectorised queries).
+        self.max_items = int(np.diff(self.offsets).max(initial=0))
         self._tuples: dict[int, tuple[int, ...]] = {}
 
     # -- geometry --------------------------------------------------------------------------------
@@ -177,8 +181,17 @@ class Grid:
         q = np.repeat(query, counts)
         k = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
         ids = self.ids[np.repeat(start, counts) + k]
-        key = np.unique(q * max(self.n_items, 1) + ids)
-        q, ids = np.divmod(key, max(self.n_items, 1))
+        n = max(self.n_items, 1)
+        queries = np.unique(query)
+        if len(queries) * n <= 8 * len(ids):
+            # Few queries, each meeting many cells (large boxes): a mark per (query, item) is
+            # cheaper than sorting the repeats away, and takes no more memory than the pairs.
+            mark = np.zeros((len(queries), n), dtype=bool)
+            mark[np.searchsorted(queries, q), ids] = True
+            row, ids = np.nonzero(mark)
+            return queries[row].astype(np.intp), ids.astype(np.intp)
+        key = np.unique(q * n + ids)
+        q, ids = np.divmod(key, n)
         return q.astype(np.intp), ids.astype(np.intp)
 
 

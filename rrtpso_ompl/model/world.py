@@ -9,28 +9,34 @@ free when *every* point of the segment is free. Both tests are computed exactly,
   else the smallest of the distances from the segment's end points to the box and from the box's
   corners to the segment;
 * polygon: zero when the segment crosses an edge or lies inside, else the smallest of the
-  point-to-segment distances between the segment's end points and the edges and between the
-  polygon's vertices and the segment (the distance between two non-crossing segments is attained
-  at an end point of one of them).
+  segment-to-edge distances (the distance between two non-crossing segments is attained at an
+  end point of one of them). A segment that comes within ``R`` of no edge lies wholly inside or
+  wholly outside the polygon, as its first point does.
 
 A spatial index (:class:`~rrtpso_ompl.model.spatial.Grid`) hands every check only the obstacles
 that can be within ``R`` of it, so a check costs about the same among 10 obstacles as among
-10,000. Two implementations of the same formulas serve two callers:
+10,000. A polygon is indexed as its edges, each on its own, and its interior (by its bounding
+box, looked at only for a segment's first point): a check near a 100,000-vertex polygon looks at
+the few edges near it, not at all of them. Two implementations of the same formulas serve two
+callers:
 
 * :meth:`World.motion_free` / :meth:`World.point_free` are scalar pure Python: OMPL asks for one
-  segment at a time, and for a few candidates plain floats beat building numpy arrays.
+  segment at a time, and for a few candidates plain floats beat building numpy arrays (an index
+  cell crowded with hundreds of a polygon's edges goes through the numpy formulas instead).
 * :meth:`World.segments_free`, :meth:`World.segment_violation` and friends are vectorised numpy
   over many segments at once: the PSO evaluates whole swarms of paths per iteration.
 
 Touching at exactly the robot radius is allowed, up to a tolerance of ``1e-9`` times the scale of
-the workspace (floating-point round-off).
+the workspace (floating-point round-off; :func:`~rrtpso_ompl.model.problem.touch_tolerance`).
 """
 
 from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+import time
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 
 import numpy as np
 import shapely
@@ -48,8 +54,16 @@ Bounds = tuple[tuple[float, float], tuple[float, float]]
 SMALL_WORLD = 24
 #: Most (segment, obstacle) pairs one vectorised step evaluates at once (memory bound).
 _PAIR_CHUNK = 1_000_000
-#: Obstacle kinds, in the order of their ids: circles, then boxes, then polygons.
-_CIRCLE, _BOX, _POLYGON = 0, 1, 2
+#: Kinds of the items in the index, in the order of their ids: circles, boxes, the edges of the
+#: polygons, the polygons' interiors.
+_CIRCLE, _BOX, _EDGE, _INTERIOR = 0, 1, 2, 3
+#: Cells holding more items than this are checked with numpy in the scalar checks (the edges of
+#: a detailed polygon crowd every cell next to it); fewer go through the Python loop, which is
+#: cheaper for a handful.
+_CROWDED = 256
+#: Polygons with more vertices than this are tested for containing a point by shapely (a
+#: prepared geometry, about 8 us whatever its size) instead of a Python loop over the vertices.
+_SHAPELY_INSIDE = 64
 
 
 class World:
@@ -90,7 +104,14 @@ class World:
         self.polygons = [np.asarray(p, dtype=float).reshape(-1, 2) for p in polygons]
         self._n_circles = len(self.circles)
         self._n_boxes = len(self.boxes)
+        #: ``time.perf_counter()`` after which :meth:`motion_free` and :meth:`segments_free`
+        #: answer "blocked" unchecked (None: never); see :meth:`refusing_motions_after`.
+        self.refuse_after: float | None = None
         self._prepare_polygons()
+        #: Ids of the index's items: circles, boxes, polygon edges, polygon interiors.
+        self._first_edge = self._n_circles + self._n_boxes
+        self._first_interior = self._first_edge + len(self._edges)
+        self._n_items = self._first_interior + len(self.polygons)
         self._prepare_scalar()
         self._prepare_index()
 
@@ -121,6 +142,24 @@ class World:
         all_boxes = np.vstack([np.asarray(rects, dtype=float).reshape(-1, 4), extra])
         return cls(bounds, circles, polygons, robot_radius, all_boxes)
 
+    @contextmanager
+    def refusing_motions_after(self, deadline: float | None) -> Iterator[None]:
+        """While the block runs, :meth:`motion_free` and :meth:`segments_free` (hence
+        :meth:`path_valid`) answer "blocked" at once after ``deadline`` (``time.perf_counter()``
+        seconds; None changes nothing).
+
+        For work that must end by a deadline but cannot poll it inside a check: OMPL's path
+        simplifier polls only between whole passes, and the swarm's shortcuts test a vertex's
+        whole view at once; near a detailed polygon either can take longer than the time left.
+        A refused motion is a shortcut not taken, so a path stays valid, and the work ends in
+        microseconds."""
+        saved = self.refuse_after
+        self.refuse_after = deadline
+        try:
+            yield
+        finally:
+            self.refuse_after = saved
+
     def with_robot_radius(self, robot_radius: float) -> World:
         """The same obstacles for another robot radius."""
         return World(self.bounds, self.circles, self.polygons, robot_radius, self.boxes)
@@ -144,7 +183,7 @@ class World:
         if self._poly_union is not None:
             out |= shapely.intersects_xy(self._poly_union, p[:, 0], p[:, 1])
         if self._n_boxes:
-            q, ids = self._pairs_near_points(p, 0.0, kinds=(_BOX,))
+            q, ids = self._pairs_near_points(p, 0.0, kind=_BOX)
             b = self.boxes[ids - self._n_circles]
             inside = (p[q, 0] >= b[:, 0]) & (p[q, 0] <= b[:, 2])
             inside &= (p[q, 1] >= b[:, 1]) & (p[q, 1] <= b[:, 3])
@@ -163,6 +202,7 @@ class World:
             sizes = np.array([len(p) for p in self.polygons])
             self._edge_start = np.concatenate([[0], np.cumsum(sizes)])
             self._shapes = shapely.polygons([shapely.linearrings(p) for p in self.polygons])
+            shapely.prepare(self._shapes)  # each answers "inside?" through its own index
             self._poly_union = shapely.union_all(self._shapes)
             shapely.prepare(self._poly_union)
         else:
@@ -178,13 +218,16 @@ class World:
         self._all_edges = np.vstack([self._edges, box_edges])
 
     def _item_boxes(self) -> np.ndarray:
-        """Bounding box of every obstacle, in id order: circles, boxes, polygons."""
+        """Bounding box of every item of the index, in id order: circles, boxes, polygon edges,
+        polygon interiors."""
         c = self.circles
         circ = np.column_stack([c[:, 0] - c[:, 2], c[:, 1] - c[:, 2],
                                 c[:, 0] + c[:, 2], c[:, 1] + c[:, 2]])  # fmt: skip
+        e = self._edges
+        edge = np.hstack([np.minimum(e[:, :2], e[:, 2:]), np.maximum(e[:, :2], e[:, 2:])])
         poly = np.array([[p[:, 0].min(), p[:, 1].min(), p[:, 0].max(), p[:, 1].max()]
                          for p in self.polygons]).reshape(-1, 4)  # fmt: skip
-        return np.vstack([circ.reshape(-1, 4), self.boxes, poly])
+        return np.vstack([circ.reshape(-1, 4), self.boxes, edge.reshape(-1, 4), poly])
 
     def _prepare_scalar(self) -> None:
         """Plain Python data for the scalar checks (no numpy scalars in the hot loop)."""
@@ -194,14 +237,18 @@ class World:
             self._py.append((_CIRCLE, cx, cy, rad + r, (rad + r) ** 2))
         for x0, y0, x1, y1 in self.boxes.tolist():
             self._py.append((_BOX, x0, y0, x1, y1))
-        for p in self.polygons:
+        for cx, cy, dx, dy in self._edges.tolist():
+            # The edge's bounding box grown by the threshold: a quick rejection.
+            reach = (min(cx, dx) - r, min(cy, dy) - r, max(cx, dx) + r, max(cy, dy) + r)
+            self._py.append((_EDGE, cx, cy, dx, dy, reach))
+        for k, p in enumerate(self.polygons):
             xs, ys = tuple(p[:, 0].tolist()), tuple(p[:, 1].tolist())
-            bbox = (min(xs) - r, min(ys) - r, max(xs) + r, max(ys) + r)
-            self._py.append((_POLYGON, xs, ys, bbox))
+            shape = self._shapes[k] if len(xs) > _SHAPELY_INSIDE else None
+            self._py.append((_INTERIOR, xs, ys, (min(xs), min(ys), max(xs), max(ys)), shape))
 
     def _prepare_index(self) -> None:
-        """The grid over every obstacle grown by its reach (the threshold and a margin)."""
-        n = self.n_obstacles
+        """The grid over every item grown by its reach (the threshold and a margin)."""
+        n = self._n_items
         self._all_ids = tuple(range(n))
         self._reach = self.threshold + 4.0 * self.tol  # a margin: grazing is never missed
         boxes = self._item_boxes()
@@ -215,6 +262,8 @@ class World:
             hi = np.maximum(hi, boxes[:, 2:].max(axis=0))
         self._grid = Grid(lo, hi, boxes)
         self._indexed = n > SMALL_WORLD
+        self._reach_boxes = boxes
+        self._crowd: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # cell -> (ids, their boxes)
 
     # ------------------------------------------------------------------------------------------
     # Scalar checks (OMPL callbacks)
@@ -228,6 +277,8 @@ class World:
     def point_free(self, x: float, y: float) -> bool:
         """Whether the robot disc centred at ``(x, y)`` overlaps no obstacle (bounds unchecked)."""
         ids = self._grid.items(self._grid.cell_of(x, y)) if self._indexed else self._all_ids
+        if len(ids) > _CROWDED and self._indexed:
+            return self._clear_crowded(self._grid.cell_of(x, y), x, y, x, y, True)
         r = self.threshold
         py = self._py
         for k in ids:
@@ -242,30 +293,72 @@ class World:
                 ey = max(item[2] - y, 0.0, y - item[4])
                 if ex * ex + ey * ey < r * r:
                     return False
-            elif not _point_polygon_free(x, y, item, r):
+            elif kind == _EDGE:
+                x0, y0, x1, y1 = item[5]
+                inside_reach = x0 <= x <= x1 and y0 <= y <= y1
+                if inside_reach and point_segment_distance_xy(x, y, *item[1:5]) < r:
+                    return False
+            elif _inside(x, y, item):
                 return False
         return True
 
     def motion_free(self, ax: float, ay: float, bx: float, by: float) -> bool:
-        """Whether every point of the segment ``(ax, ay)-(bx, by)`` is free (exact)."""
+        """Whether every point of the segment ``(ax, ay)-(bx, by)`` is free (exact); False
+        without a check after :attr:`refuse_after`."""
+        if self.refuse_after is not None and time.perf_counter() >= self.refuse_after:
+            return False
         if not self._indexed:
-            return self._segment_clear(self._all_ids, ax, ay, bx, by)
+            return self._segment_clear(self._all_ids, ax, ay, bx, by, True)
         grid = self._grid
         first = grid.cell_of(ax, ay)
+        # The first cell holds the interior of every polygon that could contain a; the segment
+        # can only enter one elsewhere by crossing an edge, which the edges' cells hold.
+        if not self._cell_clear(first, ax, ay, bx, by, True):
+            return False
         if first == grid.cell_of(bx, by):
-            return self._segment_clear(grid.items(first), ax, ay, bx, by)
+            return True
         # Cells in order from a to b, so a blocked motion usually stops within a cell or two.
         # An obstacle registered in several cells is looked at again in each: its bounding-box
         # rejection is cheaper than keeping a set of those already seen.
-        clear = self._segment_clear
-        items = grid.items
+        clear = self._cell_clear
         for cell in grid.cells_on_segment(ax, ay, bx, by):
-            if not clear(items(cell), ax, ay, bx, by):
+            if cell != first and not clear(cell, ax, ay, bx, by, False):
                 return False
         return True
 
-    def _segment_clear(self, ids, ax: float, ay: float, bx: float, by: float) -> bool:
-        """Whether the segment keeps the threshold from each obstacle of ``ids``."""
+    def _cell_clear(self, cell: int, ax: float, ay: float, bx: float, by: float, first: bool):
+        """:meth:`_segment_clear` for the items of one index cell, through numpy when it is
+        crowded."""
+        items = self._grid.items(cell)
+        if len(items) > _CROWDED:
+            return self._clear_crowded(cell, ax, ay, bx, by, first)
+        return self._segment_clear(items, ax, ay, bx, by, first)
+
+    def _clear_crowded(
+        self, cell: int, ax: float, ay: float, bx: float, by: float, first: bool
+    ) -> bool:
+        """:meth:`_segment_clear` over a crowded cell in numpy: the items whose box grown by
+        the reach meets the segment's box, then their exact distances (the vectorised formulas,
+        the same closed forms)."""
+        got = self._crowd.get(cell)
+        if got is None:
+            ids = np.asarray(self._grid.items(cell), dtype=np.intp)
+            got = self._crowd[cell] = (ids, self._reach_boxes[ids])
+        ids, box = got
+        near = (box[:, 0] <= max(ax, bx)) & (box[:, 2] >= min(ax, bx))
+        near &= (box[:, 1] <= max(ay, by)) & (box[:, 3] >= min(ay, by))
+        cand = ids[near]
+        if not first:
+            cand = cand[cand < self._first_interior]
+        if not len(cand):
+            return True
+        a, b = np.array([[ax, ay]]), np.array([[bx, by]])
+        d = self._pair_distance(np.zeros(len(cand), dtype=np.intp), cand, a, b)
+        return bool(d.min() >= self.threshold)
+
+    def _segment_clear(self, ids, ax: float, ay: float, bx: float, by: float, first: bool) -> bool:
+        """Whether the segment keeps the threshold from each obstacle of ``ids``; a polygon's
+        interior is looked at only when ``first`` (the cell of ``a``, or every item)."""
         dx, dy = bx - ax, by - ay
         len2 = dx * dx + dy * dy
         sx0, sx1 = (ax, bx) if ax <= bx else (bx, ax)
@@ -291,12 +384,14 @@ class World:
                     continue
                 if _segment_box_distance(ax, ay, bx, by, x0, y0, x1, y1) < r:
                     return False
-            else:
-                _, xs, ys, (x0, y0, x1, y1) = item
+            elif kind == _EDGE:
+                x0, y0, x1, y1 = item[5]
                 if sx1 < x0 or sx0 > x1 or sy1 < y0 or sy0 > y1:
                     continue
-                if _segment_polygon_distance(ax, ay, bx, by, xs, ys) < r:
+                if _segment_segment_distance(ax, ay, bx, by, *item[1:5]) < r:
                     return False
+            elif first and _inside(ax, ay, item):
+                return False
         return True
 
     # ------------------------------------------------------------------------------------------
@@ -339,15 +434,24 @@ class World:
             0 where a segment touches or enters an obstacle; ``inf`` with no obstacles.
         """
         a, b, shape = _flat_pair(a, b)
+        return self._distance(a, b, cap)[0].reshape(shape)
+
+    def _distance(
+        self, a: np.ndarray, b: np.ndarray, cap: float | None, stop_at: float | None = None
+    ) -> tuple[np.ndarray, int]:
+        """:meth:`segment_distance` of flat ``(n, 2)`` end points, and how many of the segments
+        were measured: all of them, unless ``time.perf_counter()`` passed ``stop_at`` between
+        two chunks (the segments from that count on are then unmeasured, ``inf``)."""
         d = np.full(len(a), np.inf)
         if cap is None or not self._indexed:
-            for seg, ids in self._all_pairs(len(a)):
-                np.minimum.at(d, seg, self._pair_distance(seg, ids, a, b))
+            chunks = self._all_pairs(len(a))
         else:
-            extra = max(cap - self.threshold, 0.0)
-            for seg, ids in self._index_pairs(a, b, extra):
-                np.minimum.at(d, seg, self._pair_distance(seg, ids, a, b))
-        return d.reshape(shape)
+            chunks = self._index_pairs(a, b, max(cap - self.threshold, 0.0))
+        for s0, seg, ids in chunks:
+            if stop_at is not None and time.perf_counter() >= stop_at:
+                return d, s0
+            np.minimum.at(d, seg, self._pair_distance(seg, ids, a, b))
+        return d, len(a)
 
     def segment_violation(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """How far each segment intrudes into the robot's safety zone, summed over obstacles.
@@ -361,9 +465,9 @@ class World:
         v = np.zeros(len(a))
         poly_d = np.full(len(a), np.inf)
         pairs = self._index_pairs(a, b, 0.0) if self._indexed else self._all_pairs(len(a))
-        for seg, ids in pairs:
+        for _, seg, ids in pairs:
             d = self._pair_distance(seg, ids, a, b)
-            is_poly = ids >= self._n_circles + self._n_boxes
+            is_poly = ids >= self._first_edge
             np.add.at(v, seg[~is_poly], np.maximum(0.0, self.threshold - d[~is_poly]))
             np.minimum.at(poly_d, seg[is_poly], d[is_poly])
         v += np.maximum(0.0, self.threshold - poly_d)
@@ -381,12 +485,15 @@ class World:
         """
         a, b, shape = _flat_pair(a, b)
         thr = self.threshold
-        if not self._indexed or not len(a):
-            return (self.segment_distance(a, b, cap=thr) >= thr).reshape(shape)
+        stop = self.refuse_after
         d = b - a
         length = np.hypot(d[:, 0], d[:, 1])
-        if length.sum() <= 4096.0 * self._grid.h:  # few cells in all: one pass is cheaper
-            return (self.segment_distance(a, b, cap=thr) >= thr).reshape(shape)
+        if not self._indexed or not len(a) or length.sum() <= 4096.0 * self._grid.h:
+            # Few cells in all: one pass is cheaper. What the deadline left unmeasured is blocked.
+            dist, done = self._distance(a, b, thr, stop)
+            free = dist >= thr
+            free[done:] = False
+            return free.reshape(shape)
         ok = np.ones(len(a), dtype=bool)
         done = np.zeros(len(a))  # fraction of each segment already known to be free
         alive = np.arange(len(a))
@@ -398,7 +505,9 @@ class World:
             # The last stretch ends exactly at b, so no rounding moves the end point.
             pb = np.where((t1 >= 1.0)[:, None], b[alive], a[alive] + t1[:, None] * d[alive])
             pa = np.where((t0 <= 0.0)[:, None], a[alive], a[alive] + t0[:, None] * d[alive])
-            free = self.segment_distance(pa, pb, cap=thr) >= thr
+            dist, measured = self._distance(pa, pb, thr, stop)
+            free = dist >= thr
+            free[measured:] = False  # unmeasured by the deadline: blocked
             ok[alive[~free]] = False
             done[alive] = t1
             alive = alive[free & (t1 < 1.0)]
@@ -451,47 +560,61 @@ class World:
     # Pairs of (segment, obstacle) and their distances
     # ------------------------------------------------------------------------------------------
     def _all_pairs(self, n_segments: int):
-        """Every (segment, obstacle) pair, in chunks of bounded size."""
-        n = self.n_obstacles
+        """Every (segment, item) pair, in chunks of bounded size: ``(first segment, segments,
+        items)``."""
+        n = self._n_items
         if not n or not n_segments:
             return
         step = max(1, _PAIR_CHUNK // n)
         ids = np.arange(n)
         for s0 in range(0, n_segments, step):
             seg = np.repeat(np.arange(s0, min(s0 + step, n_segments)), n)
-            yield seg, np.tile(ids, len(seg) // n)
+            yield s0, seg, np.tile(ids, len(seg) // n)
 
     def _index_pairs(self, a: np.ndarray, b: np.ndarray, extra: float):
-        """The (segment, obstacle) pairs the index finds within the reach (plus ``extra``) of
-        each segment, in chunks of bounded size."""
-        if not self.n_obstacles or not len(a):
+        """The (segment, item) pairs the index finds within the reach (plus ``extra``) of each
+        segment, in chunks of consecutive segments: ``(first segment, segments, items)``.
+
+        A chunk meets about :data:`_PAIR_CHUNK` / (the most items a cell holds) cells, so its
+        pairs stay bounded also next to a polygon whose edges crowd every cell (a single
+        segment's pairs are bounded by the index's registrations)."""
+        if not self._n_items or not len(a):
             return
-        length = np.hypot(*(b - a).T)
-        cells = np.ceil(length / self._grid.h) + 1.0
-        # Short chunks: the number of sampled cells, and so of pairs, stays bounded.
-        bounds = np.searchsorted(np.cumsum(cells), np.arange(0, cells.sum(), 20_000.0))
+        h = self._grid.h
+        if extra > 0.0:
+            lo = np.minimum(a, b) - extra
+            hi = np.maximum(a, b) + extra
+            side = np.minimum(
+                np.floor(hi / h) - np.floor(lo / h) + 1.0, [self._grid.nx, self._grid.ny]
+            )
+            cells = side[:, 0] * side[:, 1]
+        else:
+            cells = 9.0 * (np.ceil(np.hypot(*(b - a).T) / h) + 1.0)  # 3 x 3 around each sample
+        per_chunk = max(1.0, _PAIR_CHUNK / max(self._grid.max_items, 1))
+        bounds = np.searchsorted(np.cumsum(cells), np.arange(0, cells.sum(), per_chunk))
         starts = np.unique(np.concatenate([bounds, [len(a)]]))
         for s0, s1 in itertools.pairwise(starts):
             if extra > 0.0:
-                lo = np.minimum(a[s0:s1], b[s0:s1]) - extra
-                hi = np.maximum(a[s0:s1], b[s0:s1]) + extra
-                seg, ids = self._grid.pairs_in_boxes(lo, hi)
+                seg, ids = self._grid.pairs_in_boxes(lo[s0:s1], hi[s0:s1])
             else:
                 seg, ids = self._grid.pairs_on_segments(a[s0:s1], b[s0:s1])
-            yield seg + s0, ids
+            yield s0, seg + s0, ids
 
-    def _pairs_near_points(self, p: np.ndarray, extra: float, kinds=(_CIRCLE, _BOX, _POLYGON)):
+    def _pairs_near_points(self, p: np.ndarray, extra: float, kind: int):
+        """(point, item) pairs of the items of one kind near each point."""
         seg, ids = self._grid.pairs_in_boxes(p - extra, p + extra)
-        kind = self._kind_of(ids)
-        keep = np.isin(kind, kinds)
+        keep = self._kind_of(ids) == kind
         return seg[keep], ids[keep]
 
     def _kind_of(self, ids: np.ndarray) -> np.ndarray:
-        boxes_end = self._n_circles + self._n_boxes
-        return np.where(ids < self._n_circles, _CIRCLE, np.where(ids < boxes_end, _BOX, _POLYGON))
+        """The kind of each item id (:data:`_CIRCLE`, :data:`_BOX`, :data:`_EDGE`,
+        :data:`_INTERIOR`)."""
+        starts = np.array([self._n_circles, self._first_edge, self._first_interior])
+        return np.searchsorted(starts, ids, side="right")
 
     def _pair_distance(self, seg: np.ndarray, ids: np.ndarray, a: np.ndarray, b: np.ndarray):
-        """Exact distance of segment ``seg[k]`` to obstacle ``ids[k]``, for every pair."""
+        """Exact distance of segment ``seg[k]`` to item ``ids[k]``, for every pair: a polygon's
+        edge, or its interior (0 when the segment's first point lies in it, else ``inf``)."""
         d = np.empty(len(seg))
         kind = self._kind_of(ids)
         c = kind == _CIRCLE
@@ -503,35 +626,23 @@ class World:
         if x.any():
             d[x] = _segment_box_distance_v(a[seg[x]], b[seg[x]],
                                            self.boxes[ids[x] - self._n_circles])  # fmt: skip
-        p = kind == _POLYGON
-        if p.any():
-            d[p] = self._segment_polygon_distance_v(
-                a[seg[p]], b[seg[p]], ids[p] - self._n_circles - self._n_boxes
-            )
+        e = kind == _EDGE
+        if e.any():
+            edges = self._edges[ids[e] - self._first_edge]
+            d[e] = _segment_segment_distance_v(a[seg[e]], b[seg[e]], edges)
+        i = kind == _INTERIOR
+        if i.any():
+            d[i] = self._interior_distance(a[seg[i]], ids[i] - self._first_interior)
         return d
 
-    def _segment_polygon_distance_v(self, a: np.ndarray, b: np.ndarray, poly: np.ndarray):
-        """Distance from segment ``a[k]-b[k]`` to polygon ``poly[k]`` (0 when touching/inside)."""
-        start = self._edge_start[poly]
-        count = self._edge_start[poly + 1] - start
-        pair = np.repeat(np.arange(len(poly)), count)
-        edge = np.repeat(start, count) + np.arange(count.sum()) - np.repeat(
-            np.cumsum(count) - count, count)  # fmt: skip
-        e = self._edges[edge]
-        A, B = a[pair], b[pair]
-        e0, e1 = e[:, :2], e[:, 2:]
-        # Distance between two non-crossing segments is attained at one of the four end points.
-        de = np.minimum(
-            np.minimum(point_segment_distance(A, e0, e1), point_segment_distance(B, e0, e1)),
-            np.minimum(point_segment_distance(e0, A, B), point_segment_distance(e1, A, B)),
-        )
-        de[segments_cross(A, B, e0, e1)] = 0.0
-        d = np.full(len(poly), np.inf)
-        np.minimum.at(d, pair, de)
-        # A segment that crosses no edge lies wholly inside or wholly outside the polygon.
-        inside = shapely.intersects_xy(self._shapes[poly], a[:, 0], a[:, 1])
-        d[inside] = 0.0
-        return d
+    def _interior_distance(self, p: np.ndarray, poly: np.ndarray) -> np.ndarray:
+        """0 where point ``p[k]`` lies in (or on) polygon ``poly[k]``, else ``inf``.
+
+        A segment that comes within the threshold of none of a polygon's edges lies wholly
+        inside or wholly outside it, as its first point does; one that comes within it is
+        blocked by that edge anyway."""
+        inside = shapely.intersects_xy(self._shapes[poly], p[:, 0], p[:, 1])
+        return np.where(inside, 0.0, np.inf)
 
 
 class LocalViolation:
@@ -555,11 +666,28 @@ class LocalViolation:
         x = kind == _BOX
         self.boxes = _gather(seg[x], world.boxes[ids[x] - world._n_circles], n_seg,
                              np.array([far, far, far, far]))  # fmt: skip
-        # Polygons: their edges, and the segments whose box lies wholly inside one.
-        p = kind == _POLYGON
-        self.polygon_segments = np.unique(seg[p])
-        poly_ids = ids[p] - world._n_circles - world._n_boxes
-        self._polys = [poly_ids[seg[p] == s] for s in range(n_seg)]
+        # Polygons: the edges near each segment's box, and the interiors that could hold its
+        # first point (per segment: a segment near a large polygon has many edges, the rest few).
+        p = kind >= _EDGE
+        self.polygon_segments = np.unique(seg[p]).tolist()
+        order = np.argsort(seg[p], kind="stable")
+        p_seg, p_ids, p_kind = seg[p][order], ids[p][order], kind[p][order]
+        cut = np.searchsorted(p_seg, np.arange(n_seg + 1))
+        self._edges: list[np.ndarray] = []
+        self._edge_lo: list[np.ndarray] = []  # their bounding boxes
+        self._edge_hi: list[np.ndarray] = []
+        self._edge_mid: list[np.ndarray] = []  # their mid-points and half lengths
+        self._edge_half: list[np.ndarray] = []
+        self._interiors: list[np.ndarray] = []
+        for s in range(n_seg):
+            mine, kinds = p_ids[cut[s] : cut[s + 1]], p_kind[cut[s] : cut[s + 1]]
+            edges = world._edges[mine[kinds == _EDGE] - world._first_edge]
+            self._edges.append(edges)
+            self._edge_lo.append(np.minimum(edges[:, :2], edges[:, 2:]))
+            self._edge_hi.append(np.maximum(edges[:, :2], edges[:, 2:]))
+            self._edge_mid.append(0.5 * (edges[:, :2] + edges[:, 2:]))
+            self._edge_half.append(0.5 * np.hypot(*(edges[:, 2:] - edges[:, :2]).T))
+            self._interiors.append(mine[kinds == _INTERIOR] - world._first_interior)
 
     def violation(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Same as :meth:`World.segment_violation` for ``a, b`` of shape ``(P, S, 2)``."""
@@ -580,13 +708,29 @@ class LocalViolation:
                 np.broadcast_to(self.boxes[None], (*shape, 4)).reshape(-1, 4),
             ).reshape(shape)
             v += np.maximum(0.0, r_need - d).sum(axis=2)
+        n = a.shape[0]
         for s in self.polygon_segments:
-            polys = self._polys[s]
-            n = a.shape[0]
-            seg = np.repeat(np.arange(n), len(polys))
-            d = world._segment_polygon_distance_v(a[seg, s], b[seg, s], np.tile(polys, n))
             best = np.full(n, np.inf)
-            np.minimum.at(best, seg, d)
+            edges = self._edges[s]
+            if len(edges):
+                # Only an edge whose box comes within the threshold of a particle's segment's box
+                # can be nearer than the threshold: a cheap test before the exact distances (a
+                # segment's box may hold thousands of edges of a detailed polygon).
+                lo = np.minimum(a[:, s], b[:, s]) - r_need
+                hi = np.maximum(a[:, s], b[:, s]) + r_need
+                e_lo, e_hi = self._edge_lo[s], self._edge_hi[s]
+                near = (e_lo[None, :, 0] <= hi[:, None, 0]) & (e_hi[None, :, 0] >= lo[:, None, 0])
+                near &= (e_lo[None, :, 1] <= hi[:, None, 1]) & (e_hi[None, :, 1] >= lo[:, None, 1])
+                p_idx, e_idx = np.nonzero(near)
+                # Then an edge whose mid-point lies farther than the threshold plus half the
+                # edge from the segment cannot come within the threshold either.
+                d_mid = point_segment_distance(self._edge_mid[s][e_idx], a[p_idx, s], b[p_idx, s])
+                keep = d_mid <= r_need + self._edge_half[s][e_idx]
+                p_idx, e_idx = p_idx[keep], e_idx[keep]
+                d = _segment_segment_distance_v(a[p_idx, s], b[p_idx, s], edges[e_idx])
+                np.minimum.at(best, p_idx, d)
+            for poly in self._interiors[s].tolist():
+                best = np.minimum(best, world._interior_distance(a[:, s], np.full(n, poly)))
             v[:, s] += np.maximum(0.0, r_need - best)
         return v
 
@@ -692,13 +836,15 @@ def _segment_box_distance_v(a: np.ndarray, b: np.ndarray, box: np.ndarray) -> np
 # ----------------------------------------------------------------------------------------------
 # Scalar polygon primitives (pure Python floats)
 # ----------------------------------------------------------------------------------------------
-def _point_polygon_free(x: float, y: float, item: tuple, r: float) -> bool:
-    _, xs, ys, (x0, y0, x1, y1) = item
+def _inside(x: float, y: float, item: tuple) -> bool:
+    """Whether the point lies in the polygon of an interior item (its boundary may go either
+    way: the edges' distance test catches it)."""
+    _, xs, ys, (x0, y0, x1, y1), shape = item
     if x < x0 or x > x1 or y < y0 or y > y1:
-        return True
-    if _point_in_polygon(x, y, xs, ys):
         return False
-    return _point_polygon_boundary_distance(x, y, xs, ys) >= r
+    if shape is not None:
+        return bool(shapely.intersects_xy(shape, x, y))
+    return _point_in_polygon(x, y, xs, ys)
 
 
 def _point_in_polygon(x: float, y: float, xs: tuple[float, ...], ys: tuple[float, ...]) -> bool:
@@ -714,37 +860,31 @@ def _point_in_polygon(x: float, y: float, xs: tuple[float, ...], ys: tuple[float
     return inside
 
 
-def _point_polygon_boundary_distance(
-    x: float, y: float, xs: tuple[float, ...], ys: tuple[float, ...]
+def _segment_segment_distance(
+    ax: float, ay: float, bx: float, by: float, cx: float, cy: float, dx: float, dy: float
 ) -> float:
-    n = len(xs)
+    """Exact distance between the segments a-b and c-d (0 when they cross)."""
+    d1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    d2 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
+    d3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
+    d4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
+    if d1 * d2 < 0.0 and d3 * d4 < 0.0:
+        return 0.0
+    # Otherwise the distance is attained at an end point of one of them.
     return min(
-        point_segment_distance_xy(x, y, xs[i - 1], ys[i - 1], xs[i], ys[i]) for i in range(n)
+        point_segment_distance_xy(ax, ay, cx, cy, dx, dy),
+        point_segment_distance_xy(bx, by, cx, cy, dx, dy),
+        point_segment_distance_xy(cx, cy, ax, ay, bx, by),
+        point_segment_distance_xy(dx, dy, ax, ay, bx, by),
     )
 
 
-def _segment_polygon_distance(
-    ax: float, ay: float, bx: float, by: float, xs: tuple[float, ...], ys: tuple[float, ...]
-) -> float:
-    """Exact distance from segment a-b to a simple polygon (0 when crossing or inside)."""
-    best = math.inf
-    n = len(xs)
-    for i in range(n):
-        cx, cy, dx, dy = xs[i - 1], ys[i - 1], xs[i], ys[i]
-        d1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
-        d2 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
-        d3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
-        d4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
-        if d1 * d2 < 0.0 and d3 * d4 < 0.0:
-            return 0.0
-        d = min(
-            point_segment_distance_xy(ax, ay, cx, cy, dx, dy),
-            point_segment_distance_xy(bx, by, cx, cy, dx, dy),
-            point_segment_distance_xy(cx, cy, ax, ay, bx, by),
-            point_segment_distance_xy(dx, dy, ax, ay, bx, by),
-        )
-        if d < best:
-            best = d
-    if _point_in_polygon(ax, ay, xs, ys):
-        return 0.0
-    return best
+def _segment_segment_distance_v(a: np.ndarray, b: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """:func:`_segment_segment_distance` for arrays: ``a, b`` (k, 2), edges ``e`` (k, 4)."""
+    e0, e1 = e[:, :2], e[:, 2:]
+    d = np.minimum(
+        np.minimum(point_segment_distance(a, e0, e1), point_segment_distance(b, e0, e1)),
+        np.minimum(point_segment_distance(e0, a, b), point_segment_distance(e1, a, b)),
+    )
+    d[segments_cross(a, b, e0, e1)] = 0.0
+    return d

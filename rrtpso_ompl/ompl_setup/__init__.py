@@ -10,7 +10,6 @@
 """
 
 from .context import (
-    EXACT_GOAL_THRESHOLD,
     ExactMotionValidator,
     PlanningContext,
     WorldValidityChecker,
@@ -20,7 +19,6 @@ from .convert import array_to_path, assign_path, path_to_array
 from .process import seed_ompl, set_ompl_log_level
 
 __all__ = [
-    "EXACT_GOAL_THRESHOLD",
     "ExactMotionValidator",
     "PlanningContext",
     "WorldValidityChecker",

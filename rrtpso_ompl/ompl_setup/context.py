@@ -20,12 +20,7 @@ from ompl import geometric as og
 from ..model.problem import Problem
 from ..model.world import World
 
-__all__ = ["EXACT_GOAL_THRESHOLD", "ExactMotionValidator", "PlanningContext",
-           "WorldValidityChecker", "make_context"]  # fmt: skip
-
-#: Goal threshold used for ``goal_tolerance == 0``: OMPL's GoalState accepts ``d < threshold`` so a
-#: zero threshold would never be met; a path ending exactly at the sampled goal state has d = 0.
-EXACT_GOAL_THRESHOLD = 1e-9
+__all__ = ["ExactMotionValidator", "PlanningContext", "WorldValidityChecker", "make_context"]
 
 
 class WorldValidityChecker(ob.StateValidityChecker):
@@ -112,7 +107,10 @@ def make_context(problem: Problem, world: World | None = None) -> PlanningContex
     start[0], start[1] = problem.start
     goal = space.allocState()
     goal[0], goal[1] = problem.goal
-    threshold = max(problem.goal_tolerance, EXACT_GOAL_THRESHOLD)
+    # OMPL's GoalState accepts d < threshold, so a zero threshold would never be met: for
+    # goal_tolerance 0 the goal takes the world's round-off allowance (1e-9 of the workspace's
+    # scale, relative as every exact check; a path ending at the sampled goal state has d = 0).
+    threshold = max(problem.goal_tolerance, world.tol)
     ss.setStartAndGoalStates(start, goal, threshold)
     ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
     return PlanningContext(problem, world, ss, si, space, checker, validator)

@@ -16,9 +16,11 @@
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import time
+from collections.abc import Iterator
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -38,6 +40,7 @@ __all__ = [
     "PythonPlanner",
     "SpaceInformationCollisionModel",
     "collision_model_for",
+    "refusing_motions_after",
 ]
 
 log = logging.getLogger(__name__)
@@ -221,6 +224,28 @@ def collision_model_for(si: ob.SpaceInformation) -> Any:
     return world if world is not None else SpaceInformationCollisionModel(si)
 
 
+@contextlib.contextmanager
+def refusing_motions_after(model: Any, deadline: float | None) -> Iterator[None]:
+    """A context for OMPL's path simplifier in which motion checks through ``model`` (a World)
+    are refused after ``deadline`` (:meth:`~rrtpso_ompl.model.World.refusing_motions_after`); no
+    change for a user's checker, whose motions OMPL checks itself.
+
+    OMPL's warnings are muted meanwhile: after a refused motion the simplifier's final check
+    warns that the path "may slightly touch on an invalid region", which it does not (every
+    change it kept passed the exact check)."""
+    if not hasattr(model, "refusing_motions_after"):
+        yield
+        return
+    level = ou.getLogLevel()
+    if level.value < ou.LOG_ERROR.value:
+        ou.setLogLevel(ou.LOG_ERROR)
+    try:
+        with model.refusing_motions_after(deadline):
+            yield
+    finally:
+        ou.setLogLevel(level)
+
+
 class PythonPlanner(ob.Planner):
     """Base class: declared parameters, crash-safe ``solve`` and per-solve statistics.
 
@@ -275,7 +300,15 @@ class PythonPlanner(ob.Planner):
         self.last_stats = None
 
     def solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
-        """Run the planner; exceptions become ``PlannerStatus.CRASH`` (logged), never propagate."""
+        """Run the planner; exceptions become ``PlannerStatus.CRASH`` (logged), never propagate.
+
+        Without a problem definition (``setProblemDefinition`` never called) there is nothing to
+        solve: one error line and ``ABORT``, as OMPL's planners refuse it (they raise "Problem
+        definition not specified")."""
+        if self.getProblemDefinition() is None:
+            log.error("%s: no problem definition: call setProblemDefinition() (or use "
+                      "og.SimpleSetup) before solve()", self.getName())  # fmt: skip
+            return ob.PlannerStatus(ob.PlannerStatus.ABORT)
         try:
             return self._solve(ptc)
         except Exception:

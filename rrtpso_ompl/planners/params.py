@@ -31,7 +31,7 @@ from dataclasses import dataclass
 from typing import Any, TypeVar
 
 from ..errors import ParameterError, did_you_mean
-from ..validation import check_integer, check_number, describe
+from ..validation import check_integer, check_number, describe, number_hint
 
 __all__ = ["ParamSpec", "ParamTable", "Rule", "declared", "param"]
 
@@ -76,7 +76,7 @@ class ParamSpec:
     setter: str | None = None
     getter: str | None = None
 
-    def convert(self, value: Any, owner: str = "") -> Any:
+    def convert(self, value: Any, owner: str = "", text: bool = True) -> Any:
         """Validate ``value`` (a Python value or a command-line string) and convert it.
 
         Parameters
@@ -85,6 +85,10 @@ class ParamSpec:
             The value as given (``"50"`` from the command line, ``50`` from YAML or Python).
         owner : str
             The planner, named in the message.
+        text : bool
+            Whether a string may stand for a number or a boolean (command-line text). A YAML
+            file's values are typed: there ``"50"`` in quotes is text, refused for a number, as
+            every quoted number of a problem file is.
 
         Raises
         ------
@@ -92,6 +96,9 @@ class ParamSpec:
             Naming the parameter, the expected type and range, and the value given.
         """
         try:
+            if not text and isinstance(value, str) and self.type is not str:
+                kind = {bool: "a boolean", int: "an integer"}.get(self.type, "a number")
+                raise ValueError(f"must be {kind}, got {describe(value)}{number_hint(value)}")
             return self._convert(self._parse(value))
         except ValueError as exc:
             of = f" of {owner}" if owner else ""

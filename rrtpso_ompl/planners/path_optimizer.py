@@ -237,8 +237,11 @@ def _pso_round(
     options: PathOptimizerOptions,
     rng: np.random.Generator,
     terminate: Callable[[], bool] | None,
+    deadline: float | None = None,
 ) -> tuple[np.ndarray, pso.PSOResult]:
-    """One swarm run seeded around ``seed_path``; returns the best path and the PSO result."""
+    """One swarm run seeded around ``seed_path``; returns the best path and the PSO result
+    (the seed path itself, with no iterations, when even one evaluation would end after
+    ``deadline``)."""
     world = cost_model.world
     interior = seed_path[1:-1]
     k = len(interior)
@@ -269,7 +272,14 @@ def _pso_round(
     x0 = interior.reshape(-1)
     init = x0 + rng.standard_normal((n, 2 * k)) * sigma
     init[0] = x0  # the seed path itself is a particle, so G_best starts valid
+    t_one = time.perf_counter()
     offset = float(round_cost.terms(x0[None, :])[0][0])
+    now = time.perf_counter()
+    if deadline is not None and now + (now - t_one) > deadline:
+        # The swarm's first evaluation (of n particles) would not end in time either.
+        return seed_path, pso.PSOResult(position=x0, cost=offset, history=np.array([offset]),
+                                        n_iterations=0, n_evaluations=1, time=now - t_one,
+                                        stopped_by="deadline")  # fmt: skip
 
     def cost(x: np.ndarray) -> np.ndarray:
         c, v = round_cost.terms(x)
@@ -284,6 +294,7 @@ def _pso_round(
         init=init,
         v_max=options.v_max_fraction * float(seg_len.mean()),
         terminate=terminate,
+        deadline=deadline,
     )
     best = np.vstack([seed_path[:1], res.position.reshape(k, 2), seed_path[-1:]])
     return best, res
@@ -295,6 +306,7 @@ def optimize_path(
     options: PathOptimizerOptions | None = None,
     rng: np.random.Generator | None = None,
     terminate: Callable[[], bool] | None = None,
+    deadline: float | None = None,
 ) -> PathOptimizationResult:
     """Shorten (and optionally smooth) a valid path with the particle swarm, end points fixed.
 
@@ -310,6 +322,9 @@ def optimize_path(
         Source of all randomness; ``numpy.random.default_rng()`` (unseeded) when omitted.
     terminate : callable, optional
         Polled once per PSO iteration; stops the optimisation early when it returns True.
+    deadline : float, optional
+        ``time.perf_counter()`` seconds; no swarm evaluation is started that would, judging by
+        the last one, end after it (:func:`~rrtpso_ompl.planners.swarm.minimize`).
 
     Returns
     -------
@@ -356,7 +371,7 @@ def optimize_path(
             current = refined
         if len(current) <= 2:
             break  # a straight segment: nothing left to optimise
-        candidate, res = _pso_round(current, cost_model, options, rng, terminate)
+        candidate, res = _pso_round(current, cost_model, options, rng, terminate, deadline)
         history.append(res.history)
         iters += res.n_iterations
         evals += res.n_evaluations
@@ -371,7 +386,7 @@ def optimize_path(
         if terminate() or len(current) <= 2:
             break
         before = _cost_of(cost_model, current)
-        candidate, res = _pso_round(current, cost_model, options, rng, terminate)
+        candidate, res = _pso_round(current, cost_model, options, rng, terminate, deadline)
         history.append(res.history)
         iters += res.n_iterations
         evals += res.n_evaluations

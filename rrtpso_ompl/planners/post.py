@@ -30,7 +30,7 @@ from ompl import util as ou
 from ..errors import ParameterError
 from ..model.geometry import path_length as path_length_of
 from ..ompl_setup import assign_path, path_to_array
-from .base import SpaceInformationCollisionModel, collision_model_for
+from .base import SpaceInformationCollisionModel, collision_model_for, refusing_motions_after
 from .params import ParamSpec, ParamTable
 from .path_optimizer import PathOptimizationResult, PathOptimizerOptions, optimize_path
 
@@ -216,7 +216,10 @@ class PSOPathOptimizer:
                 return self.last_result
             model.stop = lambda: time.perf_counter() >= deadline - reserve
         try:
-            self.last_result = optimize_path(xy, model, options, self.rng, terminate)
+            # Our world answers "blocked" after the deadline: the swarm's shortcuts test whole
+            # views at once, and one view near a detailed polygon can outlast the time left.
+            with refusing_motions_after(model, deadline):
+                self.last_result = optimize_path(xy, model, options, self.rng, terminate, deadline)
         finally:
             if isinstance(model, SpaceInformationCollisionModel):
                 model.stop = None
@@ -271,7 +274,10 @@ def run_post(
         if step == "simplify":
             share = post["simplify_share"] if "pso" in steps[i + 1 :] else 1.0
             if left > 0:
-                og.PathSimplifier(si).simplify(path, max(share * left, 1e-4))
+                seconds = max(share * left, 1e-4)
+                # It polls its time only between passes: our world cuts a long pass short.
+                with refusing_motions_after(world or collision_model_for(si), t0 + seconds):
+                    og.PathSimplifier(si).simplify(path, seconds)
         else:
             optimizer = PSOPathOptimizer(si, PathOptimizerOptions.from_values(values), world, rng)
             optimizer.optimize(path, left if left > 0 else 0.0)

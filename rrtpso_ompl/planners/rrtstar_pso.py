@@ -39,6 +39,7 @@ from .base import (
     PythonPlanner,
     SpaceInformationCollisionModel,
     collision_model_for,
+    refusing_motions_after,
 )
 from .ompl_planners import RRTSTAR_PARAMS
 from .params import ParamSpec, ParamTable
@@ -298,8 +299,9 @@ class RRTstarPSO(PythonPlanner):
         simplifier = og.PathSimplifier(self.getSpaceInformation())
         if budget > 0:
             left = max(0.5 * (t0 + budget - t1), 1e-4)
-            simplifier.simplify(simplified, ob.plannerOrTerminationCondition(
-                ptc, ob.timedPlannerTerminationCondition(left)))  # fmt: skip
+            with refusing_motions_after(self._model, t1 + left):
+                simplifier.simplify(simplified, ob.plannerOrTerminationCondition(
+                    ptc, ob.timedPlannerTerminationCondition(left)))  # fmt: skip
         else:
             simplifier.simplifyMax(simplified)
         candidate = path_to_array(simplified)
@@ -311,9 +313,11 @@ class RRTstarPSO(PythonPlanner):
         """Whether OMPL's simplifier can be trusted to stop within ``left`` seconds.
 
         It polls its termination condition only between whole passes, each of which checks
-        motions along the path many times over (:data:`SIMPLIFIER_PASS_LENGTHS`). With our world
-        a motion check costs microseconds; with a user's checker of a millisecond per state a
-        single pass can take a second, so it only runs when a pass fits."""
+        motions along the path many times over (:data:`SIMPLIFIER_PASS_LENGTHS`). Our world
+        refuses the motions it is asked for after the time is up, which ends a pass at once
+        (:meth:`~rrtpso_ompl.model.World.refusing_motions_after`); with a user's checker of a
+        millisecond per state a single pass can take a second, so it only runs when a pass
+        fits."""
         model = self._model
         if not isinstance(model, SpaceInformationCollisionModel):
             return True
@@ -323,15 +327,17 @@ class RRTstarPSO(PythonPlanner):
         return SIMPLIFIER_PASS_LENGTHS * per_state * states <= left
 
     def _fine_valid(self, xy: np.ndarray, t0: float) -> bool:
-        """Whether the user's checker, sampled finer than the space's resolution, passes ``xy``
-        (always True with our exact world, whose motion validator OMPL's simplifier used).
+        """Whether ``xy`` passes our exact world's check, or the user's checker sampled finer
+        than the space's resolution.
 
         OMPL's simplifier checks motions at the space's resolution, and a shortcut into the gap
-        between two checked states is exactly what it finds: its path is only kept when the fine
-        check passes, and when that check fits in what is left of the budget."""
+        between two checked states is exactly what it finds; it may also repair a state it
+        finds invalid by moving it without checking the motions to it. Its path is only kept
+        when the check passes (with a user's checker: when that check fits in what is left of
+        the budget)."""
         model = self._model
         if not isinstance(model, SpaceInformationCollisionModel):
-            return True
+            return bool(model.path_valid(xy))
         budget = self._values["budget"]
         if budget > 0:
             rate = model.seconds_per_length() or model.probe(xy[0])

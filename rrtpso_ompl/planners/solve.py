@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -86,7 +87,7 @@ def resolve_request(
         For an unknown planner, parameter name or value, or a time limit that is not a positive
         number of seconds.
     """
-    from ..errors import ParameterError
+    from ..errors import ParameterError, ProblemError
 
     registry = registry or default_registry()
     cfg = problem.planner
@@ -102,6 +103,13 @@ def resolve_request(
             seed = check_seed(seed)
         except ValueError as exc:
             raise ParameterError(f"seed {exc}", "seed") from None
+    for key, value in cfg.params.items():
+        # The file's values are typed YAML: "30" in quotes is text there, as everywhere in it.
+        if entry.takes(key):
+            try:
+                entry.param(key).convert(value, entry.name, text=False)
+            except ParameterError as exc:
+                raise ProblemError(problem.source, f"planner.params.{key}", str(exc)) from None
     values: dict[str, Any] = {**cfg.params, **(params or {})}
     # Planners that split their time (RRTstarPSO) need to know it: OMPL's termination condition
     # does not say how much is left.
@@ -141,8 +149,9 @@ def solve(
         numpy generators; the problem's ``planner.seed`` when omitted.
     params : mapping, optional
         Planner parameters by name, on top of the problem's ``planner.params``.
-    post : sequence of str
-        Post-passes after the planner, in order, within the same budget: ``"simplify"`` (OMPL's
+    post : sequence of str, or str
+        Post-passes after the planner (a string is a comma list), in order, within the same
+        budget: ``"simplify"`` (OMPL's
         simplifier) and ``"pso"`` (:class:`~rrtpso_ompl.planners.post.PSOPathOptimizer`), after
         those of the spec. The planner then gets ``1 - post_fraction`` of the time
         (:data:`~rrtpso_ompl.planners.post.POST_PARAMS`, settable in ``params``); each step's
@@ -166,9 +175,15 @@ def solve(
 
     Raises
     ------
+    ArgumentError
+        For an argument of the wrong kind (a file name where the problem goes: load it with
+        :func:`~rrtpso_ompl.model.load_problem` first).
     UnknownPlannerError, ParameterError
         For an unknown planner, parameter name or value (before anything is planned).
+    ProblemError
+        For a value of the problem's ``planner.params`` its planner cannot take.
     """
+    post = _check_arguments(problem, planner, params, post, world)
     name, spec_steps = split_spec(planner) if planner else (None, ())
     steps = tuple(dict.fromkeys((*spec_steps, *parse_steps(post))))
     registry = registry or default_registry()
@@ -247,6 +262,41 @@ def _applied(instance: Any, values: dict[str, Any]) -> dict[str, Any]:
     """The parameters as the planner applied them (ours report OMPL's choices, e.g. range)."""
     own = getattr(instance, "param_values", None)
     return own() if callable(own) else dict(values)
+
+
+def _check_arguments(
+    problem: Any, planner: Any, params: Any, post: Any, world: Any
+) -> tuple[str, ...]:
+    """Refuse arguments of the wrong kind with an :class:`ArgumentError` that says what goes
+    there (a wrong *value* is the planners' business); ``post`` as a tuple of step names."""
+    from ..errors import ArgumentError
+    from ..validation import describe
+
+    if not isinstance(problem, Problem):
+        hint = ""
+        if isinstance(problem, str | os.PathLike):
+            hint = f"; load the file first: solve(load_problem({str(problem)!r}), ...)"
+        raise ArgumentError(f"solve: problem must be a Problem (from load_problem or "
+                            f"problem_from_dict), got {describe(problem)}{hint}")  # fmt: skip
+    if planner is not None and not isinstance(planner, str):
+        raise ArgumentError(f"solve: planner must be a planner name such as 'RRTstarPSO' (see "
+                            f"'rrtpso planners'), got {describe(planner)}")  # fmt: skip
+    if params is not None:
+        if not isinstance(params, Mapping):
+            raise ArgumentError(f"solve: params must be a mapping of parameter names to values, "
+                                f"such as {{'range': 2.0}}, got {describe(params)}")  # fmt: skip
+        for key in params:
+            if not isinstance(key, str):
+                raise ArgumentError(f"solve: params: parameter names are strings, got "
+                                    f"{describe(key)}")  # fmt: skip
+    if isinstance(post, str):
+        post = [s for s in post.split(",") if s.strip()]
+    if not isinstance(post, Sequence) or not all(isinstance(s, str) for s in post):
+        raise ArgumentError(f"solve: post must be step names such as ('simplify', 'pso'), got "
+                            f"{describe(post)}")  # fmt: skip
+    if world is not None and not isinstance(world, World):
+        raise ArgumentError(f"solve: world must be the problem's World, got {describe(world)}")
+    return tuple(post)
 
 
 def _simplify(

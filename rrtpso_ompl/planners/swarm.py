@@ -91,7 +91,7 @@ class PSOResult:
     time : float
         Wall-clock seconds.
     stopped_by : str
-        ``"iterations"``, ``"tolerance"`` or ``"terminate"``.
+        ``"iterations"``, ``"tolerance"``, ``"terminate"`` or ``"deadline"``.
     """
 
     position: np.ndarray
@@ -114,6 +114,7 @@ def minimize(
     init_velocity: np.ndarray | None = None,
     v_max: float | None = None,
     terminate: Callable[[], bool] | None = None,
+    deadline: float | None = None,
 ) -> PSOResult:
     """Minimise ``cost`` over the box ``[lower, upper]`` with a global-best PSO.
 
@@ -139,6 +140,10 @@ def minimize(
     terminate : callable, optional
         Polled once per iteration; the run stops when it returns True (e.g. OMPL's
         ``PlannerTerminationCondition``).
+    deadline : float, optional
+        ``time.perf_counter()`` seconds: the run stops before an iteration whose evaluation,
+        as long as the last one, would end after it (an evaluation cannot be interrupted, and
+        near a detailed polygon one can take a sizeable share of a short budget).
 
     Returns
     -------
@@ -157,17 +162,26 @@ def minimize(
     if v_max is not None and not v_max > 0:
         raise ValueError(f"v_max must be > 0 or None, got {v_max}")
 
-    f = np.asarray(cost(x), dtype=float)
+    t_eval = time.perf_counter()
+    cut = False
+    if deadline is None:
+        f = np.asarray(cost(x), dtype=float)
+    else:
+        f, cut = _first_costs(cost, x, deadline)
+    t_eval = time.perf_counter() - t_eval
     pbest_x, pbest_f = x.copy(), f.copy()
     g = int(np.argmin(pbest_f))
     gbest_x, gbest_f = pbest_x[g].copy(), float(pbest_f[g])
     history = [gbest_f]
     n_eval = n
     w = options.w
-    stopped_by = "iterations"
-    for k in range(1, options.iterations + 1):
+    stopped_by = "deadline" if cut else "iterations"
+    for k in range(1, 0 if cut else options.iterations + 1):
         if terminate is not None and terminate():
             stopped_by = "terminate"
+            break
+        if deadline is not None and time.perf_counter() + t_eval > deadline:
+            stopped_by = "deadline"
             break
         r1 = rng.random((n, dims))
         r2 = rng.random((n, dims))
@@ -179,7 +193,9 @@ def minimize(
         if out.any():
             np.clip(x, lower, upper, out=x)
             v[out] = 0.0  # a particle stopped by the wall keeps no momentum into it
+        t_eval = time.perf_counter()
         f = np.asarray(cost(x), dtype=float)
+        t_eval = time.perf_counter() - t_eval
         n_eval += n
         better = f < pbest_f
         pbest_x[better] = x[better]
@@ -203,3 +219,23 @@ def minimize(
         time=time.perf_counter() - t0,
         stopped_by=stopped_by,
     )
+
+
+#: Particles evaluated at a time in the first evaluation of a swarm with a deadline.
+_FIRST_CHUNK = 8
+
+
+def _first_costs(cost: CostFunction, x: np.ndarray, deadline: float) -> tuple[np.ndarray, bool]:
+    """The costs of the initial swarm, a few particles at a time, and whether they were cut
+    short (``inf`` for the rest) because the next few would end after ``deadline``: with
+    nothing measured yet, this bounds how far the first evaluation can overrun. Particle 0 (the
+    seed, when there is one) comes first. The costs are those of one call: each particle's
+    depends on it alone."""
+    f = np.full(len(x), np.inf)
+    for c0 in range(0, len(x), _FIRST_CHUNK):
+        t = time.perf_counter()
+        f[c0 : c0 + _FIRST_CHUNK] = np.asarray(cost(x[c0 : c0 + _FIRST_CHUNK]), dtype=float)
+        now = time.perf_counter()
+        if c0 + _FIRST_CHUNK < len(x) and now + (now - t) > deadline:
+            return f, True
+    return f, False

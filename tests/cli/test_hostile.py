@@ -8,6 +8,7 @@ inputs and foreign files unchanged, results files valid line by line.
 from __future__ import annotations
 
 import json
+import math
 import os
 import resource
 import signal
@@ -829,3 +830,207 @@ def test_an_output_inside_a_loop_of_links_is_refused(folder):
     assert "--json: cannot write 'loop/x.json': Too many levels of symbolic links" in proc.stderr
     proc = run("batch", "p.yaml", "--time", "0.05", "--out", "loop/r.jsonl", cwd=folder)
     assert proc.returncode == 2 and "Too many levels of symbolic links" in proc.stderr
+
+
+# Signals: whatever stops the parent, its workers go with it (issue 22)
+# ----------------------------------------------------------------------------------------------
+def processes_in(folder: Path) -> list[int]:
+    """Live processes (not zombies) whose working folder is ``folder``: the command and every
+    process it started, however they were re-parented (no psutil: /proc)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            if os.readlink(entry / "cwd") != str(folder):
+                continue
+            state = (entry / "stat").read_text().rsplit(")", 1)[1].split()[0]
+        except OSError:
+            continue  # gone meanwhile, or not ours to read
+        if state != "Z":
+            found.append(int(entry.name))
+    return found
+
+
+def wait_for(predicate, seconds: float) -> bool:
+    deadline = time.time() + seconds
+    while time.time() < deadline:
+        if predicate():
+            return True
+        time.sleep(0.1)
+    return predicate()
+
+
+needs_proc = pytest.mark.skipif(not Path("/proc/self/cwd").exists(), reason="needs /proc")
+
+
+@needs_proc
+@pytest.mark.parametrize(
+    ("command", "sig"),
+    [("batch", signal.SIGTERM), ("batch", signal.SIGHUP), ("batch", signal.SIGKILL),
+     ("bench", signal.SIGTERM)],
+    ids=["batch-TERM", "batch-HUP", "batch-KILL", "bench-TERM"],
+)  # fmt: skip
+def test_a_killed_batch_leaves_no_worker_and_a_valid_file(tmp_path, command, sig):
+    (tmp_path / "p.yaml").write_text(CIRCLE)
+    out = ["--out", "r.jsonl"] if command == "batch" else ["--out", "b"]
+    # RRT* uses its whole budget: 30 s runs that must not outlive the parent.
+    proc = subprocess.Popen([*rrtpso_exe(), command, "p.yaml", "--planner", "RRTstar", "--runs",
+                             "4", "--time", "30", "--jobs", "2", *out],
+                            cwd=tmp_path, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=_limit)  # fmt: skip
+    # The parent, the tracker, two workers and the children they fork for the runs.
+    assert wait_for(lambda: len(processes_in(tmp_path)) >= 6, 90), processes_in(tmp_path)
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=60)
+    assert wait_for(lambda: not processes_in(tmp_path), 15), processes_in(tmp_path)
+    assert "Traceback" not in err, err
+    results = tmp_path / ("r.jsonl" if command == "batch" else "b/runs.jsonl")
+    if results.exists():
+        rows_of(results)  # valid line by line, whatever killed it
+    if sig != signal.SIGKILL:  # these end like Ctrl-C: documented status, no temporary files
+        # ... and no empty results file: before any run ended there is nothing to keep
+        assert not results.exists() or results.stat().st_size > 0
+        assert proc.returncode == 128 + sig, err
+        assert f"terminated by {signal.Signals(sig).name}" in err
+        assert not [p for p in tmp_path.rglob(".*") if p.is_file()]
+
+
+@needs_proc
+def test_sigterm_while_writing_a_trajectory_removes_its_temporary_file(tmp_path):
+    # About 700,000 wheel-command rows: seconds of writing, and a temporary file meanwhile.
+    (tmp_path / "p.yaml").write_text(CIRCLE.replace("sample_time: 0.15", "sample_time: 5.0e-5"))
+    proc = subprocess.Popen([*rrtpso_exe(), "solve", "p.yaml", "--planner", "RRTConnect",
+                             "--time", "0.5", "--trajectory", "t.csv"],
+                            cwd=tmp_path, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=_limit)  # fmt: skip
+    assert wait_for(lambda: list(tmp_path.glob(".t.*.csv")) or proc.poll() is not None, 120)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 128 + signal.SIGTERM, err
+    assert "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["p.yaml"]
+
+
+# ----------------------------------------------------------------------------------------------
+# Bounds: every size the input chooses has a limit, named when it is passed (issue 22)
+# ----------------------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["batch", "p.yaml", "--runs", "4294967295", "--out", "r.jsonl"], "--runs: must be"),
+        (["batch", "p.yaml", "--runs", "100000000", "--out", "r.jsonl"], "got 100000000"),
+        (["batch", "p.yaml", "p.yaml", "d.yaml", "--runs", "60000", "--planner", "RRTstar,PRM",
+          "--out", "r.jsonl"], "runs 60,000 x 2 planners x 2 files = 240,000"),
+        (["bench", "p.yaml", "--runs", "30000", "--planner", "RRTstar,PRM", "--time", "1,2",
+          "--out", "b"], "x 2 budgets = 120,000"),
+        (["batch", "p.yaml", "--jobs", "100000", "--out", "r.jsonl"], "--jobs: must be at most"),
+    ],
+    ids=["runs-2**32", "runs-1e8", "batch-tasks", "bench-tasks", "jobs"],
+)  # fmt: skip
+def test_run_counts_have_a_bound_named_by_the_flag(folder, args, words):
+    proc = run(*args, cwd=folder, timeout=60)
+    assert proc.returncode == 2 and words in proc.stderr, proc.stderr
+    assert not (folder / "r.jsonl").exists() and not (folder / "b").exists()
+
+
+def test_a_trajectory_of_too_many_samples_is_refused_before_planning(folder):
+    name = _problem(folder, "s.yaml", CIRCLE.replace("sample_time: 0.15", "sample_time: 1.0e-6"))
+    # A 100 s budget would outlast the timeout: the refusal comes before any planning.
+    proc = run("solve", name, "--time", "100", "--trajectory", "t.csv", cwd=folder, timeout=60)
+    assert proc.returncode == 2, proc.stderr
+    assert "s.yaml" in proc.stderr and "robot.sample_time" in proc.stderr
+    assert "at most 1,000,000" in proc.stderr
+    assert not (folder / "t.csv").exists()
+
+
+def _gear(n: int) -> str:
+    """A problem with one star-shaped polygon of ``n`` vertices (0.01 units apart at 10,000)."""
+    pts = ", ".join(
+        f"[{50 + (20 + 3 * (k % 2)) * math.cos(2 * math.pi * k / n):.6f}, "
+        f"{50 + (20 + 3 * (k % 2)) * math.sin(2 * math.pi * k / n):.6f}]"
+        for k in range(n)
+    )
+    return ("bounds: [[0, 0], [100, 100]]\nstart: [5, 5]\ngoal: [95, 95]\nrobot: {radius: 1}\n"
+            f"obstacles:\n  - type: polygon\n    points: [{pts}]\n")  # fmt: skip
+
+
+@pytest.mark.parametrize(("n", "planner"), [(10_000, "RRTstarPSO"), (100_000, "RRTstar")])
+def test_a_polygon_of_many_vertices_is_planned_around_within_the_memory_limit(folder, n, planner):
+    # Before the polygons' edges were indexed one by one, 10,000 vertices took 1.8 GB and left
+    # RRTstarPSO no time to find this easy path; 100,000 ran out of memory.
+    name = _problem(folder, "gear.yaml", _gear(n))
+    proc = run("solve", name, "--planner", planner, "--time", "0.3", "--json", "o.json",
+               cwd=folder, timeout=240)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    result = json.loads((folder / "o.json").read_text())
+    assert result["solved"] and result["valid"]
+
+
+# ----------------------------------------------------------------------------------------------
+# Silent wrong answers (issue 22)
+# ----------------------------------------------------------------------------------------------
+def _map(folder: Path, resolution: str, pixels: str = "255 255 255 255") -> str:
+    rows = "\n".join([pixels] * 4)
+    (folder / "m.pgm").write_text(f"P2\n4 4\n255\n{rows}\n")
+    (folder / "m.yaml").write_text(f"image: m.pgm\nresolution: {resolution}\norigin: [0, 0, 0]\n")
+    return "m.yaml"
+
+
+@pytest.mark.parametrize(
+    ("resolution", "pixels", "words"),
+    [
+        ("1.0e-9", "255 255 255 255", "map: its extent (image size x resolution) is too small"),
+        ("1.0e+12", "255 255 255 255", "resolution: must be at most 1e+09"),
+        ("1.0e+9", "255 255 255 255", "beyond +-1e+09"),
+        ("1e-3", "255 255 255 255", "YAML reads 1e-3 as text"),
+        ("1.0", "-1 255 255 255", "is -1: pixel values run from 0 to maxval 255"),
+        ("1.0", "255 256 255 255", "exceeds maxval 255"),
+    ],
+    ids=["tiny-cells", "huge-cells", "beyond-coordinates", "yaml-1e-3", "negative-pixel",
+         "pixel-over-maxval"],
+)  # fmt: skip
+def test_maps_that_cannot_be_checked_exactly_are_refused(folder, resolution, pixels, words):
+    _map(folder, resolution, pixels)
+    res = float(resolution) if "." in resolution else 1.0
+    lo, hi = f"{0.5 * res:.6e}", f"{3.5 * res:.6e}"  # with a point: YAML 1.1 reads a number
+    name = _problem(folder, "p9.yaml", f"map: m.yaml\nstart: [{lo}, {lo}]\ngoal: [{hi}, {hi}]\n"
+                    "robot: {radius: 0}\n")  # fmt: skip
+    proc = run("solve", name, "--json", "o.json", cwd=folder)
+    assert proc.returncode == 2 and words in proc.stderr, proc.stderr
+    assert not (folder / "o.json").exists()
+
+
+def test_a_quoted_number_in_planner_params_is_refused_as_everywhere(folder):
+    name = _problem(folder, "q.yaml", CIRCLE.split("planner:")[0] +
+                    "planner:\n  params: {swarm_size: '30'}\n")  # fmt: skip
+    for args in (["solve", name], ["batch", name, "--out", "r.jsonl"]):
+        proc = run(*args, cwd=folder)
+        assert proc.returncode in (1, 2), proc.stderr
+        assert "q.yaml: planner.params.swarm_size" in proc.stderr, proc.stderr
+        assert "a number in quotes is text" in proc.stderr
+
+
+TINY = """bounds: [[0, 0], [1.0e-6, 1.0e-6]]
+start: [4.0e-8, 4.0e-8]
+goal: [9.0e-7, 9.0e-7]
+robot: {radius: 5.7e-8}
+obstacles:
+  - {type: circle, center: [5.0e-7, 5.0e-7], radius: 1.6e-7}
+  - {type: polygon, points: [[2.0e-7, 6.0e-7], [3.0e-7, 6.0e-7], [2.5e-7, 8.0e-7]]}
+  - {type: rectangle, min: [6.0e-7, 1.0e-7], max: [8.0e-7, 3.0e-7]}
+"""
+
+
+@pytest.mark.parametrize("planner", ["RRTstarPSO", "RRTConnect"])
+def test_a_workspace_a_micrometre_wide_is_checked_as_exactly_as_any(folder, planner):
+    # The round-off allowance is 1e-9 of the workspace (1e-15 here), not 1e-9 absolute: that
+    # would let a path 1.7 % of the robot's radius into an obstacle's safety zone.
+    name = _problem(folder, "tiny.yaml", TINY)
+    proc = run("solve", name, "--planner", planner, "--time", "0.2", "--json", "o.json",
+               cwd=folder)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    result = json.loads((folder / "o.json").read_text())
+    assert result["solved"] and result["valid"]
+    assert result["clearance"] >= -1e-15
+    assert math.dist(result["path"][-1], [9.0e-7, 9.0e-7]) <= 1e-15

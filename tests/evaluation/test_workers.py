@@ -6,13 +6,24 @@ real child processes that really abort, raise or hang.
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+import threading
 import time
+from multiprocessing.connection import Connection
+from pathlib import Path
 
 import pytest
 from helpers import PROBLEMS
 
 from rrtpso_ompl.evaluation.batch import Task, error_row, make_tasks, run_batch
-from rrtpso_ompl.evaluation.workers import ChildFailure, run_local, run_once_in_child
+from rrtpso_ompl.evaluation.workers import (
+    ChildFailure,
+    _ParentGone,
+    run_local,
+    run_once_in_child,
+)
 
 ABORT = "__import__('os').abort()"
 KILL_WORKER = "__import__('os').kill(__import__('os').getppid(), 9)"
@@ -81,3 +92,77 @@ def test_error_rows_name_the_task():
     task = Task(file="x.yaml", planner="RRTstar", seed=3, run=0, time_limit=1.0)
     row = error_row(task, "x.yaml: it broke")
     assert row["status"] == "error" and row["seed"] == 3 and row["error"] == "x.yaml: it broke"
+
+
+# ----------------------------------------------------------------------------------------------
+# Nothing outlives its parent (issue 22; the command-line side is in tests/cli/test_hostile.py)
+# ----------------------------------------------------------------------------------------------
+def _alive(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie waiting for its parent does not)."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return stat.rsplit(")", 1)[1].split()[0] != "Z"
+
+
+def _wait_for_pid(path, seconds: float = 60) -> int:
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        if path.exists() and path.read_text().strip():
+            return int(path.read_text())
+        time.sleep(0.05)
+    raise AssertionError(f"{path} never got a pid")
+
+
+def _sleeper(path) -> str:
+    """A task that writes its process id to ``path``, then sleeps for a minute."""
+    return (f"open({str(path)!r}, 'w').write(str(__import__('os').getpid())) and "
+            "__import__('time').sleep(60)")  # fmt: skip
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/self"), reason="needs /proc")
+def test_a_run_is_killed_when_its_worker_s_parent_goes_away(tmp_path):
+    """The fallback where the kernel cannot help (no PR_SET_PDEATHSIG): the worker watches its
+    pipe to the parent while a child runs; when it closes, the child is killed at once."""
+    # The parent's end of the pipe lives in another process (as the batch's does), so that the
+    # forked child holds no copy of it: killing that process closes the pipe.
+    r, w = os.pipe()
+    parent = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(600)"],
+                              pass_fds=(w,))  # fmt: skip
+    os.close(w)
+    watched = Connection(r, writable=False)
+    pid_file = tmp_path / "pid"
+    closer = threading.Thread(target=lambda: (_wait_for_pid(pid_file), parent.kill()))
+    closer.start()
+    t0 = time.perf_counter()
+    with pytest.raises(_ParentGone):
+        run_once_in_child(eval, _sleeper(pid_file), timeout=120, watch=watched)
+    closer.join()
+    parent.wait(timeout=30)
+    watched.close()
+    assert time.perf_counter() - t0 < 60  # not the child's minute, nor the timeout
+    assert not _alive(int(pid_file.read_text()))
+
+
+SPAWNER = """
+import sys
+from rrtpso_ompl.evaluation.workers import run_spawned
+print(run_spawned(eval, sys.argv[1], 120, warm=True))
+"""
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/self"), reason="needs /proc")
+def test_a_dask_style_run_dies_with_the_process_that_started_it(tmp_path):
+    """run_spawned's process is a child of the fork server, not of its caller (a Dask worker):
+    it watches the caller's pid and ends with it, even after a kill -9."""
+    pid_file = tmp_path / "pid"
+    owner = subprocess.Popen([sys.executable, "-c", SPAWNER, _sleeper(pid_file)], cwd=tmp_path)
+    run_pid = _wait_for_pid(pid_file)
+    assert _alive(run_pid)
+    owner.kill()
+    owner.wait(timeout=30)
+    deadline = time.monotonic() + 15
+    while _alive(run_pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not _alive(run_pid)

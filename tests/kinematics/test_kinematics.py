@@ -17,6 +17,7 @@ from helpers import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
 from rrtpso_ompl.kinematics import (
     CSV_HEADER,
     ReferenceCurve,
+    TrajectoryError,
     integrate_wheels,
     reference_curve,
     reference_polynomial,
@@ -24,8 +25,10 @@ from rrtpso_ompl.kinematics import (
     track,
     wheel_speeds,
 )
+from rrtpso_ompl.kinematics.diffdrive import step_wheels
 from rrtpso_ompl.model.problem import Robot, load_problem
 from rrtpso_ompl.model.world import World
+from rrtpso_ompl.validation import MAX_STEPS
 
 PAPER_ROBOT = Robot(radius=28.5, wheel_radius=7.6, track_width=38.0, speed=20.0, sample_time=0.15)
 BOUNDS = ((0.0, 0.0), (500.0, 500.0))
@@ -210,3 +213,20 @@ def test_missing_drive_parameters_are_bad_input(tmp_path):
     proc = subprocess.run([*rrtpso_exe(), "solve", str(f), "--trajectory", str(out)],
                           capture_output=True, text=True, timeout=60)  # fmt: skip
     assert proc.returncode == 2 and "robot.speed" in proc.stderr and not out.exists()
+
+
+def test_one_closed_loop_step_is_one_step_of_the_drive_equations():
+    pose = (1.0, 2.0, 0.3)
+    poses = integrate_wheels(pose, [12.0, 12.0], [9.0, 9.0], 38.0, 0.15)
+    assert step_wheels(pose, 12.0, 9.0, 38.0, 0.15) == pytest.approx(tuple(poses[1]), abs=1e-12)
+
+
+def test_a_trajectory_has_at_most_max_steps_samples():
+    """A tiny sample time would build and write tens of millions of rows: refused with the key
+    to change (``rrtpso solve --trajectory`` refuses it before planning, see test_hostile)."""
+    world = World(((0.0, 0.0), (500.0, 500.0)), [], [], 28.5)
+    curve = reference_curve(np.array([[20.0, 20.0], [450.0, 450.0]]), world)
+    fine = replace(PAPER_ROBOT, sample_time=608.0 / 20.0 / (0.9 * MAX_STEPS))
+    assert len(time_parametrize(curve, fine).t) <= MAX_STEPS + 1
+    with pytest.raises(TrajectoryError, match=r"robot\.sample_time .* at most 1,000,000"):
+        time_parametrize(curve, replace(PAPER_ROBOT, sample_time=1e-6))

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from PIL import Image
 
 from rrtpso_ompl.errors import ProblemError
-from rrtpso_ompl.model import World, load_problem
+from rrtpso_ompl.model import World, load_problem, problem_from_dict
 from rrtpso_ompl.model.occupancy import OCCUPIED, UNKNOWN, load_map, merge_cells, read_pgm
 
 FREE_STATE = 0
@@ -341,3 +341,54 @@ def test_exact_check_agrees_with_shapely_on_random_maps(seed, radius, segments):
     scalar = np.array([world.motion_free(*p, *q) for p, q in zip(a, b, strict=True)])
     assert np.array_equal(got[clear], want[clear])
     assert np.array_equal(scalar[clear], want[clear])
+
+
+# ----------------------------------------------------------------------------------------------
+# Values that would be read as something else (issue 22)
+# ----------------------------------------------------------------------------------------------
+def test_pgm_pixel_values_outside_0_to_maxval_are_refused(tmp_path):
+    # "-1" once read as 255 (free): a wall drawn with -1 vanished without a word.
+    (tmp_path / "neg.pgm").write_text("P2\n2 2\n255\n0 -1\n255 255\n")
+    with pytest.raises(ValueError, match=r"pixel 1 \(row 0, column 1\) is -1"):
+        read_pgm(tmp_path / "neg.pgm")
+    (tmp_path / "big.pgm").write_text("P2\n2 2\n100\n0 1\n101 2\n")
+    with pytest.raises(ValueError, match="exceeds maxval 100"):
+        read_pgm(tmp_path / "big.pgm")
+
+
+def _map_text(tmp_path, resolution: str) -> str:
+    """A 4 x 4 free map whose resolution is written as given (JSON would write 1e-09, which
+    YAML 1.1 reads as text)."""
+    _pgm(tmp_path / "m.pgm", np.full((4, 4), 254, dtype=np.uint8))
+    (tmp_path / "m.yaml").write_text(f"image: m.pgm\nresolution: {resolution}\norigin: [0, 0, 0]\n")
+    return str(tmp_path / "m.yaml")
+
+
+@pytest.mark.parametrize(
+    ("resolution", "words"),
+    [
+        ("1.0e+12", "resolution: must be at most 1e+09 (the largest length"),
+        ("1.0e+9", "4 cells of 1e+09 from origin 0 reach x = 4e+09, beyond +-1e+09"),
+        ("1e-3", "(YAML reads 1e-3 as text, not a number: write 0.001)"),
+        ("0", "resolution: must be > 0"),
+    ],
+    ids=["too-large", "extent", "yaml-text", "zero"],
+)
+def test_a_resolution_out_of_range_says_why(tmp_path, resolution, words):
+    with pytest.raises(ProblemError) as exc:
+        load_map(_map_text(tmp_path, resolution))
+    assert words in str(exc.value)
+
+
+def test_a_map_too_fine_for_its_bounds_is_refused_at_the_documented_minimum(tmp_path):
+    """1e-9 m cells give a 4e-9 m map: under the smallest side a workspace may have (1e-6), and
+    RRTstarPSO then reported "exact" one cell short of the goal."""
+    _map_text(tmp_path, "1.0e-9")
+    doc = {"map": "m.yaml", "start": [5e-10, 5e-10], "goal": [3.5e-9, 3.5e-9],
+           "robot": {"radius": 0}}  # fmt: skip
+    with pytest.raises(ProblemError) as exc:
+        problem_from_dict(doc, str(tmp_path / "p.yaml"))
+    assert exc.value.key == "map" and "each must be at least 1e-06" in str(exc.value)
+    # With bounds of a plannable size the same fine map is fine.
+    doc["bounds"] = [[0, 0], [1e-6, 1e-6]]
+    assert problem_from_dict(doc, str(tmp_path / "p.yaml")).map.resolution == 1e-9

@@ -12,6 +12,7 @@ from helpers import PROBLEMS, SINGLE_CIRCLE
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from rrtpso_ompl.errors import ArgumentError
 from rrtpso_ompl.model.format import TOP
 from rrtpso_ompl.model.problem import (
     Circle,
@@ -765,3 +766,42 @@ def test_a_problem_knows_every_file_it_was_read_from(tmp_path):
     # Best effort: what cannot be read is left out (loading the problem reports it).
     (tmp_path / "bad.yaml").write_text("map: [")
     assert input_files(tmp_path / "bad.yaml") == (str(tmp_path / "bad.yaml"),)
+
+
+# ----------------------------------------------------------------------------------------------
+# Issue 22: arguments of the wrong kind, and exactness at every scale
+# ----------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("path", [None, 3, ["p.yaml"]])
+def test_load_problem_of_something_that_is_not_a_path(path):
+    with pytest.raises(ArgumentError, match="load_problem: path must be a file name"):
+        load_problem(path)
+
+
+def test_problem_from_dict_names_its_source_with_a_string():
+    with pytest.raises(ArgumentError, match="source must be a str"):
+        problem_from_dict(SINGLE_CIRCLE, source=None)
+    with pytest.raises(ArgumentError, match="name must be a str"):
+        problem_from_dict(SINGLE_CIRCLE, name=5)
+
+
+def test_a_micrometre_workspace_is_as_exact_as_any():
+    """The round-off allowance is 1e-9 of the workspace's scale (1e-15 here), as the docs say:
+    a start 5e-10 inside an obstacle's safety zone overlaps it (the old absolute 1e-9 floor
+    accepted it), one 5e-10 outside is free."""
+    doc = {"bounds": [[0, 0], [1e-6, 1e-6]], "goal": [9e-7, 9e-7], "robot": {"radius": 5e-8},
+           "obstacles": [{"type": "circle", "center": [5e-7, 5e-7], "radius": 1e-7}]}  # fmt: skip
+    with pytest.raises(ProblemError, match="overlaps obstacles"):
+        problem_from_dict({**doc, "start": [5e-7 + 1.5e-7 - 5e-10, 5e-7]})
+    assert problem_from_dict({**doc, "start": [5e-7 + 1.5e-7 + 5e-10, 5e-7]})
+
+
+def test_a_workspace_far_from_the_origin_needs_sides_relative_to_its_coordinates():
+    """Far from the origin the round-off allowance grows with the coordinates: a side must stay
+    a thousand allowances long."""
+    doc = {**SINGLE_CIRCLE, "obstacles": [], "robot": {"radius": 0}}
+    far = {**doc, "bounds": [[1e6, 1e6], [1e6 + 0.5, 1e6 + 0.5]], "start": [1e6 + 0.1, 1e6 + 0.1],
+           "goal": [1e6 + 0.4, 1e6 + 0.4]}  # fmt: skip
+    with pytest.raises(ProblemError, match=r"at least 1 \(1e-06 of its coordinates' magnitude"):
+        problem_from_dict(far)
+    far["bounds"] = [[1e6, 1e6], [1e6 + 2, 1e6 + 2]]
+    assert problem_from_dict(far).bounds[1] == (1e6 + 2, 1e6 + 2)

@@ -532,3 +532,83 @@ def test_map_cells_are_exact_squares(cells, seg, radius):
     assume(abs(d - world.threshold) > BOUNDARY_WINDOW)
     assert world.motion_free(*a, *b) == (d >= world.threshold)
     assert bool(world.segments_free(np.array([a]), np.array([b]))[0]) == (d >= world.threshold)
+
+
+def _gear(n: int, centre=(50.0, 50.0), r=(20.0, 23.0)) -> np.ndarray:
+    """A star-shaped polygon of ``n`` vertices alternating between two radii."""
+    k = np.arange(n)
+    rad = np.where(k % 2, r[1], r[0])
+    ang = 2 * np.pi * k / n
+    return np.column_stack([centre[0] + rad * np.cos(ang), centre[1] + rad * np.sin(ang)])
+
+
+@pytest.mark.parametrize(("radius", "crowded"), [(0.0, 256), (1.0, 256), (1.0, 8)])
+def test_a_polygon_of_thousands_of_vertices_is_checked_edge_by_edge(radius, crowded, monkeypatch):
+    """A detailed polygon is indexed as its edges and its interior: a check looks at the edges
+    near it only, and the answers are those of brute force and of shapely, also for segments
+    wholly inside it (far from every edge) and crossing its crowded boundary. The scalar checks
+    go through numpy in cells holding more than ``crowded`` items."""
+    import rrtpso_ompl.model.world as world_module
+
+    monkeypatch.setattr(world_module, "_CROWDED", crowded)
+    gear = _gear(2000)
+    world = World(BOUNDS, [(90.0, 10.0, 3.0)], [gear, L_SHAPE * 0.2], radius)
+    brute = _brute(world)
+    assert world._indexed and world._grid.max_items < 2000  # no cell holds the whole ring
+    rng = np.random.default_rng(7)
+    a = rng.uniform(0, 100, (2000, 2))
+    b = a + rng.normal(0, 1, (2000, 2)) * rng.choice([0.0, 1.0, 10.0, 40.0], (2000, 1))
+    a[:100] = rng.uniform(40, 60, (100, 2))  # wholly inside the gear, far from its edges
+    b[:100] = rng.uniform(40, 60, (100, 2))
+    d = brute.segment_distance(a, b)
+    lines = shapely.linestrings(np.stack([a, b], axis=1))
+    lines[np.all(a == b, axis=1)] = shapely.points(a[np.all(a == b, axis=1)])
+    ref = np.minimum.reduce(
+        [shapely.distance(lines, shapely.Polygon(p)) for p in world.polygons]
+        + [np.maximum(0.0, shapely.distance(lines, shapely.Point(90, 10)) - 3)]
+    )
+    np.testing.assert_allclose(d, ref, rtol=0, atol=1e-9)  # fmt: skip
+    assert np.all(d[:100] == 0.0)
+    free = world.segments_free(a, b)
+    keep = np.abs(d - world.threshold) > BOUNDARY_WINDOW
+    np.testing.assert_array_equal(free[keep], (d >= world.threshold)[keep])
+    scalar = np.array([world.motion_free(*p, *q) for p, q in zip(a, b, strict=True)])
+    np.testing.assert_array_equal(scalar, free)
+    np.testing.assert_array_equal([world.point_free(*p) for p in a],
+                                  brute.point_clearance(a) >= world.threshold)  # fmt: skip
+    np.testing.assert_allclose(world.segment_violation(a, b), brute.segment_violation(a, b),
+                               rtol=0, atol=1e-12)  # fmt: skip
+    cap = world.threshold + 2.0
+    capped = world.segment_distance(a, b, cap=cap)
+    near = d <= cap
+    np.testing.assert_allclose(capped[near], d[near], rtol=0, atol=1e-12)
+    assert np.all(capped[~near] > cap)
+    # The swarm's culled model: segments confined to boxes over the crowded ring.
+    seg_lo = rng.uniform(20, 70, (6, 2))
+    seg_hi = seg_lo + rng.uniform(1, 15, (6, 2))
+    pa = seg_lo + rng.uniform(0, 1, (30, 6, 2)) * (seg_hi - seg_lo)
+    pb = seg_lo + rng.uniform(0, 1, (30, 6, 2)) * (seg_hi - seg_lo)
+    np.testing.assert_allclose(world.local_model(seg_lo, seg_hi).violation(pa, pb),
+                               brute.segment_violation(pa, pb), rtol=0, atol=1e-12)  # fmt: skip
+
+
+def test_after_its_deadline_the_world_refuses_motions_unchecked():
+    world = World(BOUNDS, [(50.0, 50.0, 5.0)], [], 1.0)
+    a, b = np.array([[10.0, 10.0]]), np.array([[20.0, 10.0]])
+    assert world.motion_free(10, 10, 20, 10) and world.segments_free(a, b)[0]
+    with world.refusing_motions_after(0.0):  # long past
+        assert not world.motion_free(10, 10, 20, 10)
+        assert not world.segments_free(a, b)[0] and not world.path_valid([[10, 10], [20, 10]])
+        assert world.segment_distance(a, b)[0] > 0  # distances are still measured
+    assert world.motion_free(10, 10, 20, 10) and world.refuse_after is None
+
+
+def test_the_round_off_allowance_is_relative_at_every_scale():
+    tiny = ((0.0, 0.0), (1e-6, 1e-6))
+    assert World(tiny, [], [], 0.0).tol == pytest.approx(1e-15)
+    assert World(BOUNDS, [], [], 0.0).tol == pytest.approx(1e-7)
+    # A disc 1e-9 into a circle's safety zone is a collision in a micrometre-wide world (the
+    # old absolute allowance of 1e-9 let it through).
+    world = World(tiny, [(5e-7, 5e-7, 1e-7)], [], 5e-8)
+    x = 5e-7 + 1.5e-7 - 1e-9
+    assert not world.point_free(x, 5e-7) and world.point_free(x + 2e-9, 5e-7)

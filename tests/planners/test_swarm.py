@@ -425,3 +425,49 @@ def test_options_are_keyword_only_and_frozen():
     opts = PSOOptions()
     with pytest.raises(AttributeError):
         opts.w = 0.5  # type: ignore[misc]
+
+
+def test_a_deadline_stops_the_swarm_before_an_evaluation_that_would_end_after_it():
+    """An evaluation cannot be interrupted (near a detailed polygon one can take a sizeable share
+    of a short budget): the swarm does not start one that, as long as the last, would end after
+    the deadline. Here each evaluation takes 0.2 s and 0.3 s are left after the first."""
+    import time
+
+    def slow(x):
+        time.sleep(0.2)
+        return sphere(x)
+
+    opts = PSOOptions(swarm_size=4, iterations=50, tolerance=0.0)
+    lo, hi = -np.ones(2), np.ones(2)
+    rng = np.random.default_rng(0)
+    res = minimize(slow, lo, hi, opts, rng, deadline=time.perf_counter() + 0.3)
+    assert res.stopped_by == "deadline" and res.n_iterations <= 1
+    # Without a deadline the same swarm runs its iterations (a cheap cost here).
+    full = minimize(sphere, lo, hi, opts, np.random.default_rng(0))
+    assert full.n_iterations == 50
+
+
+def test_the_first_evaluation_of_a_swarm_with_a_deadline_stops_between_particles():
+    """Nothing is measured before the first evaluation: it runs a few particles at a time and
+    leaves the rest unevaluated (never the best) when the next few would end too late."""
+    import time
+
+    calls = []
+
+    def slow(x):
+        calls.append(len(x))
+        time.sleep(0.2)
+        return sphere(x)
+
+    opts = PSOOptions(swarm_size=30, iterations=50)
+    lo, hi = -np.ones(2), np.ones(2)
+    init = np.zeros((30, 2))
+    init[1:] = 0.5
+    res = minimize(slow, lo, hi, opts, np.random.default_rng(0), init=init,
+                   deadline=time.perf_counter() + 0.3)  # fmt: skip
+    assert calls == [8] and res.stopped_by == "deadline" and res.n_iterations == 0
+    assert res.cost == 0.0 and np.array_equal(res.position, [0.0, 0.0])  # the seed particle
+    # Costs come out the same whether the swarm is evaluated at once or in parts.
+    a = minimize(sphere, lo, hi, opts, np.random.default_rng(3), deadline=time.perf_counter() + 60)
+    b = minimize(sphere, lo, hi, opts, np.random.default_rng(3))
+    assert a.cost == b.cost and np.array_equal(a.history, b.history)
