@@ -64,7 +64,7 @@ def command_figure(name: str) -> None:
 
 
 def bench_figures() -> None:
-    from rrtpso_ompl.evaluation.bench import read_report_csv
+    from rrtpso_ompl.harness.bench import read_report_csv
     from rrtpso_ompl.plotting import plot_bench, save_figure
 
     summary = read_report_csv(REPO / "docs" / "bench" / "report.csv")

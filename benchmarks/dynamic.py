@@ -205,7 +205,7 @@ def _case_timeout(job: tuple) -> float:
 def _warm() -> None:
     """What a worker imports once, before it forks a process per case."""
     import rrtpso_ompl.dynamic.dwa
-    import rrtpso_ompl.evaluation.optimum  # noqa: F401
+    import rrtpso_ompl.groundtruth.optimum  # noqa: F401
     from rrtpso_ompl.planners import default_registry
 
     default_registry()
@@ -432,8 +432,8 @@ def main(argv: list[str] | None = None) -> int:
 
     from tqdm import tqdm
 
-    from rrtpso_ompl.evaluation.optimum import shortest_path
-    from rrtpso_ompl.evaluation.workers import ChildFailure, run_local
+    from rrtpso_ompl.groundtruth.optimum import shortest_path
+    from rrtpso_ompl.harness.workers import ChildFailure, run_local
     from rrtpso_ompl.model import World
     from rrtpso_ompl.model.problem import load_problem
 

@@ -50,7 +50,7 @@ PLANNERS = (("RRTstarPSO", False), ("BITstar", True), ("InformedRRTstar", True))
 
 
 def problem_files(which: str, seeds, folder: Path, only=None) -> list[tuple[str, Path]]:
-    from rrtpso_ompl.evaluation.generate import generate_to_file
+    from rrtpso_ompl.groundtruth.generate import generate_to_file
 
     out = []
     for family, (kind, options) in FAMILIES.items():
@@ -82,7 +82,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default="-", help="markdown file to write (default: print)")
     args = ap.parse_args(argv)
 
-    from rrtpso_ompl.evaluation import shortest_path
+    from rrtpso_ompl.groundtruth import shortest_path
     from rrtpso_ompl.model import World, load_problem
     from rrtpso_ompl.ompl_setup import set_ompl_log_level
     from rrtpso_ompl.planners import solve

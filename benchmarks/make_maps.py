@@ -178,7 +178,7 @@ def main() -> int:
     grey, alpha = lab(rng)
     Image.fromarray(np.dstack([grey, alpha]), mode="LA").save(GRIDS / "lab.png", optimize=True)
     (GRIDS / "lab.yaml").write_text(_yaml("lab", "lab.png", 0.025))
-    from rrtpso_ompl.evaluation import shortest_path
+    from rrtpso_ompl.groundtruth import shortest_path
     from rrtpso_ompl.model import load_problem
 
     for name, (mp, start, goal, radius, what) in PROBLEMS.items():

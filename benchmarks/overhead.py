@@ -37,7 +37,7 @@ PROBLEMS = ("problems/static/single_circle.yaml", "problems/maps/office_corridor
 
 
 def spawn_per_run(tasks, jobs, tmp):
-    from rrtpso_ompl.evaluation.batch import run_task
+    from rrtpso_ompl.harness.batch import run_task
 
     ctx = mp.get_context("spawn")
     with ProcessPoolExecutor(jobs, mp_context=ctx, max_tasks_per_child=1) as pool:
@@ -45,13 +45,13 @@ def spawn_per_run(tasks, jobs, tmp):
 
 
 def warm_workers(tasks, jobs, tmp):
-    from rrtpso_ompl.evaluation.batch import run_batch
+    from rrtpso_ompl.harness.batch import run_batch
 
     return run_batch(tasks, Path(tmp) / "warm.jsonl", jobs=jobs, optimum=False)
 
 
 def fork_server(tasks, jobs, tmp):
-    from rrtpso_ompl.evaluation.batch import _run_isolated
+    from rrtpso_ompl.harness.batch import _run_isolated
 
     with ThreadPoolExecutor(jobs) as pool:
         return list(pool.map(_run_isolated, tasks))
@@ -60,12 +60,12 @@ def fork_server(tasks, jobs, tmp):
 def dask_cluster(tasks, jobs, tmp):
     from distributed import Client, LocalCluster
 
-    from rrtpso_ompl.evaluation.batch import run_batch
+    from rrtpso_ompl.harness.batch import run_batch
 
     with LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True,
                       dashboard_address=None) as cluster, Client(cluster) as client:  # fmt: skip
-        client.run(lambda: __import__("rrtpso_ompl.evaluation.batch"))  # workers keep imports
-        client.run(lambda: __import__("rrtpso_ompl.evaluation.workers").evaluation.workers
+        client.run(lambda: __import__("rrtpso_ompl.harness.batch"))  # workers keep imports
+        client.run(lambda: __import__("rrtpso_ompl.harness.workers").harness.workers
                    ._forkserver())  # fmt: skip
         return run_batch(tasks, Path(tmp) / "dask.jsonl", jobs=jobs, executor="dask",
                          scheduler=client, optimum=False)  # fmt: skip
@@ -87,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default=str(REPO / "docs" / "overhead.md"))
     args = ap.parse_args(argv)
 
-    from rrtpso_ompl.evaluation.batch import make_tasks
+    from rrtpso_ompl.harness.batch import make_tasks
 
     try:
         import distributed  # noqa: F401

@@ -43,7 +43,7 @@ FRESH_SEED = 301
 
 def problems(folder: Path) -> list[tuple[str, Path]]:
     """``(set, path)``: the report part of the library, two maps, fresh generated problems."""
-    from rrtpso_ompl.evaluation.generate import generate_to_file
+    from rrtpso_ompl.groundtruth.generate import generate_to_file
 
     out = []
     for path in sorted((REPO / "problems" / "static").glob("*.yaml")):
@@ -114,7 +114,7 @@ def main(argv: list[str] | None = None) -> int:
     planners = args.planners.split(",")
     times = [float(t) for t in args.times.split(",")]
 
-    from rrtpso_ompl.evaluation import shortest_path
+    from rrtpso_ompl.groundtruth import shortest_path
     from rrtpso_ompl.model import load_problem
 
     t_start = time.perf_counter()

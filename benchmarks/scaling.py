@@ -140,7 +140,7 @@ def run_solve(problem_file: Path, planner: str, folder: Path) -> dict:
 
 _CHILD = """
 import json, resource, sys, time
-from rrtpso_ompl.evaluation import shortest_path
+from rrtpso_ompl.groundtruth import shortest_path
 from rrtpso_ompl.model import World, load_problem
 t = time.perf_counter()
 p = load_problem(sys.argv[1])

@@ -1,6 +1,6 @@
 """The paper's Table 3 on the reconstructed workspace: RRT, RRT*, PSO and RRT*PSO at one budget.
 
-A thin layer over ``rrtpso bench`` (:func:`rrtpso_ompl.evaluation.run_bench`: one process per
+A thin layer over ``rrtpso bench`` (:func:`rrtpso_ompl.harness.run_bench`: one process per
 run, the same exact collision checker for every planner, lengths over the exact optimum). As in
 the paper, OMPL's planners are reported with their raw paths (no simplifier). The PSO's share of
 the budget comes from each run's own figures (the swarm is RRTstarPSO's simplification stage).
@@ -35,7 +35,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", default=str(REPO / "docs" / "table3.md"))
     args = parser.parse_args(argv)
 
-    from rrtpso_ompl.evaluation.bench import run_bench
+    from rrtpso_ompl.harness.bench import run_bench
 
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:

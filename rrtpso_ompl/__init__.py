@@ -8,8 +8,10 @@ One subpackage per stage, each with a short ``__init__`` that is its public face
   and :func:`~rrtpso_ompl.planners.solve`, the one door to planning;
 - :mod:`rrtpso_ompl.kinematics`: reference path, velocities and wheel speeds;
 - :mod:`rrtpso_ompl.dynamic`: moving obstacles, prediction and replanning;
-- :mod:`rrtpso_ompl.evaluation`: the exact optimum, batches, benchmarks in OMPL's format,
-  generated problems;
+- :mod:`rrtpso_ompl.groundtruth`: the exact optimum, certificates of solvability, generated
+  problems (geometry only);
+- :mod:`rrtpso_ompl.harness`: batches, benchmarks in OMPL's format, worker processes, results
+  files;
 - :mod:`rrtpso_ompl.cli`: the ``rrtpso`` command; :mod:`rrtpso_ompl.plotting`: every figure.
 
 The names below are importable from here; ``solve`` and ``RRTstarPSO`` load OMPL on first use,

@@ -251,7 +251,7 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
 
 
 def plot_optimum(problem: Problem, result: Any) -> Figure:
-    """The world with the exact shortest path (an :class:`~rrtpso_ompl.evaluation.OptimumResult`):
+    """The world with the exact shortest path (an :class:`~rrtpso_ompl.groundtruth.OptimumResult`):
     its tangent segments and its arcs around the inflated obstacles."""
     fig, ax = plt.subplots(figsize=(world_width(problem, 6.0), 6))
     key = draw_world(ax, problem)
@@ -279,7 +279,7 @@ DODGE_PT = 7.0
 
 
 def plot_bench(summary: Any, what: str = "ratio") -> Figure:
-    """Benchmark summary (:class:`~rrtpso_ompl.evaluation.SummaryRow` list) against the time budget:
+    """Benchmark summary (:class:`~rrtpso_ompl.harness.SummaryRow` list) against the time budget:
     ``what="ratio"`` the median excess length over the optimum, ``100 (length / optimum - 1)``
     in percent on a log axis (quartiles shaded), ``"success"`` the success rate; one panel per
     problem, one line and marker per planner.

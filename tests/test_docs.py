@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from helpers import REPO as ROOT
 
-from rrtpso_ompl.evaluation.bench import overview_markdown, read_report_csv
+from rrtpso_ompl.harness.bench import overview_markdown, read_report_csv
 
 DOCS = ROOT / "docs"
 

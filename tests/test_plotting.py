@@ -11,7 +11,7 @@ import pytest
 from helpers import PROBLEMS
 
 from rrtpso_ompl import load_problem, problem_from_dict, solve
-from rrtpso_ompl.evaluation.bench import SummaryRow
+from rrtpso_ompl.harness.bench import SummaryRow
 from rrtpso_ompl.plotting import (  # the Agg backend: files only
     plot_bench,
     plot_optimum,
@@ -81,7 +81,7 @@ def legend_labels(ax) -> list[str]:
 # Worlds
 # ----------------------------------------------------------------------------------------------
 def test_the_legend_of_a_10000_circle_world_hides_nothing_and_explains_the_symbols():
-    from rrtpso_ompl.evaluation.generate import generate
+    from rrtpso_ompl.groundtruth.generate import generate
 
     problem = problem_from_dict(generate("circles", seed=7, n=10000))
     result = solve(problem, "RRTstarPSO", time_limit=0.5, seed=1)
@@ -123,7 +123,7 @@ def test_the_best_cost_axis_has_a_unit():
 
 
 def test_the_optimum_legend_hides_nothing():
-    from rrtpso_ompl.evaluation import shortest_path
+    from rrtpso_ompl.groundtruth import shortest_path
 
     problem = load_problem(PROBLEMS / "static" / "maze.yaml")
     fig = plot_optimum(problem, shortest_path(problem))

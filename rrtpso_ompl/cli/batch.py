@@ -55,7 +55,7 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..evaluation import make_tasks, run_batch
+    from ..harness import make_tasks, run_batch
 
     check_run_options(args)
     planners = planner_list(args.planner, "RRTstarPSO")

@@ -67,8 +67,8 @@ def _budgets(text: str) -> list[float]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..evaluation import run_bench
-    from ..evaluation.bench import OUTPUT_FILES
+    from ..harness import run_bench
+    from ..harness.bench import OUTPUT_FILES
 
     times = _budgets(args.time)
     args.time = None  # checked above, one budget at a time

@@ -474,7 +474,7 @@ def check_run_options(args: argparse.Namespace) -> None:
 def batch_inputs(items: Sequence[str]) -> list[str]:
     """Every file the problems of a batch or bench read (:func:`check_outputs`' ``inputs``): the
     problem files and their maps' YAML and images, found without loading the problems."""
-    from ..evaluation import expand_inputs
+    from ..harness import expand_inputs
     from ..model.problem import input_files
 
     files = (input_files(path) for path, error in expand_inputs(items) if error is None)

@@ -67,7 +67,7 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..evaluation import generate_to_file
+    from ..groundtruth import generate_to_file
 
     check_seed_flag(args.seed)
     options = {k: getattr(args, k) for k in _OPTIONS if getattr(args, k) is not None}

@@ -27,7 +27,7 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..evaluation import shortest_path
+    from ..groundtruth import shortest_path
     from ..model import load_problem
 
     problem = load_problem(args.problem)

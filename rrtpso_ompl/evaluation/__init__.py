@@ -1,38 +1,40 @@
-"""Measuring planners: the exact optimum, batches, benchmarks in OMPL's format, generated problems.
+"""Deprecated: the old name of :mod:`rrtpso_ompl.harness` and :mod:`rrtpso_ompl.groundtruth`.
 
-- :mod:`.optimum`: :func:`shortest_path`, the exact shortest path for the disc robot (the
-  reference of every length ratio);
-- :mod:`.batch`: :func:`run_batch`, many problem files x planners x runs in parallel, streamed
-  to JSON lines and resumable;
-- :mod:`.bench`: :func:`run_bench`, a batch written as OMPL benchmark logs, the SQLite database
-  Planner Arena opens (:mod:`.ompl_log`) and a report;
-- :mod:`.generate`: seeded random problems with a certificate of solvability.
+``rrtpso_ompl.evaluation`` held both the harness (batches, benchmarks, worker processes, results
+files, OMPL logs) and the ground truth (the exact optimum, certificates, generated problems);
+they are subpackages of their own now. Importing this module, or ``rrtpso_ompl.evaluation.X``
+for one of its old modules, still works and warns.
 """
 
-from .batch import Task, expand_inputs, make_tasks, read_rows, run_batch, run_task
-from .bench import BenchResult, SummaryRow, run_bench, summarise
-from .generate import generate, generate_to_file
-from .ompl_log import Experiment, PlannerRuns, build_database, format_log, write_log
-from .optimum import OptimumResult, shortest_path
+from __future__ import annotations
 
-__all__ = [
-    "BenchResult",
-    "Experiment",
-    "OptimumResult",
-    "PlannerRuns",
-    "SummaryRow",
-    "Task",
-    "build_database",
-    "expand_inputs",
-    "format_log",
-    "generate",
-    "generate_to_file",
-    "make_tasks",
-    "read_rows",
-    "run_batch",
-    "run_bench",
-    "run_task",
-    "shortest_path",
-    "summarise",
-    "write_log",
-]
+import importlib
+import sys
+import warnings
+
+from .. import groundtruth, harness
+from ..groundtruth import *  # noqa: F403 - the old public names
+from ..harness import *  # noqa: F403
+
+warnings.warn(
+    "rrtpso_ompl.evaluation is deprecated: use rrtpso_ompl.harness (batch, bench, workers, "
+    "results files, OMPL logs) and rrtpso_ompl.groundtruth (optimum, certify, generate)",
+    DeprecationWarning,
+    stacklevel=2,
+)
+
+# The old module paths (rrtpso_ompl.evaluation.optimum, ...) name the moved modules.
+_MOVED = {
+    "certify": "groundtruth",
+    "generate": "groundtruth",
+    "optimum": "groundtruth",
+    "batch": "harness",
+    "bench": "harness",
+    "ompl_log": "harness",
+    "results_file": "harness",
+    "workers": "harness",
+}
+for _name, _package in _MOVED.items():
+    sys.modules[f"{__name__}.{_name}"] = importlib.import_module(f"rrtpso_ompl.{_package}.{_name}")
+
+__all__ = [*groundtruth.__all__, *harness.__all__]

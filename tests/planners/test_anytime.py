@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from helpers import PROBLEMS
 
-from rrtpso_ompl.evaluation.generate import generate
+from rrtpso_ompl.groundtruth.generate import generate
 from rrtpso_ompl.model import World, load_problem, problem_from_dict
 from rrtpso_ompl.model.geometry import path_length, shortcut
 from rrtpso_ompl.planners import solve
@@ -28,7 +28,7 @@ def test_a_budget_is_used_by_further_rounds_while_they_pay():
     rng = np.random.default_rng(0)
     world = World.from_problem(load_problem(PROBLEMS / "static" / "cluttered_circles.yaml"))
     problem = load_problem(PROBLEMS / "static" / "cluttered_circles.yaml")
-    from rrtpso_ompl.evaluation.certify import grid_path
+    from rrtpso_ompl.groundtruth.certify import grid_path
 
     seed = grid_path(problem, shortcut=False)
     polled = []

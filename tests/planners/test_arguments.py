@@ -10,7 +10,7 @@ from helpers import PROBLEMS, SINGLE_CIRCLE
 from ompl import base as ob
 
 from rrtpso_ompl.errors import ArgumentError, ProblemError, RrtpsoError, UsageError
-from rrtpso_ompl.evaluation import make_tasks
+from rrtpso_ompl.harness import make_tasks
 from rrtpso_ompl.model import load_problem, problem_from_dict
 from rrtpso_ompl.planners import default_registry, solve
 

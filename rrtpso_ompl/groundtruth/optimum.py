@@ -18,7 +18,7 @@ LaValle, *Planning Algorithms*, 2006, section 6.2.4; Latombe 1991 for the polygo
    segment are free: exact distances to the candidate obstacles the spatial index names, the
    bounds for the arc's extreme points. The heuristic is the straight distance to the goal.
 3. **Pruning that keeps exactness.** A valid path of length ``C`` (the grid certificate of
-   :func:`~rrtpso_ompl.evaluation.certify.grid_path`) bounds the optimum, so a circle that cannot
+   :func:`~rrtpso_ompl.groundtruth.certify.grid_path`) bounds the optimum, so a circle that cannot
    touch the ellipse ``|x - start| + |x - goal| <= C`` is never a candidate, and an edge whose end
    already needs more than ``C`` is never checked. Only the tangents of the circles A\* expands are
    ever built, instead of those of every pair: 10,000 circles take seconds, not terabytes.

@@ -1,16 +1,16 @@
 """Benchmarks in OMPL's format: every planner through the same harness, logs, database, report.
 
 ``run_bench`` solves every problem x time budget x planner x run as a batch task
-(:mod:`rrtpso_ompl.evaluation.batch`: one fresh process per run, seeded, with the same exact
+(:mod:`rrtpso_ompl.harness.batch`: one fresh process per run, seeded, with the same exact
 collision checker for every planner), then writes
 
 - ``runs.jsonl``: one row per run (the batch format, with the optimum and the ratio to it);
 - ``<problem>_<budget>s.log``: OMPL's benchmark log, one experiment per problem and budget
-  (:mod:`rrtpso_ompl.evaluation.ompl_log`);
+  (:mod:`rrtpso_ompl.harness.ompl_log`);
 - ``benchmark.db``: the SQLite database that Planner Arena opens, built from the logs by OMPL's
   own converter;
 - ``report.csv`` and ``report.md``: per problem, budget and planner, the success rate, the median
-  path length over the exact optimum (:mod:`rrtpso_ompl.evaluation.optimum`) and the median time;
+  path length over the exact optimum (:mod:`rrtpso_ompl.groundtruth.optimum`) and the median time;
 - ``ratio.png`` and ``success.png`` (drawn by the command line; this module draws nothing).
 
 How runs map to OMPL's properties, as Planner Arena expects them: each planner's stats say it
@@ -188,8 +188,8 @@ def run_bench(
     times : sequence of float
         Time budgets, seconds; one experiment per problem and budget.
     seed, params, jobs, executor, scheduler, resume, progress, on_start
-        As for :func:`~rrtpso_ompl.evaluation.run_batch` and
-        :func:`~rrtpso_ompl.evaluation.make_tasks`.
+        As for :func:`~rrtpso_ompl.harness.run_batch` and
+        :func:`~rrtpso_ompl.harness.make_tasks`.
     command : str, optional
         The command line that ran the benchmark, quoted at the top of ``report.md``.
     simplify : bool, optional

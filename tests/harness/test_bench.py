@@ -10,9 +10,9 @@ import subprocess
 import pytest
 from helpers import PROBLEMS, rrtpso_exe
 
-from rrtpso_ompl.evaluation.batch import read_rows
-from rrtpso_ompl.evaluation.bench import run_bench, run_properties, summarise
-from rrtpso_ompl.evaluation.optimum import shortest_path
+from rrtpso_ompl.groundtruth.optimum import shortest_path
+from rrtpso_ompl.harness.batch import read_rows
+from rrtpso_ompl.harness.bench import run_bench, run_properties, summarise
 from rrtpso_ompl.model.problem import load_problem
 from rrtpso_ompl.planners.result import BenchmarkRun
 
@@ -249,7 +249,7 @@ def test_solve_records_progress_for_every_kind_of_planner(planner):
 
 
 def test_overview_counts_the_cells_the_first_planner_loses():
-    from rrtpso_ompl.evaluation.bench import SummaryRow, overview_markdown
+    from rrtpso_ompl.harness.bench import SummaryRow, overview_markdown
 
     def row(problem, planner, ratio, solved=10):
         return SummaryRow(problem, 1.0, planner, 10, solved, solved / 10, 100.0, None, ratio,

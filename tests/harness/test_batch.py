@@ -11,8 +11,8 @@ import time
 import pytest
 from helpers import PROBLEMS, rrtpso_exe
 
-from rrtpso_ompl.evaluation.batch import expand_inputs, make_tasks, read_rows, run_batch
-from rrtpso_ompl.evaluation.optimum import shortest_path
+from rrtpso_ompl.groundtruth.optimum import shortest_path
+from rrtpso_ompl.harness.batch import expand_inputs, make_tasks, read_rows, run_batch
 from rrtpso_ompl.model.problem import load_problem
 
 ROW_KEYS = {"file", "problem", "planner", "seed", "run", "status", "solved", "length", "time",
@@ -171,7 +171,7 @@ def test_dask_process_workers_fork_warm_runs_with_the_same_paths(tmp_path):
 def test_only_a_solved_row_gets_a_ratio():
     """An approximate path stops short of the goal, so it can be shorter than the optimum: it
     gets the optimum but no ratio (seen on the maze at 0.2 s: ratio 0.39 before the fix)."""
-    from rrtpso_ompl.evaluation.batch import _Optima
+    from rrtpso_ompl.harness.batch import _Optima
 
     maze = str(PROBLEMS / "static" / "maze.yaml")
     optima = _Optima()
@@ -201,3 +201,21 @@ def test_an_unsolvable_file_is_an_unsolved_row_and_exit_1(tmp_path):
     walled = next(r for name, r in rows.items() if name != "single_circle")
     assert not walled["solved"] and walled["error"] is None
     assert walled["optimum"] is None and walled["ratio"] is None
+
+
+def test_the_old_evaluation_package_still_imports_and_warns():
+    """rrtpso_ompl.evaluation was split into harness and groundtruth; old imports keep working."""
+    import importlib
+    import sys
+    import warnings
+
+    sys.modules.pop("rrtpso_ompl.evaluation", None)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        old = importlib.import_module("rrtpso_ompl.evaluation")
+        from rrtpso_ompl.evaluation.optimum import shortest_path
+    from rrtpso_ompl.groundtruth import shortest_path as new
+    from rrtpso_ompl.harness import run_batch
+
+    assert shortest_path is new and old.run_batch is run_batch
+    assert any(issubclass(w.category, DeprecationWarning) for w in caught)

@@ -2,12 +2,12 @@
 
 Every run gets an OMPL of its own, seeded before any of its random generators exists (OMPL takes
 its seed once per process): the local executor's warm workers fork one child per run
-(:mod:`rrtpso_ompl.evaluation.workers`), after loading the run's problem once per worker; the
+(:mod:`rrtpso_ompl.harness.workers`), after loading the run's problem once per worker; the
 Dask executor forks a process per run from a warm fork server. So each row is reproducible from
 its seed, whichever worker ran it, and a run that crashes is an error row, not the end of the
 batch. Rows are written
 by the parent as they finish, one whole line per write, to a locked results file
-(:mod:`rrtpso_ompl.evaluation.results_file`), so an interrupted batch leaves a valid file that
+(:mod:`rrtpso_ompl.harness.results_file`), so an interrupted batch leaves a valid file that
 ``resume=True`` continues.
 """
 
@@ -64,7 +64,7 @@ class Task:
     @property
     def key(self) -> tuple[str, str, int, float | None]:
         """Identifies the row in a results file (for resuming): the problem file resolved
-        (:func:`~rrtpso_ompl.evaluation.results_file.row_key`), however it was spelled."""
+        (:func:`~rrtpso_ompl.harness.results_file.row_key`), however it was spelled."""
         source = self.source if self.source is not None else resolved_source(self.file)
         return (source, self.planner, self.seed, self.time_limit)
 
@@ -365,7 +365,7 @@ def run_batch(
     ----------
     tasks : iterable of Task
     out : path
-        The results file (:class:`~rrtpso_ompl.evaluation.results_file.ResultsFile`: locked while
+        The results file (:class:`~rrtpso_ompl.harness.results_file.ResultsFile`: locked while
         the batch runs, appended to, never replaced).
     jobs : int
         Worker processes of the local executor.
@@ -382,7 +382,7 @@ def run_batch(
     on_start : callable, optional
         Called as ``on_start(n_to_run, n_skipped)`` before the first task starts.
     optimum : bool
-        Add ``optimum`` (the exact shortest length, :mod:`rrtpso_ompl.evaluation.optimum`,
+        Add ``optimum`` (the exact shortest length, :mod:`rrtpso_ompl.groundtruth.optimum`,
         computed once per file in this process) and ``ratio`` (``length / optimum``, null unless
         solved) to every row.
 

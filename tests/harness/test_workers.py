@@ -17,8 +17,8 @@ from pathlib import Path
 import pytest
 from helpers import PROBLEMS
 
-from rrtpso_ompl.evaluation.batch import Task, error_row, make_tasks, run_batch
-from rrtpso_ompl.evaluation.workers import (
+from rrtpso_ompl.harness.batch import Task, error_row, make_tasks, run_batch
+from rrtpso_ompl.harness.workers import (
     ChildFailure,
     _ParentGone,
     run_local,
@@ -147,7 +147,7 @@ def test_a_run_is_killed_when_its_worker_s_parent_goes_away(tmp_path):
 
 SPAWNER = """
 import sys
-from rrtpso_ompl.evaluation.workers import run_spawned
+from rrtpso_ompl.harness.workers import run_spawned
 print(run_spawned(eval, sys.argv[1], 120, warm=True))
 """
 

@@ -208,7 +208,7 @@ def _reap(pid: int, killed: bool) -> str:
 #: What a fork server imports once, so that the processes it forks start planning at once (the
 #: warm workers' imports; importing OMPL creates none of its objects, so its seed is still free).
 WARM_MODULES = ("numpy", "scipy.sparse.csgraph", "shapely", "ompl.base", "ompl.geometric",
-                "rrtpso_ompl.planners", "rrtpso_ompl.evaluation.batch")  # fmt: skip
+                "rrtpso_ompl.planners", "rrtpso_ompl.harness.batch")  # fmt: skip
 
 
 def _forkserver() -> Any:

@@ -15,7 +15,7 @@ import pytest
 import yaml
 from helpers import PROBLEMS
 
-from rrtpso_ompl.evaluation.generate import (
+from rrtpso_ompl.groundtruth.generate import (
     KINDS,
     GenerationError,
     default_decimals,

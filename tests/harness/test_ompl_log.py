@@ -1,4 +1,4 @@
-"""OMPL benchmark logs: written by :mod:`rrtpso_ompl.evaluation.ompl_log`, read back by OMPL."""
+"""OMPL benchmark logs: written by :mod:`rrtpso_ompl.harness.ompl_log`, read back by OMPL."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from rrtpso_ompl import __version__
-from rrtpso_ompl.evaluation.ompl_log import (
+from rrtpso_ompl.harness.ompl_log import (
     STATUS_ENUM,
     Experiment,
     PlannerRuns,

@@ -13,8 +13,8 @@ from helpers import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
 from scipy.sparse import csr_array
 from scipy.sparse.csgraph import dijkstra
 
-from rrtpso_ompl.evaluation.generate import generate, grid_path
-from rrtpso_ompl.evaluation.optimum import shortest_path
+from rrtpso_ompl.groundtruth.generate import generate, grid_path
+from rrtpso_ompl.groundtruth.optimum import shortest_path
 from rrtpso_ompl.model.geometry import path_length
 from rrtpso_ompl.model.problem import Circle, Polygon, load_problem, problem_from_dict
 from rrtpso_ompl.model.world import World
@@ -315,7 +315,7 @@ def test_the_json_path_is_a_valid_path_of_nearly_the_exact_length(path):
 @pytest.mark.parametrize("seed", [0, 1])
 def test_occlusion_never_drops_a_free_tangent(seed):
     """The angular filter only removes tangents the exact check would reject."""
-    from rrtpso_ompl.evaluation.optimum import _node_circles, _tangents_from, _TangentSearch
+    from rrtpso_ompl.groundtruth.optimum import _node_circles, _tangents_from, _TangentSearch
 
     problem = problem_from_dict(_cluttered(seed, 0.8, 40, (1.5, 4)))
     world = World.from_problem(problem)

@@ -19,7 +19,7 @@ Every random choice comes from one ``numpy.random.default_rng(seed)`` stream, an
 byte-identical file.
 
 **Solvability is certified, not hoped for**: every problem comes with a collision-checked grid
-path (:mod:`rrtpso_ompl.evaluation.certify`); when the certificate fails the obstacles are drawn
+path (:mod:`rrtpso_ompl.groundtruth.certify`); when the certificate fails the obstacles are drawn
 again from the same generator stream.
 """
 

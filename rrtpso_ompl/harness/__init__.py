@@ -1,0 +1,32 @@
+"""The harness: running planners many times, in processes, and recording what they did.
+
+- :mod:`.batch`: :func:`run_batch`, many problem files x planners x runs in parallel, streamed
+  to JSON lines and resumable (:mod:`.results_file`), each run in a process of its own
+  (:mod:`.workers`);
+- :mod:`.bench`: :func:`run_bench`, a batch written as OMPL benchmark logs, the SQLite database
+  Planner Arena opens (:mod:`.ompl_log`) and a report.
+
+The reference lengths come from :mod:`rrtpso_ompl.groundtruth`.
+"""
+
+from .batch import Task, expand_inputs, make_tasks, read_rows, run_batch, run_task
+from .bench import BenchResult, SummaryRow, run_bench, summarise
+from .ompl_log import Experiment, PlannerRuns, build_database, format_log, write_log
+
+__all__ = [
+    "BenchResult",
+    "Experiment",
+    "PlannerRuns",
+    "SummaryRow",
+    "Task",
+    "build_database",
+    "expand_inputs",
+    "format_log",
+    "make_tasks",
+    "read_rows",
+    "run_batch",
+    "run_bench",
+    "run_task",
+    "summarise",
+    "write_log",
+]
