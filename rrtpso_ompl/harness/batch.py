@@ -445,7 +445,7 @@ class _Optima:
     def length(self, file: str) -> float | None:
         if file not in self._cache:
             from ..model.problem import load_problem
-            from .optimum import shortest_path
+            from ..groundtruth.optimum import shortest_path
 
             try:
                 self._cache[file] = shortest_path(load_problem(file)).length
