@@ -129,7 +129,7 @@ def run_case(case: Case, replan_time: float, initial_time: float,
     seed = case.seed
     head = {"group": case.group, "seed": seed}
     base = load_problem(case.base)
-    static = solve(base, "RRTstarPSO", initial_time, seed)
+    static = solve(base, "RRTstarPSO", time_limit=initial_time, seed=seed)
     if not static.solved:
         return [{**head, "strategy": s, "error": "no static path"} for s, _ in STRATEGIES]
     problem = base

@@ -102,8 +102,8 @@ def main(argv: list[str] | None = None) -> int:
             for planner, simplify in planners:
                 for run in args.runs:
                     extra = params if planner == "RRTstarPSO" else None
-                    r = solve(problem, planner, args.time, run, extra, simplify=simplify,
-                              world=world)  # fmt: skip
+                    r = solve(problem, planner, time_limit=args.time, seed=run, params=extra,
+                              simplify=simplify, world=world)  # fmt: skip
                     key = (family, planner)
                     if r.solved and best:
                         ratios.setdefault(key, []).append(r.length / best)

@@ -11,6 +11,5 @@ PLANNERS = [
         description="Particle swarm over random waypoints (the paper's PSO baseline, Table 3)",
         aliases=("geometric::PSO",),
         capabilities=Capabilities(optimizing=True),
-        configure=PSOPlanner.set_params,
     )
 ]

@@ -11,6 +11,5 @@ PLANNERS = [
         description="RRT* for a share of the budget, then PSO over its waypoints (the paper)",
         aliases=("geometric::RRTstarPSO", "RRT*PSO"),
         capabilities=Capabilities(optimizing=True),
-        configure=RRTstarPSO.set_params,
     )
 ]

@@ -86,14 +86,20 @@ class ParameterError(RrtpsoError, ValueError):
         The whole message, naming the parameter (and its owner, when known).
     name : str
         The parameter (or ``"a + b"`` for a rule over several).
+    origin : str
+        Where the value came from, put before the message: ``"p.yaml: --param swarm_size"``,
+        ``"params['swarm_size']"`` (empty when not known).
     """
 
-    def __init__(self, message: str, name: str = "") -> None:
+    def __init__(self, message: str, name: str = "", origin: str = "") -> None:
         self.name = name
-        super().__init__(message)
+        self.origin = origin
+        #: The message without its origin.
+        self.detail = message
+        super().__init__(f"{origin}: {message}" if origin else message)
 
     def __reduce__(self):
-        return (type(self), (str(self), self.name))
+        return (type(self), (self.detail, self.name, self.origin))
 
 
 class PlannerError(RrtpsoError):
@@ -104,15 +110,17 @@ class UnknownPlannerError(PlannerError, KeyError):
     """No usable planner of that name.
 
     The message lists the known names, suggests the closest one and, for a planner that exists but
-    is excluded, says why.
+    is excluded, says why. ``origin`` (where the name came from: ``"--planner"``,
+    ``"p.yaml: planner.type"``) goes before the message.
     """
 
-    def __init__(self, name: str, known, reason: str = "") -> None:
+    def __init__(self, name: str, known, reason: str = "", origin: str = "") -> None:
         import difflib
 
         self.name = name
         self.known = sorted(known, key=str.lower)
         self.reason = reason
+        self.origin = origin
         listing = ", ".join(self.known)
         if reason:
             text = f"planner '{name}' is unavailable ({reason}); known planners: {listing}"
@@ -121,10 +129,10 @@ class UnknownPlannerError(PlannerError, KeyError):
             close = difflib.get_close_matches(name.lower(), list(lower), n=1, cutoff=0.6)
             hint = f" (did you mean '{lower[close[0]]}'?)" if close else ""
             text = f"unknown planner '{name}'{hint}; known planners: {listing}"
-        super().__init__(text)
+        super().__init__(f"{origin}: {text}" if origin else text)
 
     def __reduce__(self):
-        return (type(self), (self.name, self.known, self.reason))
+        return (type(self), (self.name, self.known, self.reason, self.origin))
 
 
 class UsageError(RrtpsoError):

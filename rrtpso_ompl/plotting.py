@@ -30,7 +30,7 @@ from matplotlib.transforms import ScaledTranslation
 
 from .model.problem import Circle, Polygon, Problem
 from .outputs import atomic_path
-from .planners.solve import SolveResult
+from .planners.result import SolveResult
 
 __all__ = [
     "animate_simulation",

@@ -16,13 +16,16 @@ import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import ParameterError, UnknownPlannerError, UsageError, did_you_mean
-from ..model import Problem, load_problem
+from ..model import load_problem
 from ..model.yamlfile import file_kind
 from ..outputs import STDOUT, is_stream, name_max, os_reason, stdout_closed
 from ..validation import check_seconds, check_seed
+
+if TYPE_CHECKING:
+    from ..planners.request import PlannerRequest
 
 __all__ = [
     "EXIT_BAD_INPUT",
@@ -30,7 +33,6 @@ __all__ = [
     "EXIT_OK",
     "EXIT_UNSOLVED",
     "Output",
-    "PlannerChoice",
     "RunProgress",
     "add_run_options",
     "add_shared_flags",
@@ -78,94 +80,46 @@ def add_shared_flags(parser: argparse.ArgumentParser) -> None:
 # ----------------------------------------------------------------------------------------------
 # One problem and its planner (solve, simulate)
 # ----------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class PlannerChoice:
-    """A problem file loaded and its planner resolved and checked, before anything runs.
+def choose_planner(args: argparse.Namespace) -> PlannerRequest:
+    """Load ``args.problem`` and resolve ``--planner``, ``--post``/``--simplify``, ``--param``,
+    ``--time`` and ``--seed`` against it (:func:`~rrtpso_ompl.planners.request.resolve`).
 
-    Attributes
-    ----------
-    problem : Problem
-        The validated problem.
-    entry : PlannerEntry
-        The registered planner (``--planner``, else the file's ``planner.type``, else the
-        default).
-    params : dict
-        The file's ``planner.params`` under the ``--param`` values, checked against the planner.
-    cli_params : dict
-        The ``--param`` values alone (as text), the post-passes' included.
-    post : tuple of str
-        The post-passes after the planner: the spec's (``BITstar+pso``), then ``--post``'s.
-    """
-
-    problem: Problem
-    entry: Any
-    params: dict[str, Any]
-    cli_params: dict[str, str]
-    post: tuple[str, ...] = ()
-
-
-def choose_planner(args: argparse.Namespace) -> PlannerChoice:
-    """Load ``args.problem`` and resolve ``args.planner`` and ``args.param`` against it.
+    Returns
+    -------
+    PlannerRequest
 
     Raises
     ------
     ProblemError
-        For a bad problem file.
+        For a bad problem file, or a value of its ``planner`` section its planner cannot take.
     UsageError
-        For an unknown planner or a bad parameter, naming the file and where the value came from
-        (``--planner``, ``planner.type``, ``--param NAME``, ``planner.params.NAME``).
+        For an unknown planner or a bad flag, the message naming the file and where the value
+        came from (``--planner``, ``planner.type``, ``--param NAME``, ...).
     """
-    from ..planners import DEFAULT_PLANNER, default_registry
-    from ..planners.post import split_params, split_spec
+    from ..planners.request import command_line, resolve
 
-    if args.planner is not None and not args.planner.strip():
-        raise UsageError("--planner: give a planner name (see 'rrtpso planners')")
     problem = load_problem(args.problem)
-    src = args.problem
-    name = args.planner or problem.planner.type or DEFAULT_PLANNER
-    origin = (
-        "--planner" if args.planner else ("planner.type" if problem.planner.type else "planner")
-    )
     try:
-        base, steps = split_spec(name)
-        steps = (*steps, *post_steps(args, src))
-        entry = default_registry().get(base)
-    except UnknownPlannerError as exc:
-        raise UsageError(f"{src}: {origin}: {exc}") from None
-    except ParameterError as exc:
-        raise UsageError(f"{src}: {origin}: {exc}") from None
-    cli_params = parse_params(args.param, src)
-    try:
-        _, post_params = split_params(entry, cli_params, steps)
-    except ParameterError as exc:
-        raise UsageError(f"{src}: --param {exc.name}: {exc}") from None
-    for key, value in problem.planner.params.items():
-        _check_param(entry, key, value, f"{src}: planner.params.{key}", text=False)
-    for key, value in cli_params.items():
-        if key not in post_params:
-            _check_param(entry, key, value, f"{src}: --param {key}")
-    params = {**problem.planner.params, **{k: v for k, v in cli_params.items()
-                                           if k not in post_params}}  # fmt: skip
-    try:
-        entry.validate(params)  # the rules over several parameters (c1 + c2 < 4)
-    except ParameterError as exc:
-        raise UsageError(f"{src}: planner parameters: {exc}") from None
-    return PlannerChoice(problem, entry, params, cli_params, tuple(dict.fromkeys(steps)))
+        return resolve(
+            problem,
+            args.planner,
+            params=parse_params(args.param, args.problem),
+            time_limit=getattr(args, "time", None),
+            seed=args.seed,
+            post=_post_steps(args),
+            sources=command_line(args.problem),
+        )
+    except (ParameterError, UnknownPlannerError) as exc:
+        raise UsageError(str(exc)) from None
 
 
-def post_steps(args: argparse.Namespace, src: str = "") -> tuple[str, ...]:
-    """``--post STEPS`` (a comma list) and ``--simplify`` (its alias for ``simplify``), checked:
-    an unknown step is a usage error that names the known ones."""
-    from ..planners.post import parse_steps
-
+def _post_steps(args: argparse.Namespace) -> list[str]:
+    """``--post STEPS`` (a comma list) and ``--simplify`` (its alias for ``simplify``, first)."""
     text = getattr(args, "post", None)
     steps = [s for s in (text.split(",") if text else []) if s.strip()]
     if getattr(args, "simplify", False) and "simplify" not in steps:
         steps.insert(0, "simplify")
-    try:
-        return parse_steps(steps, "--post")
-    except ParameterError as exc:
-        raise UsageError(f"{src}: --post: {exc}" if src else f"--post: {exc}") from None
+    return steps
 
 
 def parse_params(items: list[str], src: str = "") -> dict[str, str]:
@@ -186,13 +140,6 @@ def parse_params(items: list[str], src: str = "") -> dict[str, str]:
                              "give it once")  # fmt: skip
         params[key] = value
     return params
-
-
-def _check_param(entry: Any, key: str, value: Any, where: str, text: bool = True) -> None:
-    try:
-        entry.param(key).convert(value, entry.name, text)
-    except ParameterError as exc:
-        raise UsageError(f"{where}: {exc}") from None
 
 
 def check_positive_seconds(value: float | None, flag: str, src: str = "") -> None:
@@ -482,47 +429,32 @@ def batch_inputs(items: Sequence[str]) -> list[str]:
 
 
 def check_planners(names: list[str], items: list[str], flag: str) -> dict[str, dict[str, str]]:
-    """Resolve planner names and check ``--param`` against each; returns params per planner.
+    """Resolve planner specs and check ``--param`` against each (without a problem: the files
+    are loaded by the runs); returns the ``--param`` values (text) per spec.
 
-    A ``--param`` applies to the planners that have it; one that none of them has is an error.
+    A ``--param`` applies to the specs that take it (the planner, or its post-passes); one that
+    none of them takes is an error.
     """
-    from ..planners import ParamTable, PathOptimizerOptions, default_registry
-    from ..planners.post import POST_PARAMS, split_spec
+    import dataclasses
+
+    from ..planners import default_registry
+    from ..planners.request import COMMAND_LINE, resolve
 
     registry = default_registry()
+    sources = dataclasses.replace(COMMAND_LINE, planner=flag)
     params = parse_params(items)
-    out = {}
-    for name in names:
-        try:
-            base, steps = split_spec(name)
-            entry = registry.get(base)
-        except (UnknownPlannerError, ParameterError) as exc:
-            raise UsageError(f"{flag}: {exc}") from None
-        post = POST_PARAMS + PathOptimizerOptions.PARAMS if steps else ParamTable()
-        for key in params:
-            if key in post and not entry.takes(key):
-                try:
-                    post[key].convert(params[key], "post-pass")
-                except ParameterError as exc:
-                    raise UsageError(f"--param {key}: {exc}") from None
-        mine = {k: v for k, v in params.items() if entry.takes(k) or k in post}
-        for key, value in mine.items():
-            if entry.takes(key):  # the post-passes' own were checked above
-                _check_param(entry, key, value, f"--param {key}")
-        out[name] = mine
+    out: dict[str, dict[str, str]] = {}
+    known: set[str] = set()
+    try:
+        for name in names:
+            spec = resolve(None, name, sources=sources, registry=registry)
+            known.update(spec.param_names())
+            out[name] = {k: v for k, v in params.items() if spec.takes(k)}
+            resolve(None, name, params=out[name], sources=sources, registry=registry)
+    except (ParameterError, UnknownPlannerError) as exc:
+        raise UsageError(str(exc)) from None
     for key in params:
         if not any(key in p for p in out.values()):
-            known = {n for name in names for n in _param_names(registry, name)}
             raise UsageError(f"--param {key}: none of the planners {', '.join(names)} has it"
                              f"{did_you_mean(key, sorted(known))}")  # fmt: skip
     return out
-
-
-def _param_names(registry: Any, spec: str) -> list[str]:
-    """The parameters a planner spec (``BITstar+pso``) takes: the planner's and its post-passes'."""
-    from ..planners import PathOptimizerOptions
-    from ..planners.post import POST_PARAMS, split_spec
-
-    base, steps = split_spec(spec)
-    post = (POST_PARAMS + PathOptimizerOptions.PARAMS).names() if steps else []
-    return [*registry.get(base).params.names(), *post]

@@ -148,7 +148,9 @@ def _simulate_dwa(problem: Any, options: Any, seed: int | None, choice: Any) -> 
     from ..planners import solve
 
     budget = options.initial_time
-    static = solve(problem, options.planner, budget, seed, dict(options.params))
+    static = solve(
+        problem, options.planner, time_limit=budget, seed=seed, params=dict(options.params)
+    )
     guide = static.path
     if static.solved:
         guide = guide_path(problem, static.path, options.planner, static.time, options.params)

@@ -11,8 +11,6 @@ from .common import (
     EXIT_UNSOLVED,
     Output,
     check_outputs,
-    check_positive_seconds,
-    check_seed_flag,
     choose_planner,
     note,
 )
@@ -99,10 +97,8 @@ def run(args: argparse.Namespace) -> int:
     from ..ompl_setup import set_ompl_log_level
 
     set_ompl_log_level(args.verbose)
-    choice = choose_planner(args)
-    problem = choice.problem
-    check_positive_seconds(args.time, "--time", args.problem)
-    check_seed_flag(args.seed)
+    request = choose_planner(args)  # --planner, --post, --param, --time and --seed, checked
+    problem = request.problem
     outputs = [
         Output("--json", args.json),
         Output("--plot", args.plot, "image"),
@@ -117,9 +113,7 @@ def run(args: argparse.Namespace) -> int:
 
     from ..planners import solve
 
-    result = solve(
-        problem, choice.entry.name, args.time, args.seed, choice.cli_params, post=choice.post
-    )
+    result = solve(request)
     motion = _drive(problem, result, args.profile) if wants_motion and result.solved else None
     _write_outputs(args, problem, result, motion)
     length = f"{result.length:.3f}" if result.length is not None else "-"

@@ -183,7 +183,7 @@ def guide_path(
     bigger = dataclasses.replace(
         problem, robot=dataclasses.replace(robot, radius=grown), planner=PlannerConfig()
     )
-    res = solve(bigger, planner, time_limit, None, params)
+    res = solve(bigger, planner, time_limit=time_limit, params=params)
     return res.path if res.solved else np.asarray(static_path, dtype=float)
 
 

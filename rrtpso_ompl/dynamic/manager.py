@@ -456,7 +456,9 @@ class ReplanningManager:
         params = dict(self.options.params)
         if self._seed_param:
             params.setdefault("seed", int(self.rng.integers(2**31 - 1)))
-        return self.solve(detour_problem, self.options.planner, budget, None, params, world=world)
+        return self.solve(
+            detour_problem, self.options.planner, time_limit=budget, params=params, world=world
+        )
 
     def _horizon(self, plan: Motion, t_s: float, t_g: float) -> float:
         """Latest time the detour to the old plan's point at ``t_g`` may still be under way."""

@@ -303,7 +303,13 @@ def _static_path(problem: Problem, options: DynamicOptions, seed: int | None) ->
     """The initial static path, planned with the options' planner (empty when unsolved)."""
     from ..planners import solve
 
-    res = solve(problem, options.planner, options.initial_time, seed, dict(options.params))
+    res = solve(
+        problem,
+        options.planner,
+        time_limit=options.initial_time,
+        seed=seed,
+        params=dict(options.params),
+    )
     return res.path if res.solved else np.empty((0, 2))
 
 

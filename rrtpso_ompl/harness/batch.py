@@ -243,8 +243,9 @@ def run_task(task: Task) -> dict[str, Any]:
                          f"{task.file}: {loaded}")  # fmt: skip
     problem, world = loaded
     try:
-        result = solve(problem, task.planner, task.time_limit, task.seed, dict(task.params),
-                       simplify=task.simplify, progress=task.progress, world=world)  # fmt: skip
+        result = solve(problem, task.planner, time_limit=task.time_limit, seed=task.seed,
+                       params=dict(task.params), simplify=task.simplify, progress=task.progress,
+                       world=world)  # fmt: skip
     except ProblemError as exc:  # it names the file already
         return error_row(task, str(exc))
     except RrtpsoError as exc:  # unknown planner, bad parameter
@@ -444,8 +445,8 @@ class _Optima:
 
     def length(self, file: str) -> float | None:
         if file not in self._cache:
-            from ..model.problem import load_problem
             from ..groundtruth.optimum import shortest_path
+            from ..model.problem import load_problem
 
             try:
                 self._cache[file] = shortest_path(load_problem(file)).length

@@ -3,6 +3,8 @@
 - :mod:`.params`: each planner parameter declared once (:class:`ParamSpec`, :class:`ParamTable`);
 - :mod:`.registry`: planners by name (:class:`PlannerEntry` with its :class:`Capabilities`),
   from the first-party plugins and the entry-point group ``rrtpso_ompl.planners``;
+- :mod:`.request`: :func:`resolve`, the one place that turns a problem, a planner spec and the
+  caller's choices into a :class:`PlannerRequest` (and says where each value came from);
 - :mod:`.swarm`: the particle swarm of eqs. 4-5; :mod:`.path_optimizer`: the swarm over a path's
   waypoints, exactly collision-checked, never longer;
 - :mod:`.post`: :class:`PSOPathOptimizer`, the swarm as an OMPL path optimiser for any planner
@@ -12,19 +14,39 @@
 - :mod:`.solve`: :func:`solve`, the one door every caller plans through, returning a
   :class:`SolveResult`.
 
-The planner classes import OMPL; everything else here is plain numpy.
+The planner classes and the post-passes import OMPL, on first access (PEP 562), and
+:func:`solve` when it runs; everything else here is plain numpy, so importing
+``rrtpso_ompl.planners.swarm`` (or this package) loads no OMPL.
 """
 
-from .base import PlannerStats, PythonPlanner
+from importlib import import_module
+from typing import Any
+
 from .params import ParamSpec, ParamTable, Rule
 from .path_optimizer import PathOptimizationResult, PathOptimizerOptions, optimize_path
-from .post import POST_PARAMS, POST_STEPS, PostStep, PSOPathOptimizer, split_spec
-from .pso_baseline import PSOPlanner
 from .registry import Capabilities, PlannerEntry, PlannerRegistry, default_registry
+from .request import (
+    DEFAULT_PLANNER,
+    DEFAULT_TIME_LIMIT,
+    POST_PARAMS,
+    POST_STEPS,
+    PlannerRequest,
+    resolve,
+    split_spec,
+)
 from .result import BenchmarkRun, SolveResult
-from .rrtstar_pso import RRTstarPSO
-from .solve import DEFAULT_PLANNER, DEFAULT_TIME_LIMIT, PlannerRequest, resolve_request, solve
+from .solve import solve
 from .swarm import PSOOptions, PSOResult, minimize
+
+#: Names whose modules import OMPL, imported on first access.
+_LAZY = {
+    "PlannerStats": ".base",
+    "PythonPlanner": ".base",
+    "PostStep": ".post",
+    "PSOPathOptimizer": ".post",
+    "PSOPlanner": ".pso_baseline",
+    "RRTstarPSO": ".rrtstar_pso",
+}
 
 __all__ = [
     "DEFAULT_PLANNER",
@@ -53,7 +75,17 @@ __all__ = [
     "default_registry",
     "minimize",
     "optimize_path",
-    "resolve_request",
+    "resolve",
     "solve",
     "split_spec",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        return getattr(import_module(_LAZY[name], __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

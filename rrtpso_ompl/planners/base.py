@@ -1,7 +1,7 @@
 """What every Python planner of this project shares on top of ``ob.Planner``.
 
 * Parameters by name from its declared :class:`~rrtpso_ompl.planners.params.ParamTable`
-  (``set_param``, ``set_params``, ``get_param``, ``param_values``), because ``Planner.params()``
+  (scikit-learn's ``get_params()`` and ``set_params(**params)``), because ``Planner.params()``
   is unusable from Python.
 * Typed statistics of the last solve (:class:`PlannerStats`), which know their own part in OMPL's
   benchmark terms: planning time, simplification, planner-specific run properties and progress.
@@ -259,40 +259,33 @@ class PythonPlanner(ob.Planner):
     def __init__(self, si: ob.SpaceInformation, name: str, **params: Any) -> None:
         super().__init__(si, name)
         self._values: dict[str, Any] = self.PARAMS.defaults()
-        self.set_params(params)
+        self.set_params(**params)
         self._ompl_rng: ou.RNG | None = None
         self.last_stats: PlannerStats | None = None
 
-    # -- parameters ----------------------------------------------------------------------------
-    @classmethod
-    def param_spec(cls, name: str) -> ParamSpec:
-        """The spec of parameter ``name`` (``ParameterError`` listing the known names otherwise)."""
-        return cls.PARAMS[name]
+    # -- parameters (scikit-learn's get_params / set_params) -----------------------------------
+    def get_params(self) -> dict[str, Any]:
+        """Every parameter and its current value, as set (a value the planner chooses itself,
+        such as RRTstarPSO's automatic ``range``, is reported in its stats instead)."""
+        return dict(self._values)
 
-    def set_params(self, values: dict[str, Any]) -> None:
-        """Set several parameters at once, validated together (rules such as ``c1 + c2 < 4``
-        apply to the new values jointly, not one by one)."""
-        merged = {**self._values, **values}
-        converted = self.PARAMS.validate(merged, owner=self.getName())
-        for name in values:
+    def set_params(self, **params: Any) -> PythonPlanner:
+        """Set parameters by name, validated together over the current values (rules such as
+        ``c1 + c2 < 4`` apply to the new values jointly, not one by one); returns the planner.
+
+        Raises
+        ------
+        ParameterError
+            For an unknown name or a value its declaration refuses; nothing is changed then.
+        """
+        converted = self.PARAMS.validate({**self._values, **params}, owner=self.getName())
+        for name in params:
             self._apply(name, converted[name])
-
-    def set_param(self, name: str, value: Any) -> None:
-        """Set a parameter by name; the value is validated against its declaration."""
-        self.set_params({name: value})
+        return self
 
     def _apply(self, name: str, value: Any) -> None:
         """Store a validated value (subclasses may forward it, e.g. to an inner OMPL planner)."""
         self._values[name] = value
-
-    def get_param(self, name: str) -> Any:
-        """Current value of parameter ``name``."""
-        self.PARAMS[name]
-        return self._values[name]
-
-    def param_values(self) -> dict[str, Any]:
-        """All parameters and their current values."""
-        return dict(self._values)
 
     # -- lifecycle -----------------------------------------------------------------------------
     def clear(self) -> None:

@@ -27,12 +27,11 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from ..errors import ParameterError
 from ..model.geometry import path_length as path_length_of
 from ..ompl_setup import assign_path, path_to_array
 from .base import SpaceInformationCollisionModel, collision_model_for, refusing_motions_after
-from .params import ParamSpec, ParamTable
 from .path_optimizer import PathOptimizationResult, PathOptimizerOptions, optimize_path
+from .request import POST_PARAMS, POST_STEPS, parse_steps, split_spec
 
 __all__ = [
     "ITERATIONS_NEEDED",
@@ -44,7 +43,6 @@ __all__ = [
     "PostStep",
     "parse_steps",
     "run_post",
-    "split_params",
     "split_spec",
 ]
 
@@ -56,55 +54,6 @@ VALIDATIONS_NEEDED = 4
 ITERATIONS_NEEDED = 3
 #: The smallest swarm worth running.
 MIN_SWARM = 4
-
-#: The post-passes, in the order a spec may name them: OMPL's simplifier and the swarm.
-POST_STEPS = ("simplify", "pso")
-
-#: The harness's parameters of the post-passes.
-POST_PARAMS = ParamTable(
-    ParamSpec("post_fraction", float, 0.2,
-              "Share of the time budget kept for the post-passes after the planner (the planner "
-              "gets the rest); only used when post-passes are asked for.", low=0.0, high=0.9),
-    ParamSpec("simplify_share", float, 0.5,
-              "Most of the post-pass time OMPL's simplifier may take when the swarm follows it.",
-              low=0.0, high=1.0),
-)  # fmt: skip
-
-
-def parse_steps(items: Iterable[str], where: str = "post") -> tuple[str, ...]:
-    """Post-pass names, checked; ParameterError naming the known ones otherwise."""
-    steps = tuple(s.strip() for s in items)
-    for step in steps:
-        if step not in POST_STEPS:
-            known = ", ".join(POST_STEPS)
-            raise ParameterError(f"unknown post-pass {step!r} (known: {known})", where)
-    return steps
-
-
-def split_spec(spec: str) -> tuple[str, tuple[str, ...]]:
-    """``"BITstar+simplify+pso"`` -> ``("BITstar", ("simplify", "pso"))``; steps checked."""
-    name, *steps = spec.split("+")
-    return name.strip(), parse_steps(steps, f"planner {spec!r}")
-
-
-def split_params(
-    entry: Any, params: Mapping[str, Any], steps: tuple[str, ...]
-) -> tuple[dict[str, Any], dict[str, Any]]:
-    """``(planner's, post-passes')`` parameters: with post-passes, a parameter the planner does
-    not take goes to them when they declare it (:data:`POST_PARAMS`, the swarm's and the path
-    optimiser's), converted and checked; anything else stays with the planner (whose own check
-    then names it)."""
-    if not steps:
-        return dict(params), {}
-    table = POST_PARAMS + PathOptimizerOptions.PARAMS
-    mine: dict[str, Any] = {}
-    post: dict[str, Any] = {}
-    for key, value in params.items():
-        if key in table and not entry.takes(key):
-            post[key] = table[key].convert(value, "post-pass")
-        else:
-            mine[key] = value
-    return mine, post
 
 
 @dataclass(frozen=True)
@@ -149,6 +98,7 @@ class PSOPathOptimizer:
     def __init__(
         self,
         si: ob.SpaceInformation,
+        *,
         options: PathOptimizerOptions | None = None,
         world: Any = None,
         rng: np.random.Generator | None = None,
@@ -156,11 +106,9 @@ class PSOPathOptimizer:
     ) -> None:
         if options is not None and params:
             raise TypeError("give the options or parameters by name, not both")
-        unknown = [k for k in params if k not in PathOptimizerOptions.PARAMS]
-        if unknown:
-            raise ParameterError(f"PSOPathOptimizer has no parameter {unknown[0]!r}", unknown[0])
         self.si = si
-        self.options = options or PathOptimizerOptions.from_values(params)
+        self.options = options or PathOptimizerOptions()
+        self.set_params(**params)
         self.model = world if world is not None else collision_model_for(si)
         if rng is None:
             rng = np.random.default_rng(ou.RNG().uniformInt(0, 2**31 - 2))
@@ -169,6 +117,27 @@ class PSOPathOptimizer:
         self.last_result: PathOptimizationResult | None = None
         #: Why the last call left the path alone without running the swarm ("" when it ran).
         self.skipped = ""
+
+    def get_params(self) -> dict[str, Any]:
+        """Every parameter and its current value (as scikit-learn's ``get_params``)."""
+        return dataclasses.asdict(self.options)
+
+    def set_params(self, **params: Any) -> PSOPathOptimizer:
+        """Set parameters by name, validated together over the current values (rules such as
+        ``c1 + c2 < 4`` apply to the new values jointly); returns the optimiser.
+
+        Raises
+        ------
+        ParameterError
+            For an unknown name or a value its declaration refuses; nothing is changed then.
+        """
+        table = PathOptimizerOptions.PARAMS
+        for name in params:
+            if name not in table:
+                table[name]  # raises, naming the known parameters
+        converted = table.validate({**self.get_params(), **params}, owner="PSOPathOptimizer")
+        self.options = dataclasses.replace(self.options, **{k: converted[k] for k in params})
+        return self
 
     def optimize(self, path: og.PathGeometric, ptc_or_seconds: Any = None) -> bool:
         """Shorten ``path`` in place; True when it changed it (then shorter and valid).
@@ -252,6 +221,7 @@ def run_post(
     path: og.PathGeometric,
     steps: Iterable[str],
     deadline: float,
+    *,
     values: Mapping[str, Any] | None = None,
     world: Any = None,
     rng: np.random.Generator | None = None,
@@ -279,7 +249,8 @@ def run_post(
                 with refusing_motions_after(world or collision_model_for(si), t0 + seconds):
                     og.PathSimplifier(si).simplify(path, seconds)
         else:
-            optimizer = PSOPathOptimizer(si, PathOptimizerOptions.from_values(values), world, rng)
+            options = PathOptimizerOptions.from_values(values)
+            optimizer = PSOPathOptimizer(si, options=options, world=world, rng=rng)
             optimizer.optimize(path, left if left > 0 else 0.0)
         out.append(PostStep(step, before, float(path.length()), time.perf_counter() - t0))
     return out

@@ -94,8 +94,10 @@ class PlannerEntry:
         ``stats(planner) -> PlannerStats`` after a solve; by default the planner's own
         ``last_stats`` (planners of this package), else the figures every planner has.
     configure : callable, optional
-        ``configure(planner, values)`` applies validated parameter values; by default each value
-        goes to the ``setter`` method named in its ParamSpec, or to ``planner.set_param(name, v)``.
+        ``configure(planner, values)`` applies validated parameter values; by default they go
+        to ``planner.set_params(**values)`` when the planner has it (scikit-learn's form, as
+        :class:`~rrtpso_ompl.planners.base.PythonPlanner`), else each to the ``setter`` method
+        named in its ParamSpec, or to ``planner.set_param(name, v)``.
     source : str
         Which plugin registered it (filled by the registry).
     """
@@ -146,6 +148,8 @@ class PlannerEntry:
         if converted:
             if self.configure is not None:
                 self.configure(planner, converted)
+            elif callable(getattr(planner, "set_params", None)):
+                planner.set_params(**converted)
             else:
                 for k, v in converted.items():
                     spec = self.params[k]

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["BenchmarkRun", "SolveResult"]
+__all__ = ["STATUSES", "BenchmarkRun", "SolveResult"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -69,9 +69,17 @@ class BenchmarkRun:
         )
 
 
-@dataclass(frozen=True)
+#: The verdicts of a solve, one of them per result (the ``status`` of the JSON contract).
+STATUSES = ("exact", "approximate", "none")
+
+
+@dataclass(frozen=True, kw_only=True)
 class SolveResult:
     """The outcome of solving one problem with one planner.
+
+    One verdict, :attr:`status`; :attr:`solved` and :attr:`valid` are derived from it, and
+    :attr:`ompl_status` is what OMPL said (a path OMPL called exact that failed the exact check
+    is ``status`` "none" with ``ompl_status`` "Exact solution").
 
     Attributes
     ----------
@@ -79,16 +87,16 @@ class SolveResult:
         Problem name.
     planner : str
         Planner name as selected.
-    status : str
-        ``"exact"``, ``"approximate"`` or ``"none"`` (the contract's three values).
+    status : {"exact", "approximate", "none"}
+        ``"exact"``: a path to the goal that passed the exact validity check; ``"approximate"``:
+        a valid path that stops short of the goal; ``"none"``: no path, or one that failed the
+        check (it is never returned).
     ompl_status : str
         OMPL's own status text (``"Exact solution"``, ``"Timeout"``, ``"Crash"``, ...).
-    solved : bool
-        True only for an exact path that passed the exact validity check.
     length : float or None
         Euclidean length of ``path`` in problem units.
     time : float
-        Wall-clock seconds spent in the planner.
+        Wall-clock seconds spent in the planner and its post-passes.
     seed : int or None
         The seed OMPL and numpy ran with.
     path : (n, 2) ndarray
@@ -96,14 +104,12 @@ class SolveResult:
     time_limit : float
         The budget, seconds.
     params : dict
-        Planner parameters as applied.
+        Planner parameters as the planner holds them.
     stages : dict
         Per-stage figures (for RRTstarPSO: RRT* and PSO lengths, times, iterations, PSO best cost
-        per iteration), as the planner's stats report them.
+        per iteration, the range used), as the planner's stats report them.
     clearance : float or None
         Smallest distance from the path to an obstacle, minus the robot radius (>= 0 when valid).
-    valid : bool
-        Whether ``path`` passed the exact check (bounds, every segment, robot radius).
     benchmark : BenchmarkRun
         The run as OMPL's Benchmark records it (planning versus simplification, in the planner's
         own terms).
@@ -113,7 +119,6 @@ class SolveResult:
     planner: str
     status: str
     ompl_status: str
-    solved: bool
     length: float | None
     time: float
     seed: int | None
@@ -122,8 +127,22 @@ class SolveResult:
     params: dict[str, Any] = field(default_factory=dict)
     stages: dict[str, Any] = field(default_factory=dict)
     clearance: float | None = None
-    valid: bool = False
     benchmark: BenchmarkRun = field(default_factory=lambda: BenchmarkRun(time=0.0))
+
+    def __post_init__(self) -> None:
+        if self.status not in STATUSES:
+            raise ValueError(f"status must be one of {STATUSES}, got {self.status!r}")
+
+    @property
+    def solved(self) -> bool:
+        """True only for an exact path that passed the exact validity check."""
+        return self.status == "exact"
+
+    @property
+    def valid(self) -> bool:
+        """Whether a path is returned (it passed the exact check: bounds, every segment, robot
+        radius); an approximate one is valid too."""
+        return self.status != "none"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary with the contract's keys first."""

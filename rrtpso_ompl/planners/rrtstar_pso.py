@@ -97,9 +97,11 @@ class RRTstarPSOStats(PlannerStats):
     Lengths are in problem units, times in seconds. In OMPL's benchmark terms the RRT* stage and
     OMPL's simplifier are the planning, the swarm is the simplification. ``rrt_path`` is RRT*'s
     first path, ``seed_path`` the RRT* path the returned one was made from (a later one when the
-    anytime loop found a shorter).
+    anytime loop found a shorter). ``range_used`` is the inner RRT*'s range, the one chosen for
+    the world when the ``range`` parameter is 0 (the parameter itself stays as the user set it).
     """
 
+    range_used: float = 0.0
     rrt_length: float | None = None
     first_solution: str = "RRTstar"
     rrt_time: float = 0.0
@@ -215,7 +217,6 @@ class RRTstarPSO(PythonPlanner):
             world = self._model
             if isinstance(world, World):
                 self.inner.setRange(clutter_range(world, self.inner.getRange()))
-            self._values["range"] = self.inner.getRange()  # report what was chosen
         self._inner_ready = True
 
     def clear(self) -> None:
@@ -235,7 +236,7 @@ class RRTstarPSO(PythonPlanner):
             self.setup()
         pdef = self.getProblemDefinition()
         values = self._values
-        stats = RRTstarPSOStats()
+        stats = RRTstarPSOStats(range_used=self.inner.getRange())  # the one chosen when 0
         self.last_stats = stats
 
         # --- stage 1: RRT* ------------------------------------------------------------------
@@ -362,7 +363,7 @@ class RRTstarPSO(PythonPlanner):
         # The same post-pass any planner gets with "+pso" (one optimiser, not two).
         si = self.getSpaceInformation()
         options = PathOptimizerOptions.from_values(self._values)
-        optimizer = PSOPathOptimizer(si, options, self._model, self._rng())
+        optimizer = PSOPathOptimizer(si, options=options, world=self._model, rng=self._rng())
         result = optimizer.optimize_array(xy, terminate, deadline)
         # Summed over the swarm runs of one solve (one, unless the anytime loop ran more).
         stats.pso_time += result.time

@@ -100,7 +100,7 @@ def test_generated_problems_are_solvable(kind, seed):
     assert World.from_problem(problem).path_valid(path)
     assert tuple(path[0]) == problem.start and tuple(path[-1]) == problem.goal
     assert is_solvable(problem)
-    result = solve(problem, "RRTConnect", 0.5, seed=1)
+    result = solve(problem, "RRTConnect", time_limit=0.5, seed=1)
     assert result.solved and World.from_problem(problem).path_valid(result.path)
 
 

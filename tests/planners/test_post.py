@@ -42,7 +42,7 @@ def test_the_post_pass_never_lengthens_or_invalidates_for_any_planner(name):
     """The contract, for every registered planner: each step leaves the path no longer than it
     found it, and the final path is valid (exact check) and no longer than the planner's."""
     problem = problem_from_dict(SINGLE_CIRCLE)
-    result = solve(problem, f"{name}+simplify+pso", 0.3, 5)
+    result = solve(problem, f"{name}+simplify+pso", time_limit=0.3, seed=5)
     assert result.planner == f"{name}+simplify+pso"
     if not result.solved:
         pytest.skip(f"{name} found no path in 0.24 s")
@@ -141,18 +141,20 @@ def test_rrtstarpso_and_the_post_pass_share_one_optimiser(monkeypatch):
         return original(self, xy, *args)
 
     monkeypatch.setattr(post.PSOPathOptimizer, "optimize_array", spy)
-    result = solve(problem_from_dict(SINGLE_CIRCLE), "RRTstarPSO", 0.3, 2)
+    result = solve(problem_from_dict(SINGLE_CIRCLE), "RRTstarPSO", time_limit=0.3, seed=2)
     assert result.solved and made  # RRTstarPSO's swarm stage is the post-pass optimiser
 
 
 def test_post_passes_share_the_one_budget():
     problem = problem_from_dict(SINGLE_CIRCLE)
-    plain = solve(problem, "PRMstar", 0.4, 3, {"post_fraction": 0.5}, post=["pso"])
+    plain = solve(problem, "PRMstar", time_limit=0.4, seed=3, params={"post_fraction": 0.5},
+                  post=["pso"])  # fmt: skip
     assert plain.planner == "PRMstar"  # as asked; the post-passes are in the stages
     assert plain.benchmark.time < 0.4 * 0.5 + 0.05  # the planner had half
     assert plain.stages["post"][0]["step"] == "pso"
     with pytest.raises(ParameterError, match="post_fraction"):
-        solve(problem, "PRMstar", 0.4, 3, {"post_fraction": 0.95}, post=["pso"])
+        solve(problem, "PRMstar", time_limit=0.4, seed=3, params={"post_fraction": 0.95},
+              post=["pso"])  # fmt: skip
 
 
 def run_cli(*args, timeout=120):

@@ -1,9 +1,10 @@
-"""One contract for every registered planner (after OMPL's tests/base/PlannerTest.h)."""
+"""RRTstarPSO on its own: the known optimum, its stages, a foreign SimpleSetup, parameters by
+name (get_params / set_params), the automatic range reported and not written back, crashes
+reported (the conformance every planner passes is in test_conformance.py)."""
 
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 import pytest
@@ -11,66 +12,20 @@ from helpers import SINGLE_CIRCLE_OPTIMUM
 from ompl import base as ob
 
 from rrtpso_ompl.errors import ParameterError
-from rrtpso_ompl.ompl_setup import make_context, path_to_array
+from rrtpso_ompl.ompl_setup import make_context
+from rrtpso_ompl.planners import PSOPathOptimizer, solve
 from rrtpso_ompl.planners.registry import default_registry
-from rrtpso_ompl.planners.solve import solve
+from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSO
 
 REGISTRY = default_registry()
-BUDGET = 0.25
 
 
 def _make(problem, name: str, budget: float):
     ctx = make_context(problem)
-    entry = REGISTRY.get(name)
-    params = {"budget": budget} if any(p.name == "budget" for p in entry.params) else {}
-    planner = entry.make(ctx.si, params)
+    planner = REGISTRY.get(name).make(ctx.si, {"budget": budget})
     ctx.ss.setPlanner(planner)
     ctx.ss.setup()
     return ctx, planner
-
-
-def _check_solution(ctx, problem) -> float:
-    pdef = ctx.ss.getProblemDefinition()
-    assert pdef.hasExactSolution()
-    xy = path_to_array(pdef.getSolutionPath())
-    assert ctx.world.path_valid(xy), "returned path collides or leaves the bounds"
-    assert np.allclose(xy[0], problem.start) and np.allclose(xy[-1], problem.goal)
-    length = float(np.linalg.norm(np.diff(xy, axis=0), axis=1).sum())
-    straight = math.dist(problem.start, problem.goal)
-    assert length >= straight - 1e-9, "a path cannot be shorter than the straight line"
-    return length
-
-
-@pytest.mark.parametrize("name", REGISTRY.names())
-def test_planner_contract(name, single_circle):
-    ctx, _planner = _make(single_circle, name, BUDGET)
-    # solve, clear, solve again: the planner must work after clear() (OMPL's PlannerTest).
-    for _ in range(2):
-        ctx.ss.clear()
-        status = ctx.ss.solve(ob.timedPlannerTerminationCondition(BUDGET))
-        assert status.getStatus() == ob.PlannerStatus.EXACT_SOLUTION, str(status)
-        _check_solution(ctx, single_circle)
-
-    # A tiny budget must be honoured: whatever it returns, it returns (a generous bound, 100x
-    # the budget, so that only a planner that ignores its termination condition fails).
-    ctx.ss.clear()
-    tiny = make_context(single_circle)
-    small = REGISTRY.get(name).make(
-        tiny.si, {"budget": 0.01} if "budget" in {p.name for p in REGISTRY.get(name).params} else {}
-    )
-    tiny.ss.setPlanner(small)
-    t0 = time.perf_counter()
-    status = tiny.ss.solve(ob.timedPlannerTerminationCondition(0.01))
-    assert time.perf_counter() - t0 < 1.0
-    if status.getStatus() == ob.PlannerStatus.EXACT_SOLUTION:
-        _check_solution(tiny, single_circle)
-
-
-@pytest.mark.parametrize("name", REGISTRY.names())
-def test_always_terminating_condition(name, single_circle):
-    ctx, _ = _make(single_circle, name, 0.0)
-    status = ctx.ss.solve(ob.plannerAlwaysTerminatingCondition())
-    assert status.getStatus() != ob.PlannerStatus.CRASH
 
 
 def test_rrtstarpso_reaches_known_optimum(single_circle):
@@ -109,8 +64,6 @@ def test_rrtstarpso_works_in_a_foreign_simple_setup():
     validity function, OMPL's default motion validator) still gets a valid, shorter path."""
     from ompl import geometric as og
 
-    from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSO
-
     space = ob.RealVectorStateSpace(2)
     space.setBounds(0.0, 1.0)
     ss = og.SimpleSetup(space)
@@ -133,15 +86,59 @@ def test_params_by_name_and_validation(single_circle):
     ctx = make_context(single_circle)
     entry = REGISTRY.get("RRTstarPSO")
     planner = entry.make(ctx.si, {"swarm_size": "12", "goal_bias": 0.2, "prune": "false"})
-    assert planner.get_param("swarm_size") == 12
-    assert planner.get_param("goal_bias") == 0.2
-    assert planner.get_param("prune") is False
+    params = planner.get_params()
+    assert params["swarm_size"] == 12 and params["goal_bias"] == 0.2 and params["prune"] is False
+    assert set(params) == set(RRTstarPSO.PARAMS.names())  # every parameter, defaults included
     with pytest.raises(ValueError, match="goal_bias"):
         entry.make(ctx.si, {"goal_bias": 1.5})
     with pytest.raises(ParameterError, match="known"):
         entry.make(ctx.si, {"no_such_param": 1})
     stock = REGISTRY.get("RRTstar").make(ctx.si, {"range": 42.0, "rewire_factor": 1.5})
     assert stock.getRange() == 42.0 and stock.getRewireFactor() == 1.5
+
+
+def test_set_params_takes_keywords_validates_them_together_and_returns_the_planner(single_circle):
+    """scikit-learn's form: ``set_params(**params)`` returns the planner; rules apply to the new
+    values jointly; a refused call changes nothing."""
+    ctx = make_context(single_circle)
+    planner = RRTstarPSO(ctx.si)
+    assert planner.set_params(c1=3.0, c2=0.5) is planner  # c1 + c2 < 4 only together
+    assert (planner.get_params()["c1"], planner.get_params()["c2"]) == (3.0, 0.5)
+    before = planner.get_params()
+    with pytest.raises(ParameterError, match="c1 \\+ c2 < 4"):
+        planner.set_params(c2=1.5, swarm_size=20)
+    with pytest.raises(ParameterError, match="swarm_siz"):
+        planner.set_params(swarm_siz=20)
+    assert planner.get_params() == before
+
+
+def test_the_automatic_range_is_reported_not_written_back(single_circle):
+    """``range`` 0 lets RRTstarPSO choose; the choice goes to the stats (``range_used``), the
+    user's parameter stays 0 (before, setup() overwrote it)."""
+    ctx, planner = _make(single_circle, "RRTstarPSO", 0.1)
+    assert planner.get_params()["range"] == 0.0  # after setup()
+    ctx.ss.solve(0.1)
+    assert planner.get_params()["range"] == 0.0
+    assert planner.last_stats.range_used == pytest.approx(0.2 * math.hypot(500, 500))
+    result = solve(single_circle, "RRTstarPSO", time_limit=0.1, seed=1)
+    assert result.params["range"] == 0.0 and result.stages["range_used"] > 0
+    chosen = solve(single_circle, "RRTstarPSO", time_limit=0.1, seed=1, params={"range": 50})
+    assert chosen.params["range"] == 50.0 and chosen.stages["range_used"] == 50.0
+
+
+def test_the_path_optimizer_has_get_params_and_set_params(single_circle):
+    ctx = make_context(single_circle)
+    optimizer = PSOPathOptimizer(ctx.si, swarm_size=12)
+    assert optimizer.get_params()["swarm_size"] == 12
+    assert optimizer.set_params(iterations="7") is optimizer
+    assert optimizer.options.iterations == 7
+    with pytest.raises(ParameterError, match="c1 \\+ c2 < 4"):
+        optimizer.set_params(c1=3.0)
+    with pytest.raises(ParameterError, match="swarm_sizes"):
+        optimizer.set_params(swarm_sizes=3)
+    assert optimizer.get_params()["c1"] == PSOPathOptimizer(ctx.si).get_params()["c1"]
+    with pytest.raises(TypeError):
+        PSOPathOptimizer(ctx.si, None)  # the options are keyword-only
 
 
 def test_crash_is_reported_not_raised(single_circle, monkeypatch):
@@ -154,30 +151,3 @@ def test_crash_is_reported_not_raised(single_circle, monkeypatch):
     ctx, _ = _make(single_circle, "RRTstarPSO", 0.1)
     status = ctx.ss.solve(ob.timedPlannerTerminationCondition(0.1))
     assert status.getStatus() == ob.PlannerStatus.CRASH
-
-
-def test_unsolvable_problem_reports_no_solution():
-    from rrtpso_ompl.model.problem import problem_from_dict
-
-    # The goal sits in a closed box: start and goal are free but no path exists.
-    walls = [
-        {"type": "rectangle", "min": [300, 300], "max": [460, 310]},
-        {"type": "rectangle", "min": [300, 450], "max": [460, 460]},
-        {"type": "rectangle", "min": [300, 300], "max": [310, 460]},
-        {"type": "rectangle", "min": [450, 300], "max": [460, 460]},
-    ]
-    problem = problem_from_dict(
-        {
-            "bounds": [[0, 0], [500, 500]],
-            "start": [50, 50],
-            "goal": [380, 380],
-            "robot": {"radius": 10},
-            "obstacles": walls,
-        }
-    )
-    for name in ("RRTstarPSO", "PSO", "RRTstar"):
-        result = solve(problem, name, time_limit=0.2, seed=1)
-        assert not result.solved
-        assert result.status in ("none", "approximate")
-        if result.status == "approximate":
-            assert result.valid  # an approximate path is still collision-free
