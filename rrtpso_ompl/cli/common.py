@@ -13,16 +13,19 @@ import errno
 import os
 import stat
 import sys
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import ParameterError, UnknownPlannerError, UsageError, did_you_mean
 from ..model import Problem, load_problem
 from ..model.yamlfile import file_kind
 from ..outputs import STDOUT, is_stream, name_max, os_reason, stdout_closed
 from ..validation import check_seconds, check_seed
+
+if TYPE_CHECKING:
+    from ..harness.record import RunRecord
 
 __all__ = [
     "EXIT_BAD_INPUT",
@@ -403,8 +406,8 @@ class RunProgress:
         if skipped:
             note(f"rrtpso: resuming: {skipped} {self.noun} already done")
 
-    def row(self, row: Mapping[str, Any]) -> None:
-        kind = "error" if row.get("error") else ("solved" if row["solved"] else "unsolved")
+    def row(self, row: RunRecord) -> None:
+        kind = "error" if row.is_error else ("solved" if row.solved else "unsolved")
         self.counts[kind] += 1
         self._bar.set_postfix(self.counts, refresh=False)
         self._bar.update(1)

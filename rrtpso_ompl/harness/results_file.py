@@ -26,7 +26,7 @@ import contextlib
 import json
 import os
 import sys
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -40,6 +40,7 @@ from ..outputs import (
     remove_folders,
     stdout_closed,
 )
+from .record import ROW_KEYS, RunKey, RunRecord, resolved_source
 
 try:  # advisory locks; absent on Windows, where a second writer is not detected
     import fcntl
@@ -55,12 +56,9 @@ __all__ = [
     "latest_rows",
     "read_rows",
     "resolved_source",
-    "row_key",
 ]
 
-#: Keys every row of a batch has (error rows included): what makes a line recognisably ours.
-ROW_KEYS = ("file", "planner", "seed", "run", "status")
-#: How every row's line begins (:meth:`ResultsFile.append` puts ``file`` first): an unterminated
+#: How every row's line begins (:meth:`RunRecord.to_json` puts ``file`` first): an unterminated
 #: last line is a row cut short only when it begins so, or is a beginning of this.
 ROW_START = b'{"file": '
 #: Attempts at opening and locking the file while other batches create and remove it.
@@ -81,40 +79,20 @@ def is_torn_row(tail: bytes) -> bool:
     return is_row(obj)  # a whole row whose newline was not written
 
 
-def resolved_source(file: str) -> str:
-    """A problem file's path resolved: absolute, links followed (the ``source`` of its rows)."""
-    try:
-        return os.path.realpath(file)
-    except (OSError, ValueError):
-        return file
-
-
-def row_key(row: Mapping[str, Any]) -> tuple[Any, ...]:
-    """What identifies a run: ``(source, planner, seed, budget)``.
-
-    ``source`` is the problem file resolved (:func:`resolved_source`), so that ``probs/p.yaml``
-    and ``/abs/probs/p.yaml`` name the same run; a row written before rows had ``source`` is
-    resolved from its ``file`` (relative to the working directory).
-    """
-    source = row.get("source")
-    if source is None and isinstance(row.get("file"), str):
-        source = resolved_source(row["file"])
-    return (source, row.get("planner"), row.get("seed"), row.get("budget"))
-
-
-def latest_rows(rows: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
-    """One row per run, the last written (a retried error row is superseded by its retry), in
-    the order the runs first appear."""
-    latest: dict[tuple[Any, ...], dict[str, Any]] = {}
+def latest_rows(rows: Iterable[RunRecord]) -> list[RunRecord]:
+    """One row per run (:attr:`RunRecord.key`), the last written (a retried error row is
+    superseded by its retry), in the order the runs first appear."""
+    latest: dict[RunKey, RunRecord] = {}
     for row in rows:
-        latest.pop(row_key(row), None)  # re-insert: the retry takes the place of its run
-        latest[row_key(row)] = dict(row)
+        latest.pop(row.key, None)  # re-insert: the retry takes the place of its run
+        latest[row.key] = row
     return list(latest.values())
 
 
-def read_rows(path: str | Path) -> list[dict[str, Any]]:
+def read_rows(path: str | Path) -> list[RunRecord]:
     """The complete rows of a results file, one per run (:func:`latest_rows`); a torn last line
-    and lines that are not rows are skipped."""
+    and lines that are not rows are skipped. Rows of earlier versions are read too
+    (:meth:`RunRecord.from_json`)."""
     p = Path(path)
     if not p.exists():
         return []
@@ -126,7 +104,7 @@ def read_rows(path: str | Path) -> list[dict[str, Any]]:
             except (json.JSONDecodeError, UnicodeDecodeError):
                 continue
             if is_row(obj):
-                rows.append(obj)
+                rows.append(RunRecord.from_json(obj))
     return latest_rows(rows)
 
 
@@ -161,7 +139,7 @@ class ResultsFile:
         self.resume = resume
         self.overwrite = overwrite
         self.flag = flag
-        self.kept: list[dict[str, Any]] = []
+        self.kept: list[RunRecord] = []
         self._fh: BinaryIO | None = None
         self._fd: int | None = None
         self._target: Path | None = None
@@ -246,7 +224,7 @@ class ResultsFile:
             return False
         return (ours.st_dev, ours.st_ino) == (now.st_dev, now.st_ino)
 
-    def _take_over(self) -> list[dict[str, Any]]:
+    def _take_over(self) -> list[RunRecord]:
         """Check what the file holds and prepare it for appending; the rows to keep."""
         content = self._read()
         if not content:
@@ -286,7 +264,7 @@ class ResultsFile:
             offset += len(chunk)
         return b"".join(chunks)
 
-    def _rows(self, lines: list[bytes]) -> list[dict[str, Any]]:
+    def _rows(self, lines: list[bytes]) -> list[RunRecord]:
         rows = []
         for number, line in enumerate(lines, start=1):
             if not line.strip():
@@ -297,12 +275,13 @@ class ResultsFile:
                 obj = None
             if not is_row(obj):
                 self._refuse(f"line {number} is not one of its rows")
-            rows.append(obj)
+            rows.append(RunRecord.from_json(obj))
         return rows
 
     # -- writing -------------------------------------------------------------------------------
-    def append(self, row: Mapping[str, Any]) -> None:
-        """Write one row as one whole line, ``file`` first (:data:`ROW_START`).
+    def append(self, row: RunRecord) -> None:
+        """Write one row as one whole line (:meth:`RunRecord.to_json`: ``file`` first,
+        :data:`ROW_START`).
 
         Raises
         ------
@@ -310,9 +289,7 @@ class ResultsFile:
             When the line cannot be written (the disk is full, the reader of a stream went away);
             a file is cut back to the rows before it, so it stays valid line by line.
         """
-        if "file" in row and next(iter(row)) != "file":
-            row = {"file": row["file"], **row}
-        data = json_line(row).encode("utf-8")
+        data = json_line(row.to_json()).encode("utf-8")
         if self._fh is not None:
             try:
                 self._fh.write(data)

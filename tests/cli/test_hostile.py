@@ -554,7 +554,7 @@ def test_resume_runs_again_what_an_edited_problem_file_would_change(folder):
     assert len(rows) == 4 and rows[2]["inputs_sha256"] != first[0]["inputs_sha256"]
     from rrtpso_ompl.harness import read_rows
 
-    assert [r["inputs_sha256"] for r in read_rows(folder / "r.jsonl")] == [
+    assert [r.inputs_sha256 for r in read_rows(folder / "r.jsonl")] == [
         rows[2]["inputs_sha256"]
     ] * 2
 
