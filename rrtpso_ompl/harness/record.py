@@ -222,14 +222,19 @@ class RunRecord:
         Raises
         ------
         ValueError
-            When ``row`` lacks a key of :data:`ROW_KEYS`.
+            When ``row`` lacks a key of :data:`ROW_KEYS` or its ``benchmark`` is malformed.
         """
         missing = [k for k in ROW_KEYS if k not in row]
         if missing:
             raise ValueError(f"not a row of a results file: no {', '.join(missing)}")
         known = {k: v for k, v in row.items() if k in _FIELDS and k not in _NOT_KEYS}
-        if known.get("benchmark") is not None:
-            known["benchmark"] = BenchmarkRun.from_dict(known["benchmark"])
+        if known.get("benchmark"):
+            try:
+                known["benchmark"] = BenchmarkRun.from_dict(known["benchmark"])
+            except (KeyError, TypeError, ValueError, AttributeError):
+                raise ValueError("not a row of a results file: a malformed benchmark") from None
+        else:
+            known["benchmark"] = None
         for k in ("params", "stages"):
             if known.get(k) is None:
                 known.pop(k, None)

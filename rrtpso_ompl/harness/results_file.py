@@ -28,7 +28,7 @@ import os
 import sys
 from collections.abc import Iterable
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import Any, BinaryIO, NoReturn
 
 from ..errors import OutputError, UsageError
 from ..outputs import (
@@ -103,9 +103,20 @@ def read_rows(path: str | Path) -> list[RunRecord]:
                 obj = json.loads(line)
             except (json.JSONDecodeError, UnicodeDecodeError):
                 continue
-            if is_row(obj):
-                rows.append(RunRecord.from_json(obj))
+            record = _record(obj)
+            if record is not None:
+                rows.append(record)
     return latest_rows(rows)
+
+
+def _record(obj: Any) -> RunRecord | None:
+    """The record of a parsed line, or None when it is not a row of this package."""
+    if not is_row(obj):
+        return None
+    try:
+        return RunRecord.from_json(obj)
+    except ValueError:
+        return None
 
 
 class ResultsFile:
@@ -250,7 +261,7 @@ class ResultsFile:
             os.ftruncate(self._fd, len(content) - len(torn))
         return latest_rows(rows)
 
-    def _refuse(self, why: str) -> None:
+    def _refuse(self, why: str) -> NoReturn:
         raise UsageError(
             f"{self.flag} {self.path}: not a results file of rrtpso batch or bench ({why}); it is "
             "left as it is: choose another file"
@@ -273,9 +284,10 @@ class ResultsFile:
                 obj = json.loads(line)
             except (json.JSONDecodeError, UnicodeDecodeError):
                 obj = None
-            if not is_row(obj):
+            record = _record(obj)
+            if record is None:
                 self._refuse(f"line {number} is not one of its rows")
-            rows.append(RunRecord.from_json(obj))
+            rows.append(record)
         return rows
 
     # -- writing -------------------------------------------------------------------------------

@@ -144,3 +144,21 @@ def test_the_results_file_writes_records(tmp_path):
     line = out.read_bytes()
     assert line.startswith(b'{"file": ') and line.endswith(b"\n")
     assert read_rows(out) == [record]
+
+
+def test_a_row_with_a_malformed_benchmark_is_not_a_row(tmp_path):
+    """Read back, it is skipped; resumed, the file is refused and left as it is."""
+    from rrtpso_ompl.errors import UsageError
+
+    assert RunRecord.from_json({**OLD_ROW, "benchmark": {}}).benchmark is None  # none given
+    with pytest.raises(ValueError, match="malformed benchmark"):
+        RunRecord.from_json({**OLD_ROW, "benchmark": {"progress": 3}})
+    out = tmp_path / "r.jsonl"
+    text = json.dumps(OLD_ROW) + "\n" + json.dumps({**OLD_ROW, "benchmark": [1]}) + "\n"
+    out.write_text(text)
+    assert read_rows(out) == [RunRecord.from_json(OLD_ROW)]
+    with pytest.raises(UsageError, match="line 2 is not one of its rows"), ResultsFile(
+        out, resume=True
+    ):
+        pass
+    assert out.read_text() == text
