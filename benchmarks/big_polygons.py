@@ -103,6 +103,8 @@ def measure(n: int, folder: Path, optimum: bool) -> list[dict]:
 
 
 def markdown(rows: list[dict]) -> str:
+    from rrtpso_ompl.harness.report import markdown_table
+
     lines = [
         "# A polygon of many vertices",
         "",
@@ -113,16 +115,16 @@ def markdown(rows: list[dict]) -> str:
         "of the limit), *wall* the whole command, with loading the file; *memory* the command's "
         "peak resident size (about 100 MB of it is Python, numpy, scipy, shapely and OMPL).",
         "",
-        "| vertices | run | reported | wall | memory | result |",
-        "|---|---|---|---|---|---|",
     ]
+    table = []
     for r in rows:
         if r["what"] == "load + world":
-            lines.append(f"| {r['n']:,} | load + world (in-process) | | {r['detail']} | | |")
+            table.append([f"{r['n']:,}", "load + world (in-process)", "", r["detail"], "", ""])
             continue
         rep = f"{r['reported']:.3f} s" if r.get("reported") is not None else ""
-        lines.append(f"| {r['n']:,} | {r['what']} | {rep} | {r['wall']:.1f} s | "
-                     f"{r['memory']:.0f} MB | {r['status']} |")  # fmt: skip
+        table.append([f"{r['n']:,}", r["what"], rep, f"{r['wall']:.1f} s",
+                      f"{r['memory']:.0f} MB", r["status"]])  # fmt: skip
+    lines.append(markdown_table(["vertices", "run", "reported", "wall", "memory", "result"], table))
     return "\n".join([*lines, "", *_NOTES]) + "\n"
 
 

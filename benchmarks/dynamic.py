@@ -289,6 +289,25 @@ GROUP_TEXT = {
 }
 
 
+def strategy_table(summary: list[dict]) -> str:
+    """One family's table: a line per strategy (:func:`summarise`)."""
+    from rrtpso_ompl.harness.report import markdown_table
+
+    header = ["strategy", "runs", "success", "collision runs (of those with a free motion)",
+              "median arrival s", "median length", "over lower bound %", "over clairvoyant %",
+              "replans/run", "waits chosen", "fallbacks", "planning s median / p90 / max",
+              "min clearance"]  # fmt: skip
+    return markdown_table(header, [
+        [s["strategy"], s["runs"], s["success"],
+         f"{s['collision_runs']} ({s['collision_runs_feasible']} of {s['feasible']})",
+         _fmt(s["median_arrival"]), _fmt(s["median_length"], ".2f"), _fmt(s["median_over_lb"]),
+         _fmt(s["median_over_cw"]), f"{s['mean_replans']:.2f}", s["waits"], s["fallbacks"],
+         f"{_fmt(s['median_plan_time'], '.3f')} / {_fmt(s['p90_plan_time'], '.3f')} / "
+         f"{_fmt(s['max_plan_time'], '.3f')}", _fmt(s["min_clearance"], ".2f")]
+        for s in summary
+    ])  # fmt: skip
+
+
 def report(rows: list[dict], groups: dict[str, list[Case]], args, wall: float) -> str:
     lines = [
         "# Dynamic benchmark: replanning strategies and a DWA among moving obstacles",
@@ -310,13 +329,8 @@ def report(rows: list[dict], groups: dict[str, list[Case]], args, wall: float) -
         "obstacles turn at random). Planning time is measured wall-clock per replan.",
         "",
     ]
-    header = (
-        "| strategy | runs | success | collision runs (of those with a free motion) "
-        "| median arrival s | median length | over lower bound % | over clairvoyant % "
-        "| replans/run | waits chosen | fallbacks | planning s median / p90 / max "
-        "| min clearance |"
-    )
-    rule = "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    from rrtpso_ompl.harness.report import markdown_table
+
     verdicts = []
     for group, cases in groups.items():
         if not cases:
@@ -325,36 +339,24 @@ def report(rows: list[dict], groups: dict[str, list[Case]], args, wall: float) -
         text = GROUP_TEXT.get(group, f"named scenario `problems/dynamic/{group}.yaml`")
         seeds = f"seeds {cases[0].seed}..{cases[-1].seed}"
         verdicts.append((group, len(cases), verdict(summary), summary))
-        lines += [f"## {group}: {len(cases)} cases ({seeds})", "", text + ".", "", header, rule]
-        for s_ in summary:
-            lines.append(
-                f"| {s_['strategy']} | {s_['runs']} | {s_['success']} | {s_['collision_runs']} "
-                f"({s_['collision_runs_feasible']} of {s_['feasible']}) | "
-                f"{_fmt(s_['median_arrival'])} | {_fmt(s_['median_length'], '.2f')} | "
-                f"{_fmt(s_['median_over_lb'])} | {_fmt(s_['median_over_cw'])} | "
-                f"{s_['mean_replans']:.2f} | {s_['waits']} | {s_['fallbacks']} | "
-                f"{_fmt(s_['median_plan_time'], '.3f')} / {_fmt(s_['p90_plan_time'], '.3f')} / "
-                f"{_fmt(s_['max_plan_time'], '.3f')} | {_fmt(s_['min_clearance'], '.2f')} |"
-            )
-        lines.append("")
+        lines += [f"## {group}: {len(cases)} cases ({seeds})", "", text + ".", "",
+                  strategy_table(summary), ""]  # fmt: skip
+    target = []
+    for group, n, ok, summary in verdicts:
+        by = {s["strategy"]: s for s in summary}
+        c, g = by.get("contour", {}), by.get("global", {})
+        arrival = f"{_fmt(c.get('median_arrival'))} / {_fmt(g.get('median_arrival'))}"
+        length = f"{_fmt(c.get('median_length'), '.2f')} / {_fmt(g.get('median_length'), '.2f')}"
+        target.append([group, n, arrival, length, ok])
     lines += [
         "## Target: contour no worse than global",
         "",
         "Median arrival and median driven length of `contour` against `global`, per family and per "
         "named scenario.",
         "",
-        "| cases | n | contour arrival / global arrival s | contour length / global length "
-        "| contour no worse |",
-        "|---|---|---|---|---|",
-    ]
-    for group, n, ok, summary in verdicts:
-        by = {s["strategy"]: s for s in summary}
-        c, g = by.get("contour", {}), by.get("global", {})
-        lines.append(
-            f"| {group} | {n} | {_fmt(c.get('median_arrival'))} / "
-            f"{_fmt(g.get('median_arrival'))} | {_fmt(c.get('median_length'), '.2f')} / "
-            f"{_fmt(g.get('median_length'), '.2f')} | {ok} |"
-        )
+        markdown_table(["cases", "n", "contour arrival / global arrival s",
+                        "contour length / global length", "contour no worse"], target),
+    ]  # fmt: skip
     bad = [r for r in rows if r.get("strategy") in ("contour", "global")
            and not r.get("success", False)]  # fmt: skip
     lines += ["", "Runs of the replanning strategies that did not succeed:", ""]

@@ -83,6 +83,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     from rrtpso_ompl.groundtruth import shortest_path
+    from rrtpso_ompl.harness.report import markdown_table
     from rrtpso_ompl.model import World, load_problem
     from rrtpso_ompl.ompl_setup import set_ompl_log_level
     from rrtpso_ompl.planners import solve
@@ -122,9 +123,8 @@ def main(argv: list[str] | None = None) -> int:
         "optimum; BIT* and Informed RRT* followed by OMPL's simplifier. The library rows are "
         f"the {args.set} part of problems/ (see docs/benchmarking.md).",
         "",
-        "| family | " + " | ".join(p for p, _ in planners) + " |",
-        "|---|" + "---|" * len(planners),
     ]
+    table = []
     for fam in families:
         cells = []
         for planner, _ in planners:
@@ -136,7 +136,8 @@ def main(argv: list[str] | None = None) -> int:
             p90 = vals[min(len(vals) - 1, round(0.9 * (len(vals) - 1)))]
             cell = f"{statistics.median(vals):.4f} ({p90:.4f})"
             cells.append(cell + (f", {miss} unsolved" if miss else ""))
-        lines.append(f"| {fam} | " + " | ".join(cells) + " |")
+        table.append([fam, *cells])
+    lines.append(markdown_table(["family", *(p for p, _ in planners)], table))
     text = "\n".join(lines) + "\n"
     if args.out == "-":
         print(text)

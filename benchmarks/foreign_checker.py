@@ -70,6 +70,49 @@ def _job(args):
     return run(*args)
 
 
+def deadline_table(rows: list[dict]) -> str:
+    """geo_env: per planner and budget, how long ``ss.solve(T)`` took."""
+    from rrtpso_ompl.harness.report import markdown_table
+
+    cells = []
+    for budget in (0.25, 0.5, 1.0):
+        for planner in ("RRTstar", "RRTstarPSO"):
+            rs = [r for r in rows if r["env"] == "geo_env" and r["budget"] == budget
+                  and r["planner"] == planner]  # fmt: skip
+            t = [r["elapsed"] for r in rs]
+            cells.append([planner, f"{budget:g}", f"{statistics.median(t):.3f}", f"{max(t):.3f}",
+                          f"{100 * (max(t) / budget - 1):+.1f}",
+                          f"{sum(r['solved'] for r in rs)}/{len(rs)}"])  # fmt: skip
+    return markdown_table(["planner", "budget s", "median solve s", "max solve s",
+                           "max overrun %", "solved"], cells)  # fmt: skip
+
+
+def depth_table(rows: list[dict]) -> str:
+    """square: per planner and budget, the returned length and how deep the path goes into the
+    obstacle (for RRTstarPSO also its RRT* path's depth)."""
+    from rrtpso_ompl.harness.report import markdown_table
+
+    cells = []
+    for budget in (0.25, 1.0):
+        for planner in ("RRTstar", "RRTstarPSO"):
+            rs = [r for r in rows if r["env"] == "square" and r["budget"] == budget
+                  and r["planner"] == planner and r["solved"]]  # fmt: skip
+            seed_d = [r["seed_depth"] for r in rs if "seed_depth" in r]
+            deeper = sum(r["depth"] > r["seed_depth"] + 1e-12 for r in rs if "seed_depth" in r)
+            swarm = (
+                [f"{max(seed_d):.5f}", f"{deeper}/{len(rs)}",
+                 f"{sum(r['pso_improved'] for r in rs)}/{len(rs)}"]
+                if seed_d else ["–", "–", "–"]
+            )  # fmt: skip
+            cells.append([planner, f"{budget:g}",
+                          f"{statistics.median(r['length'] for r in rs):.5f}",
+                          f"{statistics.median(r['depth'] for r in rs):.5f}",
+                          f"{max(r['depth'] for r in rs):.5f}", *swarm])  # fmt: skip
+    return markdown_table(["planner", "budget s", "median length", "median depth", "max depth",
+                           "max depth of its RRT* path", "runs deeper than their RRT* path",
+                           "swarm improved"], cells)  # fmt: skip
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--runs", type=int, default=10)
@@ -93,42 +136,15 @@ def main(argv: list[str] | None = None) -> int:
         "",
         "## The deadline with a slow checker (geo_env: 1 ms per state)",
         "",
-        "| planner | budget s | median solve s | max solve s | max overrun % | solved |",
-        "|---|---|---|---|---|---|",
-    ]
-    for budget in (0.25, 0.5, 1.0):
-        for planner in ("RRTstar", "RRTstarPSO"):
-            rs = [r for r in rows if r["env"] == "geo_env" and r["budget"] == budget
-                  and r["planner"] == planner]  # fmt: skip
-            t = [r["elapsed"] for r in rs]
-            lines.append(
-                f"| {planner} | {budget:g} | {statistics.median(t):.3f} | {max(t):.3f} | "
-                f"{100 * (max(t) / budget - 1):+.1f} | {sum(r['solved'] for r in rs)}/{len(rs)} |"
-            )
-    lines += [
+        deadline_table(rows),
         "",
         "## The gaps of the discrete check (test_optimal_planning's square)",
         "",
         "Depth: how far the returned path goes into the obstacle, measured densely; for "
         "RRTstarPSO also the depth of the RRT* path it was made from (its `seed_path`).",
         "",
-        "| planner | budget s | median length | median depth | max depth | max depth of its RRT* "
-        "path | runs deeper than their RRT* path | swarm improved |",
-        "|---|---|---|---|---|---|---|---|",
+        depth_table(rows),
     ]
-    for budget in (0.25, 1.0):
-        for planner in ("RRTstar", "RRTstarPSO"):
-            rs = [r for r in rows if r["env"] == "square" and r["budget"] == budget
-                  and r["planner"] == planner and r["solved"]]  # fmt: skip
-            seed_d = [r["seed_depth"] for r in rs if "seed_depth" in r]
-            deeper = sum(r["depth"] > r["seed_depth"] + 1e-12 for r in rs if "seed_depth" in r)
-            lines.append(
-                f"| {planner} | {budget:g} | {statistics.median(r['length'] for r in rs):.5f} | "
-                f"{statistics.median(r['depth'] for r in rs):.5f} | "
-                f"{max(r['depth'] for r in rs):.5f} | "
-                + (f"{max(seed_d):.5f} | {deeper}/{len(rs)} | "
-                   f"{sum(r['pso_improved'] for r in rs)}/{len(rs)} |" if seed_d else "– | – | – |")
-            )  # fmt: skip
     text = "\n".join(lines) + "\n"
     if args.out != "-":
         Path(args.out).write_text(text)

@@ -27,6 +27,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     from rrtpso_ompl.groundtruth.optimum import shortest_path
+    from rrtpso_ompl.harness.report import markdown_table
     from rrtpso_ompl.model.problem import load_problem
 
     files = [Path(p) for p in args.problems] or sorted(
@@ -39,9 +40,8 @@ def main(argv: list[str] | None = None) -> int:
         f"{platform.machine()}, Python {platform.python_version()}: the best of {args.repeat} "
         "runs of `rrtpso_ompl.groundtruth.optimum.shortest_path` per problem.",
         "",
-        "| problem | obstacles | graph nodes | graph edges | length | time (ms) |",
-        "|---|---:|---:|---:|---:|---:|",
     ]
+    rows = []
     for f in files:
         problem = load_problem(f)
         best, result = float("inf"), None
@@ -50,11 +50,10 @@ def main(argv: list[str] | None = None) -> int:
             result = shortest_path(problem)
             best = min(best, time.perf_counter() - t0)
         length = "none" if result.length is None else f"{result.length:.2f}"
-        lines.append(
-            f"| {problem.name} | {len(problem.obstacles)} | {result.n_nodes} | {result.n_edges} | "
-            f"{length} | "
-            f"{1000 * best:.1f} |"
-        )
+        rows.append([problem.name, len(problem.obstacles), result.n_nodes, result.n_edges, length,
+                     f"{1000 * best:.1f}"])  # fmt: skip
+    lines.append(markdown_table(["problem", "obstacles", "graph nodes", "graph edges", "length",
+                                 "time (ms)"], rows, align="-rrrrr"))  # fmt: skip
     Path(args.out).write_text("\n".join(lines) + "\n")
     print("\n".join(lines), file=sys.stderr)
     return 0

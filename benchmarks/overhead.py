@@ -88,6 +88,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     from rrtpso_ompl.harness.batch import make_tasks
+    from rrtpso_ompl.harness.report import markdown_table
 
     try:
         import distributed  # noqa: F401
@@ -102,10 +103,10 @@ def main(argv: list[str] | None = None) -> int:
         "budget. Overhead per run = (wall x jobs - planning time) / runs; useful = planning "
         "time / (wall x jobs). Wall time includes starting the workers.",
         "",
-        "| harness | budget s | runs | wall s | planning s | overhead per run ms | useful % "
-        "| errors |",
-        "|---|---|---|---|---|---|---|---|",
     ]
+    header = ["harness", "budget s", "runs", "wall s", "planning s", "overhead per run ms",
+              "useful %", "errors"]  # fmt: skip
+    table = []
     problems = [str(REPO / p) for p in PROBLEMS]
     for budget in (float(t) for t in args.times.split(",")):
         for name, harness in HARNESSES.items():
@@ -115,13 +116,14 @@ def main(argv: list[str] | None = None) -> int:
                 t0 = time.perf_counter()
                 rows = harness(tasks, args.jobs, tmp)
                 wall = time.perf_counter() - t0
-            planning = sum(r.get("time") or 0.0 for r in rows)
-            errors = sum(bool(r.get("error")) for r in rows)
+            planning = sum(r.time or 0.0 for r in rows)
+            errors = sum(r.is_error for r in rows)
             over = (wall * args.jobs - planning) / len(rows)
             useful = planning / (wall * args.jobs)
-            lines.append(f"| {name} | {budget:g} | {len(rows)} | {wall:.2f} | {planning:.2f} | "
-                         f"{1000 * over:.0f} | {100 * useful:.0f} | {errors} |")  # fmt: skip
-            print(lines[-1], file=sys.stderr)
+            table.append([name, f"{budget:g}", len(rows), f"{wall:.2f}", f"{planning:.2f}",
+                          f"{1000 * over:.0f}", f"{100 * useful:.0f}", errors])  # fmt: skip
+            print(markdown_table(header, table[-1:]).splitlines()[-1], file=sys.stderr)
+    lines.append(markdown_table(header, table))
     text = "\n".join(lines) + "\n"
     if args.out != "-":
         Path(args.out).write_text(text)

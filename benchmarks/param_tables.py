@@ -1,11 +1,15 @@
-"""Parameter tables of docs/planners.md, generated from the registry so the docs cannot drift.
+"""Parameter tables of docs/planners.md and problems/README.md, generated from the declarations
+so the docs cannot drift: the planners' from the registry, the generator's from its kinds.
 
 Usage::
 
     python benchmarks/param_tables.py RRTstarPSO PSO          # print the tables
     python benchmarks/param_tables.py --update docs/planners.md
+    python benchmarks/param_tables.py --update problems/README.md
 
-``--update`` rewrites every block between ``<!-- params:NAME -->`` and ``<!-- /params:NAME -->``.
+``--update`` rewrites every block between ``<!-- params:NAME -->`` and ``<!-- /params:NAME -->``
+(planner NAME) and between ``<!-- generate:KIND -->`` and ``<!-- /generate:KIND -->`` (the
+options of ``rrtpso generate KIND``).
 """
 
 from __future__ import annotations
@@ -23,11 +27,20 @@ def table(name: str) -> str:
     return default_registry().get(name).params.markdown()
 
 
+def generator_table(kind: str) -> str:
+    """The markdown table of the options of ``rrtpso generate KIND`` (from its declarations)."""
+    from rrtpso_ompl.groundtruth.generate import GENERATORS
+
+    return GENERATORS[kind].PARAMS.markdown()
+
+
 def update(path: Path) -> None:
     """Regenerate every marked table in ``path``."""
-    pattern = re.compile(r"(<!-- params:(\S+) -->\n).*?(\n<!-- /params:\2 -->)", re.S)
     text = path.read_text()
-    path.write_text(pattern.sub(lambda m: m.group(1) + table(m.group(2)) + m.group(3), text))
+    for marker, make in (("params", table), ("generate", generator_table)):
+        pattern = re.compile(rf"(<!-- {marker}:(\S+) -->\n).*?(\n<!-- /{marker}:\2 -->)", re.S)
+        text = pattern.sub(lambda m, make=make: m.group(1) + make(m.group(2)) + m.group(3), text)
+    path.write_text(text)
 
 
 def main(argv: list[str] | None = None) -> int:

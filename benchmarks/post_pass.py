@@ -22,7 +22,6 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import json
 import platform
 import statistics
 import subprocess
@@ -65,25 +64,23 @@ def _fmt(x, spec="+.2f", suffix=" %"):
     return "–" if x is None else format(x, spec) + suffix
 
 
-def summarise(rows: list[dict], optimum: dict[str, float], planners, times) -> list[str]:
-    """Per planner and budget: excess over the optimum raw / simplified / after the swarm, the
-    swarm's paired gain and time."""
-    lines = [
-        "| planner | budget s | runs solved | raw | +simplify | +simplify+pso | pso gain "
-        "(paired) | pso improved | pso time s |",
-        "|---|---|---|---|---|---|---|---|---|",
-    ]
+def summarise(rows: list, optimum: dict[str, float], planners, times) -> list[str]:
+    """Per planner and budget (rows: :class:`~rrtpso_ompl.harness.record.RunRecord`): excess
+    over the optimum raw / simplified / after the swarm, the swarm's paired gain and time."""
+    from rrtpso_ompl.harness.report import markdown_table
+
+    table = []
     for planner in planners:
         for budget in times:
-            both = [r for r in rows if r["planner"] == f"{planner}+simplify+pso"
-                    and r["budget"] == budget and not r.get("error")]  # fmt: skip
-            simp = [r for r in rows if r["planner"] == f"{planner}+simplify"
-                    and r["budget"] == budget and not r.get("error")]  # fmt: skip
+            both = [r for r in rows if r.planner == f"{planner}+simplify+pso"
+                    and r.budget == budget and not r.is_error]  # fmt: skip
+            simp = [r for r in rows if r.planner == f"{planner}+simplify"
+                    and r.budget == budget and not r.is_error]  # fmt: skip
             raw, after_s, after_p, gain, took, improved = [], [], [], [], [], 0
             for r in both:
-                post = (r.get("stages") or {}).get("post") or []
-                best = optimum.get(r["file"])
-                if not (r.get("solved") and len(post) == 2 and best):
+                post = r.stages.get("post") or []
+                best = optimum.get(r.file)
+                if not (r.solved and len(post) == 2 and best):
                     continue
                 raw.append(100 * (post[0]["length_before"] / best - 1))
                 after_p.append(100 * (post[1]["length_after"] / best - 1))
@@ -91,17 +88,16 @@ def summarise(rows: list[dict], optimum: dict[str, float], planners, times) -> l
                 took.append(post[1]["time"])
                 improved += post[1]["length_after"] < post[1]["length_before"] - 1e-9
             for r in simp:
-                best = optimum.get(r["file"])
-                if r.get("solved") and best:
-                    after_s.append(100 * (r["length"] / best - 1))
-            n = len(both)
-            lines.append(
-                f"| {planner} | {budget:g} | {len(raw)}/{n} | {_fmt(_median(raw))} | "
-                f"{_fmt(_median(after_s))} | {_fmt(_median(after_p))} | "
-                f"{_fmt(_median(gain), '.3f')} | {improved}/{len(raw)} | "
-                f"{_fmt(_median(took), '.3f', '')} |"
-            )
-    return lines
+                best = optimum.get(r.file)
+                if r.solved and best:
+                    after_s.append(100 * (r.length / best - 1))
+            table.append([planner, f"{budget:g}", f"{len(raw)}/{len(both)}", _fmt(_median(raw)),
+                          _fmt(_median(after_s)), _fmt(_median(after_p)),
+                          _fmt(_median(gain), ".3f"), f"{improved}/{len(raw)}",
+                          _fmt(_median(took), ".3f", "")])  # fmt: skip
+    return markdown_table(["planner", "budget s", "runs solved", "raw", "+simplify",
+                           "+simplify+pso", "pso gain (paired)", "pso improved", "pso time s"],
+                          table).splitlines()  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -115,6 +111,7 @@ def main(argv: list[str] | None = None) -> int:
     times = [float(t) for t in args.times.split(",")]
 
     from rrtpso_ompl.groundtruth import shortest_path
+    from rrtpso_ompl.harness import read_rows
     from rrtpso_ompl.model import load_problem
 
     t_start = time.perf_counter()
@@ -127,7 +124,7 @@ def main(argv: list[str] | None = None) -> int:
                "--planner", ",".join(specs), "--runs", "1", "--time", args.times,
                "--jobs", str(args.jobs), "--out", str(out_dir), "-q"]  # fmt: skip
         subprocess.run(cmd, check=True)
-        rows = [json.loads(line) for line in (out_dir / "runs.jsonl").open()]
+        rows = read_rows(out_dir / "runs.jsonl")
     wall = time.perf_counter() - t_start
     sets = {str(p): s for s, p in items}
     lines = [
@@ -147,7 +144,7 @@ def main(argv: list[str] | None = None) -> int:
         "",
     ]
     for which in ("library", "generated"):
-        subset = [r for r in rows if sets.get(r["file"]) == which]
+        subset = [r for r in rows if sets.get(r.file) == which]
         lines += [f"## {which}", ""]
         lines += summarise(subset, optimum, planners, times)
         lines.append("")

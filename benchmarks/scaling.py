@@ -177,6 +177,8 @@ def _ratio(length, best) -> str:
 
 
 def write_report(rows: list[dict], out: Path, plot: Path, quick: bool) -> None:
+    from rrtpso_ompl.harness.report import markdown_table
+
     lines = [
         "# Scaling: from a dozen shapes to maps of millions of cells",
         "",
@@ -193,48 +195,56 @@ def write_report(rows: list[dict], out: Path, plot: Path, quick: bool) -> None:
         "`segments_free` call (the swarm's). Lengths are over the exact optimum after 2 s, each "
         "planner in its own `rrtpso solve` process.",
         "",
-        "| world | obstacles | motion check | point check | vectorised | RRT* it/s | "
-        "RRTstarPSO | BIT* | optimum | optimum time | optimum memory |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
-    ]
-    for r in rows:
-        opt = r["optimum"]
-        best = opt.get("length")
-        bit = r["BITstar"]
-        bit_text = _ratio(bit["length"], best)
-        if bit.get("killed"):
-            bit_text = f"killed at {PLANNER_CAP:.0f} s"
-        elif bit["wall"] > 10:
-            bit_text += f" (stopped after {bit['wall']:.0f} s)"
-        rate = r["RRTstarPSO"].get("rrt_rate")
-        lines.append(
-            f"| {r['label']} | {r['obstacles']:,} | {r['motion_us']:.1f} us | "
-            f"{r['point_us']:.1f} us | {r['vector_us']:.1f} us | "
-            f"{f'{rate:,.0f}' if rate else '-'} | {_ratio(r['RRTstarPSO']['length'], best)} | "
-            f"{bit_text} | {best:.2f} | {opt['time']:.1f} s | {opt['rss_mb']:.0f} MB |"
-            if best is not None
-            else f"| {r['label']} | {r['obstacles']:,} | - | - | - | - | - | - | "
-            f"{opt.get('error', 'none')} | - | - |"
-        )
-    lines += ["", "![scaling](img/scaling.png)", "", *_targets(rows), *_BEFORE]
+        markdown_table(["world", "obstacles", "motion check", "point check", "vectorised",
+                        "RRT* it/s", "RRTstarPSO", "BIT*", "optimum", "optimum time",
+                        "optimum memory"], [_report_row(r) for r in rows]),
+    ]  # fmt: skip
+    lines += ["", "![scaling](img/scaling.png)", "", *_targets(rows), *_before()]
     out.write_text("\n".join(lines) + "\n")
     _plot(rows, plot)
 
 
-_BEFORE = [
-    "",
-    "## Before the index (issue 12's measurements, the same lattice worlds)",
-    "",
-    "| obstacles | motion check | point check | RRTstarPSO, 2 s | BIT*, 2 s | `rrtpso optimum` |",
-    "|---|---|---|---|---|---|",
-    "| 100 | 10.8 us | 31.5 us | solved | solved | 1.0 s |",
-    "| 1,000 | 73.9 us | 330 us | solved, +4.4 % over the optimum | +1.8 % | 204 s, 0.47 GB |",
-    "| 10,000 | 303 us | 2,363 us | not solved | not solved | killed at 24 GB |",
-    "",
-    "Memory above is the peak resident size of the whole `rrtpso optimum` process, about 100 MB "
-    "of which is Python, numpy, scipy and shapely.",
-    "",
-]
+def _report_row(r: dict) -> list[str]:
+    """One world's cells of the report's table."""
+    opt = r["optimum"]
+    best = opt.get("length")
+    if best is None:
+        return [r["label"], f"{r['obstacles']:,}", "-", "-", "-", "-", "-", "-",
+                opt.get("error", "none"), "-", "-"]  # fmt: skip
+    bit = r["BITstar"]
+    bit_text = _ratio(bit["length"], best)
+    if bit.get("killed"):
+        bit_text = f"killed at {PLANNER_CAP:.0f} s"
+    elif bit["wall"] > 10:
+        bit_text += f" (stopped after {bit['wall']:.0f} s)"
+    rate = r["RRTstarPSO"].get("rrt_rate")
+    return [r["label"], f"{r['obstacles']:,}", f"{r['motion_us']:.1f} us",
+            f"{r['point_us']:.1f} us", f"{r['vector_us']:.1f} us",
+            f"{rate:,.0f}" if rate else "-", _ratio(r["RRTstarPSO"]["length"], best), bit_text,
+            f"{best:.2f}", f"{opt['time']:.1f} s", f"{opt['rss_mb']:.0f} MB"]  # fmt: skip
+
+
+def _before() -> list[str]:
+    """Issue 12's measurements before the spatial index (the same lattice worlds)."""
+    from rrtpso_ompl.harness.report import markdown_table
+
+    return [
+        "",
+        "## Before the index (issue 12's measurements, the same lattice worlds)",
+        "",
+        markdown_table(
+            ["obstacles", "motion check", "point check", "RRTstarPSO, 2 s", "BIT*, 2 s",
+             "`rrtpso optimum`"],
+            [["100", "10.8 us", "31.5 us", "solved", "solved", "1.0 s"],
+             ["1,000", "73.9 us", "330 us", "solved, +4.4 % over the optimum", "+1.8 %",
+              "204 s, 0.47 GB"],
+             ["10,000", "303 us", "2,363 us", "not solved", "not solved", "killed at 24 GB"]],
+        ),
+        "",
+        "Memory above is the peak resident size of the whole `rrtpso optimum` process, about "
+        "100 MB of which is Python, numpy, scipy and shapely.",
+        "",
+    ]  # fmt: skip
 
 
 def _targets(rows: list[dict]) -> list[str]:

@@ -52,6 +52,8 @@ def main(argv: list[str] | None = None) -> int:
 
 def report(result, args: argparse.Namespace, command: str, total: float) -> str:
     """The markdown table: per planner, median length, excess over the optimum, success, time."""
+    from rrtpso_ompl.harness.report import markdown_table
+
     rows = {s.planner: s for s in result.summary}
     optimum = next((s.optimum for s in result.summary if s.optimum), None)
     lines = [
@@ -67,22 +69,22 @@ def report(result, args: argparse.Namespace, command: str, total: float) -> str:
         if optimum
         else "",
         "",
-        "| planner | median length | over the optimum | solved | median time | PSO share |",
-        "|---|---:|---:|---:|---:|---:|",
     ]
+    table = []
     for planner in PLANNERS:
         s = rows.get(planner)
         if s is None:
             continue
-        mine = [r for r in result.rows if r["planner"] == planner and r.get("benchmark")]
-        shares = [r["benchmark"]["simplification_time"] / args.time for r in mine
-                  if r["benchmark"].get("simplification_time") is not None]  # fmt: skip
+        shares = [r.benchmark.simplification_time / args.time for r in result.rows
+                  if r.planner == planner and r.benchmark
+                  and r.benchmark.simplification_time is not None]  # fmt: skip
         share = f"{100 * statistics.median(shares):.1f} %" if shares else "–"
         length = f"{s.median_length:.2f}" if s.median_length is not None else "–"
         excess = f"+{100 * (s.median_ratio - 1):.2f} %" if s.median_ratio else "–"
         median_time = f"{s.median_time:.2f} s" if s.median_time is not None else "–"
-        lines.append(f"| {planner} | {length} | {excess} | {s.solved}/{s.runs} | "
-                     f"{median_time} | {share} |")  # fmt: skip
+        table.append([planner, length, excess, f"{s.solved}/{s.runs}", median_time, share])
+    lines.append(markdown_table(["planner", "median length", "over the optimum", "solved",
+                                 "median time", "PSO share"], table, align="-rrrrr"))  # fmt: skip
     lines += ["", "The paper's Table 3 reports RRT 665.4, RRT* 649.6, PSO 660 and RRT*PSO "
               "615.3 cm on its own workspace, whose exact geometry is not published; the "
               "reconstruction is described in problems/README.md.", ""]  # fmt: skip

@@ -48,6 +48,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default=str(REPO / "docs" / "tracking.md"))
     args = ap.parse_args(argv)
 
+    from rrtpso_ompl.harness.report import markdown_table
+
     ctx = mp.get_context("spawn")
     with ProcessPoolExecutor(args.jobs, mp_context=ctx, max_tasks_per_child=1) as pool:
         rows = list(pool.map(run_seed, range(1, args.seeds + 1), [args.time] * args.seeds))
@@ -59,14 +61,15 @@ def main(argv: list[str] | None = None) -> int:
         "RRTstarPSO, wheel commands every `sample_time` (docs/kinematics.md). Errors are the "
         "largest distance from the reference, in cm.",
         "",
-        "| seed | path length | open-loop drift | tracking error | tracking / drift |",
-        "|---:|---:|---:|---:|---:|",
+        markdown_table(
+            ["seed", "path length", "open-loop drift", "tracking error", "tracking / drift"],
+            [
+                [seed, f"{length:.1f}", f"{d:.2f}", f"{t:.2f}", f"{t / d:.2f}"]
+                for seed, length, d, t in rows
+            ],
+            align="rrrrr",
+        ),
     ]
-    for seed, length, open_loop, tracking in rows:
-        lines.append(
-            f"| {seed} | {length:.1f} | {open_loop:.2f} | {tracking:.2f} | "
-            f"{tracking / open_loop:.2f} |"
-        )
     drift = [r[2] for r in rows]
     tracking = [r[3] for r in rows]
     lines += [

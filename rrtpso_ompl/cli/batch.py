@@ -83,12 +83,10 @@ def run(args: argparse.Namespace) -> int:
             progress=bar.row,
             on_start=bar.started,
         )
-    failed = [r for r in rows if not r.get("solved")]
-    for r in rows:
-        if r.get("error"):
-            print(f"rrtpso: {r['error']}", file=sys.stderr)  # errors, also with -q
-    note(
-        f"batch: {len(rows)} rows, {len(rows) - len(failed)} solved, "
-        f"{sum(bool(r.get('error')) for r in rows)} errors -> {args.out}",
-    )
+    failed = [r for r in rows if not r.solved]
+    errors = [r.error for r in rows if r.is_error]
+    for error in errors:
+        print(f"rrtpso: {error}", file=sys.stderr)  # errors, also with -q
+    note(f"batch: {len(rows)} rows, {len(rows) - len(failed)} solved, {len(errors)} errors -> "
+         f"{args.out}")  # fmt: skip
     return EXIT_UNSOLVED if failed else EXIT_OK

@@ -13,7 +13,7 @@ import errno
 import os
 import stat
 import sys
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -25,6 +25,7 @@ from ..outputs import STDOUT, is_stream, name_max, os_reason, stdout_closed
 from ..validation import check_seconds, check_seed
 
 if TYPE_CHECKING:
+    from ..harness.record import RunRecord
     from ..planners.request import PlannerRequest
 
 __all__ = [
@@ -350,8 +351,8 @@ class RunProgress:
         if skipped:
             note(f"rrtpso: resuming: {skipped} {self.noun} already done")
 
-    def row(self, row: Mapping[str, Any]) -> None:
-        kind = "error" if row.get("error") else ("solved" if row["solved"] else "unsolved")
+    def row(self, row: RunRecord) -> None:
+        kind = "error" if row.is_error else ("solved" if row.solved else "unsolved")
         self.counts[kind] += 1
         self._bar.set_postfix(self.counts, refresh=False)
         self._bar.update(1)

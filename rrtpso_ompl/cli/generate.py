@@ -1,4 +1,9 @@
-"""``rrtpso generate``: a seeded random problem file, certified solvable."""
+"""``rrtpso generate``: a seeded random problem file, certified solvable.
+
+The kinds and their option flags are derived from the generator's declarations
+(:data:`~rrtpso_ompl.groundtruth.generate.GENERATORS`): one flag per option, its help from the
+option's doc, its type and range from its declaration, a range option as two numbers.
+"""
 
 from __future__ import annotations
 
@@ -12,71 +17,85 @@ from .common import EXIT_OK, Output, check_outputs, check_seed_flag, note
 
 __all__ = ["add_parser", "run"]
 
-#: The options passed on to the generator, as named on the command line.
-_OPTIONS = (
-    "size",
-    "n",
-    "cells",
-    "robot_radius",
-    "radius_range",
-    "vertices",
-    "gap",
-    "wall",
-    "algorithm",
-    "name",
-)
-
 
 def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
+    from ..groundtruth.generate import GENERATORS
+
+    kinds = list(GENERATORS)
     g = sub.add_parser(
         "generate",
         parents=parents,
-        help="write a seeded random problem (circles, polygons or a maze)",
+        help=f"write a seeded random problem ({', '.join(kinds)})",
         description="Write a seeded random problem file whose start and goal are free and "
         "connected (certified by a collision-checked grid path). The same seed and options give "
-        "the same file, byte for byte.",
+        "the same file, byte for byte. Each option applies to the kinds named in its help.",
     )
-    g.add_argument("kind", choices=("circles", "polygons", "maze"))
+    g.add_argument("kind", choices=kinds)
     g.add_argument("--seed", type=int, required=True, help="seed (>= 0)")
     g.add_argument("--out", required=True, metavar="FILE.yaml", help="where to write the problem")
-    g.add_argument("--size", type=float, help="side of the square workspace (default 100)")
-    g.add_argument("--n", type=int, help="number of obstacles (circles 30, polygons 20)")
-    g.add_argument("--cells", type=int, help="maze cells per side (default 8)")
-    g.add_argument("--robot-radius", type=float, help="robot radius (0: a point robot)")
-    g.add_argument(
-        "--radius-range",
-        type=float,
-        nargs=2,
-        metavar=("LO", "HI"),
-        help="obstacle radii (circles) or circumradii (polygons)",
-    )
-    g.add_argument(
-        "--vertices",
-        type=int,
-        nargs=2,
-        metavar=("LO", "HI"),
-        help="polygon vertex counts (default 3 8)",
-    )
-    g.add_argument("--gap", type=float, help="least free distance between obstacles")
-    g.add_argument("--wall", type=float, help="maze wall thickness")
-    g.add_argument("--algorithm", choices=("dfs", "kruskal"), help="maze algorithm")
-    g.add_argument("--name", help="problem name (default: from kind and seed)")
+    for name, declarations in _options().items():
+        g.add_argument(f"--{name.replace('_', '-')}", dest=name, **_flag(declarations))
     g.add_argument("--overwrite", action="store_true",
                    help="replace --out when it exists (it is refused otherwise)")  # fmt: skip
     g.set_defaults(func=run)
+
+
+def _options() -> dict[str, list[tuple[str, Any]]]:
+    """Every option of every kind: name -> ``[(kind, ParamSpec), ...]``, in declaration order."""
+    from ..groundtruth.generate import GENERATORS
+
+    out: dict[str, list[tuple[str, Any]]] = {}
+    for kind, options in GENERATORS.items():
+        for spec in options.PARAMS:
+            out.setdefault(spec.name, []).append((kind, spec))
+    return out
+
+
+def _flag(declarations: list[tuple[str, Any]]) -> dict[str, Any]:
+    """``add_argument`` keywords of one option, from its declarations (one per kind)."""
+    from ..groundtruth.generate import GENERATORS
+
+    spec = declarations[0][1]
+    kw: dict[str, Any] = {"default": None}
+    if spec.type is bool:
+        kw["action"] = argparse.BooleanOptionalAction
+    else:
+        kw["type"] = spec.type
+    if spec.choices is not None:
+        kw["choices"] = spec.choices
+    if spec.length is not None:
+        kw["nargs"] = spec.length
+        kw["metavar"] = ("MIN", "MAX") if spec.length == 2 else spec.name.upper()
+    texts = {}
+    for kind, s in declarations:
+        default = "" if s.default is None else f" Default: {_value(s.default)}."
+        texts.setdefault(f"{s.doc}{default}", []).append(kind)
+    if len(texts) == 1:
+        (text, kinds), = texts.items()  # fmt: skip
+        help_ = text if len(kinds) == len(GENERATORS) else f"{', '.join(kinds)}: {text}"
+    else:
+        help_ = " ".join(f"{', '.join(kinds)}: {text}" for text, kinds in texts.items())
+    kw["help"] = help_.replace("%", "%%")
+    return kw
+
+
+def _value(value: Any) -> str:
+    return " ".join(map(str, value)) if isinstance(value, tuple) else str(value)
 
 
 def run(args: argparse.Namespace) -> int:
     from ..groundtruth import generate_to_file
 
     check_seed_flag(args.seed)
-    options = {k: getattr(args, k) for k in _OPTIONS if getattr(args, k) is not None}
+    options = {k: getattr(args, k) for k in _options() if getattr(args, k) is not None}
     check_outputs([Output("--out", args.out)])
     if os.path.lexists(args.out) and not args.overwrite and not is_stream(args.out):
         raise UsageError(f"--out: '{args.out}' exists; pass --overwrite to replace it")
     try:
         path = generate_to_file(args.kind, args.seed, args.out, **options)
     except (GenerationError, ValueError) as exc:
-        raise UsageError(f"generate {args.kind}: {exc}") from None
+        where = f"generate {args.kind}:"
+        text = str(exc)
+        raise UsageError(text if text.startswith(where) else f"{where} {text}") from None
     note(f"wrote {path}")
     return EXIT_OK

@@ -7,12 +7,12 @@ order, so it round-trips through :func:`~rrtpso_ompl.model.problem_from_dict` an
 dictionary as a problem file and :func:`generate_to_file` does both (the ``rrtpso generate``
 command is a thin wrapper around it).
 
-Three kinds:
+Three kinds (:data:`GENERATORS`, by name):
 
-* ``"circles"``: random non-overlapping circles;
-* ``"polygons"``: random non-overlapping convex polygons;
+* ``"circles"``: random non-overlapping circles (:class:`CirclesOptions`);
+* ``"polygons"``: random non-overlapping convex polygons (:class:`PolygonsOptions`);
 * ``"maze"``: a perfect maze (exactly one route between any two cells) on a grid of cells, its walls
-  as rectangles, start and goal in opposite corner cells.
+  as rectangles, start and goal in opposite corner cells (:class:`MazeOptions`).
 
 Every random choice comes from one ``numpy.random.default_rng(seed)`` stream, and nothing else
 (no clock, no hash order) enters the output, so the same kind, seed and options give a
@@ -21,32 +21,69 @@ byte-identical file.
 **Solvability is certified, not hoped for**: every problem comes with a collision-checked grid
 path (:mod:`rrtpso_ompl.groundtruth.certify`); when the certificate fails the obstacles are drawn
 again from the same generator stream.
+
+**Options are declared once.** A kind is an option set: a class of
+:func:`~rrtpso_ompl.planners.params.param` fields made a frozen, keyword-only dataclass by
+:func:`~rrtpso_ompl.planners.params.declared`, extending :class:`GeneratorOptions` (the options
+every kind takes). Everything else is derived from the declarations: the checks of the values
+(one :class:`~rrtpso_ompl.errors.GenerationError` naming the option), the flags of ``rrtpso
+generate`` (:mod:`rrtpso_ompl.cli.generate`), the command line written into a generated file's
+header and the option tables of ``problems/README.md`` (``python benchmarks/param_tables.py
+--update problems/README.md``). An option whose default depends on others (a radius that is a
+fraction of ``size``) defaults to None, its doc says what that stands for, and the kind
+resolves it (:meth:`GeneratorOptions.resolved`).
+
+**Adding a kind** is one class and one registration (nothing else lists the kinds)::
+
+    @register_kind
+    @declared
+    class RoomsOptions(GeneratorOptions):
+        \"\"\"Rooms joined by doors.\"\"\"
+
+        KIND: ClassVar[str] = "rooms"
+        rooms: int = param(4, "Rooms per side.", low=1, high=MAX_CELLS)
+
+        def resolved(self) -> RoomsOptions: ...  # None defaults filled in, feasibility checked
+        def start_goal(self) -> tuple[np.ndarray, np.ndarray]: ...
+        def draw(self, rng: np.random.Generator) -> list[dict[str, Any]]: ...  # the obstacles
+        def describe(self) -> str: ...  # the first sentences of the problem's description
+
+``generate("rooms", ...)``, ``rrtpso generate rooms --rooms 6``, the header and the docs follow.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
-from ..errors import GenerationError, ProblemError, RrtpsoError
+from ..errors import GenerationError, ParameterError, ProblemError, RrtpsoError
 from ..model.geometry import path_length
 from ..model.problem import problem_from_dict
 from ..model.problem_file import default_decimals, round_floats, write_problem
-from ..validation import check_integer, check_number
+from ..planners.params import ParamTable, Rule, declared, param
+from ..validation import check_integer
 from .certify import GRID_POINTS, grid_path, is_solvable
 
 __all__ = [
+    "GENERATORS",
     "KINDS",
+    "CirclesOptions",
     "GenerationError",
+    "GeneratorOptions",
+    "MazeOptions",
+    "PolygonsOptions",
     "default_decimals",
     "generate",
+    "generate_command",
     "generate_to_file",
     "grid_path",
     "is_solvable",
+    "register_kind",
     "write_problem",
 ]
 
@@ -56,53 +93,146 @@ __all__ = [
 MAX_OBSTACLES = 100_000
 MAX_CELLS = 200
 
-#: The kinds of problem :func:`generate` can make.
-KINDS = ("circles", "polygons", "maze")
-
-#: Options every kind accepts, then the kind-specific ones (in signature order: it is also the
-#: order in which :func:`generate_to_file` writes them into the header's command line).
-_COMMON_OPTIONS = ("size", "robot_radius", "resolution", "max_attempts", "decimals", "name")
-_KIND_OPTIONS = {
-    "circles": ("n", "radius_range", "gap"),
-    "polygons": ("n", "radius_range", "vertices", "gap"),
-    "maze": ("cells", "wall", "algorithm"),
-}
-_OPTION_ORDER = (
-    "size",
-    "n",
-    "cells",
-    "robot_radius",
-    "radius_range",
-    "vertices",
-    "gap",
-    "wall",
-    "algorithm",
-    "resolution",
-    "max_attempts",
-    "decimals",
-    "name",
-)
-_MAZE_ALGORITHMS = ("dfs", "kruskal")
+_G = TypeVar("_G", bound="GeneratorOptions")
 
 
-def generate(
-    kind: str,
-    seed: int,
-    *,
-    size: float = 100.0,
-    n: int | None = None,
-    cells: int | None = None,
-    robot_radius: float | None = None,
-    radius_range: Sequence[float] | None = None,
-    vertices: Sequence[int] | None = None,
-    gap: float | None = None,
-    wall: float | None = None,
-    algorithm: str | None = None,
-    resolution: float | None = None,
-    max_attempts: int = 50,
-    decimals: int | None = None,
-    name: str | None = None,
-) -> dict[str, Any]:
+# ----------------------------------------------------------------------------------------------
+# The options every kind takes, and the registry of kinds
+# ----------------------------------------------------------------------------------------------
+@declared(
+    rules=(
+        Rule(("size",), lambda size: size > 0, "size > 0"),
+        Rule(("resolution", "size"), lambda r, size: r is None or 0 < r <= size / 2,
+             "0 < resolution <= size / 2"),
+        Rule(("name",), lambda name: name is None or bool(name.strip()),
+             "name is not empty"),
+    )
+)  # fmt: skip
+class GeneratorOptions:
+    """Options every kind of generated problem takes (a kind extends them with its own)."""
+
+    #: The kind's name (``rrtpso generate KIND``); set by each kind.
+    KIND: ClassVar[str] = ""
+    #: The declarations of the kind's options (made by ``declared``).
+    PARAMS: ClassVar[ParamTable]
+
+    size: float = param(100.0, "Side of the square workspace [0, size]^2, > 0.", unit="length",
+                        low=0.0)  # fmt: skip
+    robot_radius: float | None = param(
+        None, "Robot radius (0: a point robot). Default: the kind's.", unit="length", low=0.0
+    )
+    resolution: float | None = param(
+        None,
+        "Grid spacing of the solvability certificate, at most size / 2. Default: size / 200 (for "
+        "the maze at most a quarter of the corridors' free width).",
+        unit="length",
+        low=0.0,
+    )
+    max_attempts: int = param(50, "How many times the obstacles are drawn before giving up.",
+                              low=1)  # fmt: skip
+    decimals: int | None = param(
+        None,
+        "Decimal places of every coordinate. Default: about 1e-5 of the workspace "
+        "(default_decimals(size)).",
+        low=0,
+        high=12,
+    )
+    name: str | None = param(
+        None, "The problem's name. Default: the kind and the seed, as circles_7."
+    )
+
+    # -- what each kind provides -----------------------------------------------------------------
+    def resolved(self: _G) -> _G:
+        """The options with every None default replaced by its value and the combination checked
+        (a robot that does not fit raises :class:`GenerationError`)."""
+        raise NotImplementedError
+
+    def start_goal(self) -> tuple[np.ndarray, np.ndarray]:
+        """Start and goal (of the resolved options)."""
+        raise NotImplementedError
+
+    def draw(self, rng: np.random.Generator) -> list[dict[str, Any]]:
+        """The obstacles in the file format, drawn from ``rng`` (of the resolved options)."""
+        raise NotImplementedError
+
+    def describe(self) -> str:
+        """What was generated, in words: the description's first sentences."""
+        raise NotImplementedError
+
+    # -- shared ----------------------------------------------------------------------------------
+    @classmethod
+    def from_options(cls: type[_G], options: Mapping[str, Any]) -> _G:
+        """The kind's options from keyword arguments (None: not given), checked.
+
+        Raises
+        ------
+        TypeError
+            For a name that no kind has.
+        GenerationError
+            For an option of another kind, or a value its declaration does not allow.
+        """
+        given = {k: v for k, v in options.items() if v is not None}
+        _check_names(cls, given)
+        try:
+            return cls(**cls.PARAMS.validate(given))
+        except ParameterError as exc:
+            raise GenerationError(str(exc)) from None
+
+    def _resolve(self: _G, resolution: float, **values: Any) -> _G:
+        """A copy with ``values``, the certificate's ``resolution`` unless one was given, and the
+        default decimals."""
+        decimals = default_decimals(self.size) if self.decimals is None else self.decimals
+        return dataclasses.replace(self, resolution=self.resolution or resolution,
+                                   decimals=decimals, **values)  # fmt: skip
+
+    def document(self, name: str, obstacles: list[dict[str, Any]]) -> dict[str, Any]:
+        """The problem dictionary around ``obstacles`` (its description filled in later)."""
+        start, goal = self.start_goal()
+        return {
+            "name": name,
+            "description": "",  # filled in once the problem is certified
+            "bounds": [[0.0, 0.0], [float(self.size), float(self.size)]],
+            "start": [float(v) for v in start],
+            "goal": [float(v) for v in goal],
+            "robot": {"radius": float(self.robot_radius)},
+            "obstacles": obstacles,
+        }
+
+
+#: The kinds by name, in registration order: what :func:`generate`, ``rrtpso generate`` (its
+#: choices and flags) and the docs read.
+GENERATORS: dict[str, type[GeneratorOptions]] = {}
+
+
+def register_kind(cls: type[_G]) -> type[_G]:
+    """Class decorator: make a declared option set a kind of :func:`generate` under its
+    ``KIND``."""
+    if not cls.KIND or cls.KIND in GENERATORS:
+        raise ValueError(f"{cls.__name__}: KIND must be a new kind's name, got {cls.KIND!r}")
+    GENERATORS[cls.KIND] = cls
+    return cls
+
+
+def _check_names(cls: type[GeneratorOptions], given: Mapping[str, Any]) -> None:
+    """Every option given is the kind's: a name of another kind, or of none, is refused."""
+    mine = cls.PARAMS.names()
+    for key in given:
+        if key in mine:
+            continue
+        applies = [k for k, c in GENERATORS.items() if key in c.PARAMS]
+        if not applies:
+            known = dict.fromkeys(n for c in GENERATORS.values() for n in c.PARAMS.names())
+            raise TypeError(f"generate() got unknown option(s) {key}; known: {', '.join(known)}")
+        raise GenerationError(
+            f"option '{key}' does not apply to kind '{cls.KIND}' (it applies to: "
+            f"{', '.join(applies)}); options for {cls.KIND}: {', '.join(mine)}"
+        )
+
+
+# ----------------------------------------------------------------------------------------------
+# Generating
+# ----------------------------------------------------------------------------------------------
+def generate(kind: str, seed: int, **options: Any) -> dict[str, Any]:
     """A random, valid and certified-solvable problem as a dictionary in the file format.
 
     The workspace is the square ``[0, size]^2``. For ``"circles"`` and ``"polygons"`` the start is
@@ -115,43 +245,16 @@ def generate(
 
     Parameters
     ----------
-    kind : {"circles", "polygons", "maze"}
-        What to generate.
+    kind : str
+        What to generate: a name of :data:`GENERATORS` (``"circles"``, ``"polygons"``,
+        ``"maze"``).
     seed : int
         Seed of ``numpy.random.default_rng``, >= 0. The same seed and options give the same
         problem, byte for byte once written.
-    size : float
-        Side of the square workspace, > 0 (default 100).
-    n : int, optional
-        ``circles``/``polygons``: number of obstacles, >= 1 (defaults 30 and 20).
-    cells : int, optional
-        ``maze``: cells per side, >= 2 (default 8).
-    robot_radius : float, optional
-        Robot radius, >= 0 (0 is a point robot). Defaults: ``0.01 size`` for circles and polygons,
-        a fifth of a cell for the maze.
-    radius_range : (float, float), optional
-        ``circles``: range of the radii; ``polygons``: range of the circumradii; ``0 < lo <= hi``.
-        Defaults ``(0.02 size, 0.06 size)`` and ``(0.03 size, 0.08 size)``.
-    vertices : (int, int), optional
-        ``polygons``: range of the number of vertices, ``3 <= lo <= hi`` (default ``(3, 8)``).
-    gap : float, optional
-        ``circles``/``polygons``: least free distance between two obstacles (between their
-        circumscribed circles for polygons), >= 0 (default 0: obstacles may touch but not overlap).
-    wall : float, optional
-        ``maze``: wall thickness, ``0 < wall < cell`` (default a tenth of a cell).
-    algorithm : {"dfs", "kruskal"}, optional
-        ``maze``: randomised depth-first search (long winding corridors, the default) or
-        randomised Kruskal (many short dead ends). Both give a perfect maze.
-    resolution : float, optional
-        Grid spacing of the solvability certificate, > 0. Default ``size / 200``, and for the maze
-        at most a quarter of the corridor's free width.
-    max_attempts : int
-        How many times to draw the obstacles before giving up, >= 1 (default 50).
-    decimals : int, optional
-        Decimal places of every coordinate, 0..12 (default :func:`default_decimals`: about
-        ``1e-5`` of the workspace).
-    name : str, optional
-        The problem's ``name`` (default ``"<kind>_<seed>"``).
+    **options
+        The kind's options (:class:`CirclesOptions`, :class:`PolygonsOptions`,
+        :class:`MazeOptions`: their fields, with types, defaults and ranges); None stands for
+        the default.
 
     Returns
     -------
@@ -161,46 +264,40 @@ def generate(
 
     Raises
     ------
-    ValueError
-        For an unknown kind, an option that does not apply to the kind, or an option out of range.
+    TypeError
+        For an option that no kind has.
     GenerationError
-        (a ``ValueError``) When obstacles cannot be placed or no certified-solvable problem is
+        (a ``ValueError``) For an unknown kind, an option that does not apply to the kind or is
+        out of range, or when obstacles cannot be placed or no certified-solvable problem is
         found within ``max_attempts``.
     """
-    given = {"n": n, "cells": cells, "robot_radius": robot_radius, "radius_range": radius_range,
-             "vertices": vertices, "gap": gap, "wall": wall, "algorithm": algorithm}  # fmt: skip
-    kind = _check_kind(kind, given)
-    seed = _option("seed", check_integer, seed, low=0)
-    size = _option("size", check_number, size, low=0.0, strict_low=True)
-    max_attempts = _option("max_attempts", check_integer, max_attempts, low=1)
-    if decimals is None:
-        decimals = default_decimals(size)
-    decimals = _option("decimals", check_integer, decimals, low=0, high=12)
-    if name is not None and (not isinstance(name, str) or not name.strip()):
-        raise GenerationError(f"name must be a non-empty string, got {name!r}")
-    if resolution is not None:
-        resolution = _option("resolution", check_number, resolution, low=0.0, strict_low=True)
-    if kind == "maze":
-        spec = _MazeSpec.build(size, cells, robot_radius, wall, algorithm, resolution)
-    else:
-        spec = _FieldSpec.build(kind, size, n, robot_radius, radius_range, vertices, gap)
-    resolution = resolution or spec.resolution
-    if resolution > size / 2:
-        raise GenerationError(
-            f"resolution must be at most size / 2 = {size / 2:g}, got {resolution:g}"
-        )
-    return _draw_until_certified(
-        spec, kind, seed, name or f"{kind}_{seed}", decimals, resolution, max_attempts
-    )
+    options_ = _options_of(kind, options)
+    return _draw_until_certified(options_.resolved(), _seed(seed))
 
 
-def _draw_until_certified(spec, kind, seed, name, decimals, resolution, max_attempts):
+def _options_of(kind: Any, options: Mapping[str, Any]) -> GeneratorOptions:
+    if kind not in GENERATORS:
+        raise GenerationError(f"unknown kind {kind!r}; known kinds: {', '.join(GENERATORS)}")
+    return GENERATORS[kind].from_options(options)
+
+
+def _seed(seed: Any) -> int:
+    try:
+        return check_integer(seed, low=0)
+    except ValueError as exc:
+        raise GenerationError(f"seed {exc}") from None
+
+
+def _draw_until_certified(options: GeneratorOptions, seed: int) -> dict[str, Any]:
     """Draw obstacles from one seeded stream until the rounded problem is valid and certified."""
+    kind = options.KIND
+    name = options.name or f"{kind}_{seed}"
+    resolution = options.resolution
     rng = np.random.default_rng(seed)
     last_failure = ""
-    for attempt in range(1, max_attempts + 1):
-        obstacles = spec.draw(rng)
-        data = round_floats(spec.document(name, obstacles), decimals)
+    for attempt in range(1, options.max_attempts + 1):
+        obstacles = options.draw(rng)
+        data = round_floats(options.document(name, obstacles), options.decimals)
         try:
             problem = problem_from_dict(data, source=f"<generate {kind}>")
         except ProblemError as exc:
@@ -225,13 +322,13 @@ def _draw_until_certified(spec, kind, seed, name, decimals, resolution, max_atte
             length = _round_up(best.length, 4)
             how = "the exact shortest path, by rrtpso optimum's tangent graph"
         data["description"] = (
-            f"{spec.describe()} Generated by rrtpso generate (kind {kind}, seed {seed}, "
+            f"{options.describe()} Generated by rrtpso generate (kind {kind}, seed {seed}, "
             f"attempt {attempt}). A collision-free path of length {length:g} exists "
             f"({how}), so the shortest path is at most that long."
         )
         return data
     raise GenerationError(
-        f"generate {kind}: no certified-solvable problem in {max_attempts} attempts "
+        f"generate {kind}: no certified-solvable problem in {options.max_attempts} attempts "
         f"(last: {last_failure}); use fewer or smaller obstacles, a smaller robot_radius, "
         "a finer resolution or more max_attempts"
     )
@@ -242,7 +339,7 @@ def generate_to_file(kind: str, seed: int, out: str | Path, **options: Any) -> P
 
     Parameters
     ----------
-    kind : {"circles", "polygons", "maze"}
+    kind : str
         What to generate (see :func:`generate`).
     seed : int
         Seed of the generator, >= 0.
@@ -250,111 +347,106 @@ def generate_to_file(kind: str, seed: int, out: str | Path, **options: Any) -> P
         The YAML file to write (its folder is created if needed; an existing file is replaced
         atomically).
     **options
-        Any keyword of :func:`generate`:
-
-        * every kind: ``size`` (side of the square workspace, default 100), ``robot_radius``,
-          ``resolution`` (grid spacing of the solvability certificate), ``max_attempts``
-          (default 50), ``decimals`` (decimal places of coordinates), ``name``;
-        * ``circles``: ``n`` (default 30), ``radius_range`` (min and max radius), ``gap`` (least
-          distance between circles);
-        * ``polygons``: ``n`` (default 20), ``radius_range`` (circumradii), ``vertices`` (min and
-          max vertex count, default 3 to 8), ``gap``;
-        * ``maze``: ``cells`` (per side, default 8), ``wall`` (thickness), ``algorithm``
-          (``"dfs"`` or ``"kruskal"``).
+        The kind's options, as for :func:`generate`.
 
     Returns
     -------
     Path
-        ``out``. The file starts with a comment holding the command that regenerates it,
-        ``rrtpso generate KIND --seed N [--option value ...]``, and is byte-identical for the same
-        kind, seed and options (the output path is not part of it).
+        ``out``. The file starts with a comment holding the command that regenerates it
+        (:func:`generate_command`), and is byte-identical for the same kind, seed and options
+        (the output path is not part of it).
 
     Raises
     ------
-    ValueError
-        Bad options, or :class:`GenerationError` (see :func:`generate`).
     TypeError
-        An unknown option name.
+        An option that no kind has.
+    GenerationError
+        See :func:`generate`.
     """
-    unknown = sorted(set(options) - set(_OPTION_ORDER))
-    if unknown:
-        raise TypeError(
-            f"generate_to_file() got unknown option(s) {', '.join(unknown)}; "
-            f"known: {', '.join(_OPTION_ORDER)}"
-        )
-    data = generate(kind, seed, **options)
-    command = " ".join(
-        [f"rrtpso generate {kind} --seed {seed}"]
-        + [
-            f"--{key.replace('_', '-')} {_cli_value(options[key])}"
-            for key in _OPTION_ORDER
-            if options.get(key) is not None
-        ]
-    )
+    options_ = _options_of(kind, options)
+    seed = _seed(seed)
+    data = _draw_until_certified(options_.resolved(), seed)
     header = (
-        f"Generated by: {command} --out FILE\n"
+        f"Generated by: {generate_command(options_, seed)} --out FILE\n"
         "Every obstacle below was drawn from numpy.random.default_rng(seed); the same command\n"
         "writes the same bytes. Solvability is certified by a collision-free grid path\n"
         "(rrtpso generate's certificate), see the description."
     )
-    return write_problem(data, out, header=header, decimals=options.get("decimals"))
+    return write_problem(data, out, header=header, decimals=options_.decimals)
+
+
+def generate_command(options: GeneratorOptions, seed: int) -> str:
+    """``rrtpso generate KIND --seed N --option value ...``: the command line that makes the
+    problem of ``options`` (those that differ from their defaults, in declaration order; a range
+    as its two numbers)."""
+    words = [f"rrtpso generate {options.KIND} --seed {seed}"]
+    for spec in options.PARAMS:
+        value = getattr(options, spec.name)
+        if value != spec.default:
+            words.append(f"--{spec.name.replace('_', '-')} {_cli_value(value)}")
+    return " ".join(words)
 
 
 # ----------------------------------------------------------------------------------------------
 # The kinds
 # ----------------------------------------------------------------------------------------------
-class _FieldSpec:
-    """Random non-overlapping circles or convex polygons, start and goal in opposite corners."""
+#: The radii of circles and polygons: 0 < min <= max < size / 2.
+_RADII_RULE = Rule(
+    ("radius_range", "size"),
+    lambda r, size: r is None or 0 < r[0] <= r[1] < size / 2,
+    "0 < radius_range min <= max < size / 2",
+)
 
-    def __init__(self, kind, size, n, robot_radius, radius_range, vertices, gap) -> None:
-        self.kind = kind
-        self.size = size
-        self.n = n
-        self.robot_radius = robot_radius
-        self.radius_range = radius_range
-        self.vertices = vertices
-        self.gap = gap
-        inset = 0.05 * size
-        self.start = np.array([inset, inset])
-        self.goal = np.array([size - inset, size - inset])
-        # Obstacles keep off start and goal: the robot must be able to turn away from them.
-        self.keep_out = max(2.0 * robot_radius, 0.03 * size)
-        self.resolution = size / GRID_POINTS
 
-    @classmethod
-    def build(cls, kind, size, n, robot_radius, radius_range, vertices, gap) -> _FieldSpec:
-        default_n = 30 if kind == "circles" else 20
-        n = _option("n", check_integer, default_n if n is None else n, low=1, high=MAX_OBSTACLES)
-        default_range = (0.02, 0.06) if kind == "circles" else (0.03, 0.08)
+@declared(
+    rules=(
+        Rule(("robot_radius", "size"), lambda r, size: r is None or r < 0.05 * size,
+             "robot_radius < 0.05 size (the start's inset from the corner)"),
+    )
+)  # fmt: skip
+class _FieldOptions(GeneratorOptions):
+    """Random non-overlapping obstacles, start and goal in opposite corners (circles and
+    polygons: each kind declares ``n``, ``radius_range`` and ``gap`` and draws its shapes)."""
+
+    #: Default radii (circumradii) as fractions of ``size``, for the default number of obstacles.
+    RADII: ClassVar[tuple[float, float]] = (0.0, 0.0)
+
+    robot_radius: float | None = param(
+        None,
+        "Robot radius (0: a point robot), less than 0.05 size (the start's inset from the "
+        "corner). Default: 0.01 size, shrunk as the radii beyond 100 obstacles.",
+        unit="length",
+        low=0.0,
+    )
+
+    # Each kind declares n, radius_range and gap (their defaults and docs differ).
+
+    def resolved(self) -> _FieldOptions:
+        default_n = self.PARAMS["n"].default
+        shrink = _shrink(self.n, default_n)
+        radius_range = self.radius_range
         if radius_range is None:
-            shrink = _shrink(n, default_n)
-            radius_range = (default_range[0] * size * shrink, default_range[1] * size * shrink)
-        lo, hi = _check_range("radius_range", radius_range, number=True)
-        if lo <= 0:
-            raise GenerationError(f"radius_range must be positive, got ({lo:g}, {hi:g})")
-        if hi >= size / 2:
-            raise GenerationError(
-                f"radius_range: the largest radius {hi:g} must be less than size / 2 = {size / 2:g}"
-            )
-        if kind == "polygons":
-            v = _check_range("vertices", (3, 8) if vertices is None else vertices, number=False)
-            if v[0] < 3:
-                raise GenerationError(f"vertices: a polygon needs at least 3, got ({v[0]}, {v[1]})")
-        else:
-            v = None
-        if robot_radius is None:
-            robot_radius = 0.01 * size * _shrink(n, default_n)  # as the radii
-        robot_radius = _option("robot_radius", check_number, robot_radius, low=0.0)
-        if robot_radius >= 0.05 * size:
-            raise GenerationError(
-                f"robot_radius {robot_radius:g} must be less than the start's inset from the "
-                f"corner, 0.05 size = {0.05 * size:g}"
-            )
-        gap = _option("gap", check_number, 0.0 if gap is None else gap, low=0.0)
-        return cls(kind, size, n, robot_radius, (lo, hi), v, gap)
+            lo, hi = self.RADII
+            radius_range = (lo * self.size * shrink, hi * self.size * shrink)
+        robot = 0.01 * self.size * shrink if self.robot_radius is None else self.robot_radius
+        return self._resolve(self.size / GRID_POINTS, radius_range=radius_range,
+                             robot_radius=robot)  # fmt: skip
+
+    def start_goal(self) -> tuple[np.ndarray, np.ndarray]:
+        inset = 0.05 * self.size
+        return np.array([inset, inset]), np.array([self.size - inset, self.size - inset])
 
     def draw(self, rng: np.random.Generator) -> list[dict[str, Any]]:
-        """n obstacles by rejection sampling.
+        centres, radii = self._place(rng)
+        return self._shapes(rng, centres, radii)
+
+    def _shapes(self, rng: np.random.Generator, centres: np.ndarray, radii: np.ndarray
+                ) -> list[dict[str, Any]]:  # fmt: skip
+        """The obstacles in the circles ``(centres, radii)``."""
+        raise NotImplementedError
+
+    def _place(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        """n non-overlapping discs by rejection sampling: ``(centres, radii)``.
 
         Candidates come in batches of 256, each tested against the obstacles placed so far that
         a k-d tree of their centres names within reach (``r + hi + gap``), then accepted in
@@ -365,7 +457,9 @@ class _FieldSpec:
         lo, hi = self.radius_range
         centres = np.empty((self.n, 2))
         radii = np.empty(self.n)
-        ends = np.array([self.start, self.goal])
+        ends = np.array(self.start_goal())
+        # Obstacles keep off start and goal: the robot must be able to turn away from them.
+        keep_out = max(2.0 * self.robot_radius, 0.03 * self.size)
         placed = 0
         budget = max(200 * self.n, 10_000)
         batch = 256
@@ -376,7 +470,7 @@ class _FieldSpec:
                 np.hypot(c[:, None, 0] - ends[None, :, 0], c[:, None, 1] - ends[None, :, 1])
                 - r[:, None]
             )
-            ok = np.all(clear_ends >= self.keep_out, axis=1)
+            ok = np.all(clear_ends >= keep_out, axis=1)
             if placed:
                 ok &= _clear_of(c, r, centres[:placed], radii[:placed], hi, self.gap)
             first_new = placed
@@ -394,34 +488,187 @@ class _FieldSpec:
                 break
         else:
             raise GenerationError(
-                f"generate {self.kind}: placed only {placed} of {self.n} non-overlapping "
+                f"generate {self.KIND}: placed only {placed} of {self.n} non-overlapping "
                 f"obstacles (radius {lo:g}-{hi:g}, gap {self.gap:g}) in {budget} tries; "
                 "use fewer or smaller obstacles or a larger size"
             )
-        if self.kind == "circles":
-            return [
-                {"type": "circle", "center": c.tolist(), "radius": float(r)}
-                for c, r in zip(centres, radii, strict=True)
-            ]
+        return centres, radii
+
+    def _where(self) -> str:
+        return (
+            f"in a {self.size:g} x {self.size:g} workspace, robot radius "
+            f"{self.robot_radius:g}, start and goal in opposite corners."
+        )
+
+
+@register_kind
+@declared(rules=(_RADII_RULE,))
+class CirclesOptions(_FieldOptions):
+    """Random non-overlapping circles (``rrtpso generate circles``)."""
+
+    KIND: ClassVar[str] = "circles"
+    RADII: ClassVar[tuple[float, float]] = (0.02, 0.06)
+
+    n: int = param(30, "Number of circles.", low=1, high=MAX_OBSTACLES)
+    radius_range: tuple[float, float] | None = param(
+        None,
+        "Least and largest radius, 0 < min <= max < size / 2. Default: (0.02 size, 0.06 "
+        "size), shrunk by sqrt(30 / n) beyond 100 circles.",
+        unit="length",
+        low=0.0,
+    )
+    gap: float = param(0.0, "Least free distance between two circles (0: they may touch).",
+                       unit="length", low=0.0)  # fmt: skip
+
+    def _shapes(self, rng: np.random.Generator, centres: np.ndarray, radii: np.ndarray
+                ) -> list[dict[str, Any]]:  # fmt: skip
+        return [
+            {"type": "circle", "center": c.tolist(), "radius": float(r)}
+            for c, r in zip(centres, radii, strict=True)
+        ]
+
+    def describe(self) -> str:
+        lo, hi = self.radius_range
+        return (
+            f"{self.n} random non-overlapping circles of radius {lo:.3g}-{hi:.3g} {self._where()}"
+        )
+
+
+@register_kind
+@declared(
+    rules=(
+        _RADII_RULE,
+        Rule(("vertices",), lambda v: v[0] <= v[1], "vertices min <= max"),
+    )
+)
+class PolygonsOptions(_FieldOptions):
+    """Random non-overlapping convex polygons (``rrtpso generate polygons``)."""
+
+    KIND: ClassVar[str] = "polygons"
+    RADII: ClassVar[tuple[float, float]] = (0.03, 0.08)
+
+    n: int = param(20, "Number of polygons.", low=1, high=MAX_OBSTACLES)
+    radius_range: tuple[float, float] | None = param(
+        None,
+        "Least and largest circumradius, 0 < min <= max < size / 2. Default: (0.03 size, "
+        "0.08 size), shrunk by sqrt(20 / n) beyond 100 polygons.",
+        unit="length",
+        low=0.0,
+    )
+    vertices: tuple[int, int] = param((3, 8), "Least and most vertices of a polygon.", low=3)
+    gap: float = param(
+        0.0,
+        "Least free distance between the circumscribed circles of two polygons (0: they may "
+        "touch).",
+        unit="length",
+        low=0.0,
+    )
+
+    def _shapes(self, rng: np.random.Generator, centres: np.ndarray, radii: np.ndarray
+                ) -> list[dict[str, Any]]:  # fmt: skip
         return [
             {"type": "polygon", "points": _convex_polygon(rng, c, r, self.vertices).tolist()}
             for c, r in zip(centres, radii, strict=True)
         ]
 
-    def document(self, name: str, obstacles: list[dict[str, Any]]) -> dict[str, Any]:
-        return _document(name, self.size, self.start, self.goal, self.robot_radius, obstacles)
-
     def describe(self) -> str:
         lo, hi = self.radius_range
-        what = (
-            f"{self.n} random non-overlapping circles of radius {lo:.3g}-{hi:.3g}"
-            if self.kind == "circles"
-            else f"{self.n} random non-overlapping convex polygons with {self.vertices[0]}-"
-            f"{self.vertices[1]} vertices and circumradius {lo:.3g}-{hi:.3g}"
-        )
         return (
-            f"{what} in a {self.size:g} x {self.size:g} workspace, robot radius "
-            f"{self.robot_radius:g}, start and goal in opposite corners."
+            f"{self.n} random non-overlapping convex polygons with {self.vertices[0]}-"
+            f"{self.vertices[1]} vertices and circumradius {lo:.3g}-{hi:.3g} {self._where()}"
+        )
+
+
+@register_kind
+@declared(
+    rules=(
+        Rule(("wall", "size", "cells"), lambda w, size, c: w is None or 0 < w < size / c,
+             "0 < wall < size / cells (the cell size)"),
+    )
+)  # fmt: skip
+class MazeOptions(GeneratorOptions):
+    """A perfect maze on a cells x cells grid; one rectangle per wall between two cells
+    (``rrtpso generate maze``)."""
+
+    KIND: ClassVar[str] = "maze"
+
+    robot_radius: float | None = param(
+        None,
+        "Robot radius (0: a point robot); the robot must fit the corridors. Default: a fifth of "
+        "a cell (size / cells).",
+        unit="length",
+        low=0.0,
+    )
+    cells: int = param(8, "Cells per side.", low=2, high=MAX_CELLS)
+    wall: float | None = param(
+        None,
+        "Wall thickness, 0 < wall < size / cells. Default: a tenth of a cell.",
+        unit="length",
+        low=0.0,
+    )
+    algorithm: str = param(
+        "dfs",
+        "dfs: randomised depth-first search (long winding corridors); kruskal: randomised "
+        "Kruskal (many short dead ends). Both give a perfect maze.",
+        choices=("dfs", "kruskal"),
+    )
+
+    def resolved(self) -> MazeOptions:
+        cell = self.size / self.cells
+        wall = 0.1 * cell if self.wall is None else self.wall
+        robot = 0.2 * cell if self.robot_radius is None else self.robot_radius
+        corridor = cell - wall - 2.0 * robot  # free width for the robot's centre
+        if corridor <= 0:
+            raise GenerationError(
+                f"the robot (diameter {2 * robot:g}) does not fit the maze corridors "
+                f"(cell {cell:g} minus wall {wall:g} = {cell - wall:g}); use a smaller "
+                "robot_radius or wall, or fewer cells"
+            )
+        # At least four grid points across every corridor, so the certificate cannot miss one.
+        resolution = min(self.size / GRID_POINTS, corridor / 4.0)
+        return self._resolve(resolution, wall=wall, robot_radius=robot)
+
+    def start_goal(self) -> tuple[np.ndarray, np.ndarray]:
+        cell = self.size / self.cells
+        return (np.array([0.5 * cell, 0.5 * cell]),
+                np.array([self.size - 0.5 * cell, self.size - 0.5 * cell]))  # fmt: skip
+
+    def draw(self, rng: np.random.Generator) -> list[dict[str, Any]]:
+        c = self.cells
+        # Interior walls: vertical ones between (r, k) and (r, k + 1), then horizontal ones
+        # between (r, k) and (r + 1, k); a cell (r, k) is the integer r * c + k.
+        vertical = [(r * c + k, r * c + k + 1) for r in range(c) for k in range(c - 1)]
+        horizontal = [(r * c + k, (r + 1) * c + k) for r in range(c - 1) for k in range(c)]
+        walls = vertical + horizontal
+        carve = _dfs_tree if self.algorithm == "dfs" else _kruskal_tree
+        opened = carve(rng, c, walls)
+        cell = self.size / c
+        h = 0.5 * self.wall
+        obstacles = []
+        # Each wall runs along its cell edge and half a thickness beyond both ends, so walls
+        # meeting at a corner overlap (no leak) and walls reaching the border pass it (no gap).
+        for w, (p, q) in enumerate(walls):
+            if w in opened:
+                continue
+            r, k = divmod(p, c)
+            if q == p + 1:  # vertical wall at x = (k + 1) cell
+                lo = [(k + 1) * cell - h, r * cell - h]
+                hi = [(k + 1) * cell + h, (r + 1) * cell + h]
+            else:  # horizontal wall at y = (r + 1) cell
+                lo = [k * cell - h, (r + 1) * cell - h]
+                hi = [(k + 1) * cell + h, (r + 1) * cell + h]
+            obstacles.append({"type": "rectangle", "min": lo, "max": hi})
+        return obstacles
+
+    def describe(self) -> str:
+        how = "randomised depth-first search" if self.algorithm == "dfs" else "randomised Kruskal"
+        n_walls = (self.cells - 1) ** 2
+        return (
+            f"A perfect maze ({how}) of {self.cells} x {self.cells} cells in a {self.size:g} x "
+            f"{self.size:g} workspace: its {n_walls} interior walls of thickness {self.wall:g} are "
+            "rectangles (the bounds are the outer wall), so exactly one corridor route joins any "
+            f"two cells. Robot radius {self.robot_radius:g}; start and goal at the centres of "
+            "opposite corner cells."
         )
 
 
@@ -451,94 +698,6 @@ def _clear_of(c, r, centres, radii, hi: float, gap: float) -> np.ndarray:
             d = np.hypot(*(centres[idx] - c[k]).T)
             ok[k] = bool(np.all(d >= radii[idx] + r[k] + gap))
     return ok
-
-
-class _MazeSpec:
-    """A perfect maze on a cells x cells grid; one rectangle per wall between two cells."""
-
-    def __init__(self, size, cells, robot_radius, wall, algorithm, resolution) -> None:
-        self.size = size
-        self.cells = cells
-        self.robot_radius = robot_radius
-        self.wall = wall
-        self.algorithm = algorithm
-        self.resolution = resolution
-        cell = size / cells
-        self.start = np.array([0.5 * cell, 0.5 * cell])
-        self.goal = np.array([size - 0.5 * cell, size - 0.5 * cell])
-
-    @classmethod
-    def build(cls, size, cells, robot_radius, wall, algorithm, resolution) -> _MazeSpec:
-        cells = _option(
-            "cells", check_integer, 8 if cells is None else cells, low=2, high=MAX_CELLS
-        )
-        cell = size / cells
-        wall = _option(
-            "wall", check_number, 0.1 * cell if wall is None else wall, low=0.0, strict_low=True
-        )
-        if wall >= cell:
-            raise GenerationError(
-                f"wall thickness {wall:g} must be less than the cell size {cell:g}"
-            )
-        if robot_radius is None:
-            robot_radius = 0.2 * cell
-        robot_radius = _option("robot_radius", check_number, robot_radius, low=0.0)
-        corridor = cell - wall - 2.0 * robot_radius  # free width for the robot's centre
-        if corridor <= 0:
-            raise GenerationError(
-                f"the robot (diameter {2 * robot_radius:g}) does not fit the maze corridors "
-                f"(cell {cell:g} minus wall {wall:g} = {cell - wall:g}); use a smaller "
-                "robot_radius or wall, or fewer cells"
-            )
-        algorithm = "dfs" if algorithm is None else algorithm
-        if algorithm not in _MAZE_ALGORITHMS:
-            raise GenerationError(
-                f"algorithm must be one of {', '.join(_MAZE_ALGORITHMS)}, got {algorithm!r}"
-            )
-        # At least four grid points across every corridor, so the certificate cannot miss one.
-        resolution = resolution or min(size / GRID_POINTS, corridor / 4.0)
-        return cls(size, cells, robot_radius, wall, algorithm, resolution)
-
-    def draw(self, rng: np.random.Generator) -> list[dict[str, Any]]:
-        c = self.cells
-        # Interior walls: vertical ones between (r, k) and (r, k + 1), then horizontal ones
-        # between (r, k) and (r + 1, k); a cell (r, k) is the integer r * c + k.
-        vertical = [(r * c + k, r * c + k + 1) for r in range(c) for k in range(c - 1)]
-        horizontal = [(r * c + k, (r + 1) * c + k) for r in range(c - 1) for k in range(c)]
-        walls = vertical + horizontal
-        carve = _dfs_tree if self.algorithm == "dfs" else _kruskal_tree
-        opened = carve(rng, c, walls)
-        cell = self.size / c
-        h = 0.5 * self.wall
-        obstacles = []
-        # Each wall runs along its cell edge and half a thickness beyond both ends, so walls
-        # meeting at a corner overlap (no leak) and walls reaching the border pass it (no gap).
-        for w, (p, q) in enumerate(walls):
-            if w in opened:
-                continue
-            r, k = divmod(p, c)
-            if q == p + 1:  # vertical wall at x = (k + 1) cell
-                lo = [(k + 1) * cell - h, r * cell - h]
-                hi = [(k + 1) * cell + h, (r + 1) * cell + h]
-            else:  # horizontal wall at y = (r + 1) cell
-                lo = [k * cell - h, (r + 1) * cell - h]
-                hi = [(k + 1) * cell + h, (r + 1) * cell + h]
-            obstacles.append({"type": "rectangle", "min": lo, "max": hi})
-        return obstacles
-
-    def document(self, name: str, obstacles: list[dict[str, Any]]) -> dict[str, Any]:
-        return _document(name, self.size, self.start, self.goal, self.robot_radius, obstacles)
-
-    def describe(self) -> str:
-        how = "randomised depth-first search" if self.algorithm == "dfs" else "randomised Kruskal"
-        n_walls = (self.cells - 1) ** 2
-        return (
-            f"A perfect maze ({how}) of {self.cells} x {self.cells} cells in a {self.size:g} x "
-            f"{self.size:g} workspace: its {n_walls} interior walls of thickness {self.wall:g} are "
-            "rectangles (the bounds are the outer wall), so exactly one corridor route joins any "
-            f"two cells. Robot radius {self.robot_radius:g}; start and goal at the centres of "
-            "opposite corner cells."
-        )
 
 
 def _dfs_tree(rng: np.random.Generator, c: int, walls: list[tuple[int, int]]) -> set[int]:
@@ -614,25 +773,6 @@ def _convex_polygon(
     return centre + radius * unit @ rot.T
 
 
-def _document(
-    name: str,
-    size: float,
-    start: np.ndarray,
-    goal: np.ndarray,
-    robot_radius: float,
-    obstacles: list[dict[str, Any]],
-) -> dict[str, Any]:
-    return {
-        "name": name,
-        "description": "",  # filled in once the problem is certified
-        "bounds": [[0.0, 0.0], [float(size), float(size)]],
-        "start": [float(v) for v in start],
-        "goal": [float(v) for v in goal],
-        "robot": {"radius": float(robot_radius)},
-        "obstacles": obstacles,
-    }
-
-
 def _round_up(x: float, digits: int) -> float:
     """``x`` rounded *up* to ``digits`` significant digits (an upper bound stays an upper bound)."""
     if x <= 0 or not math.isfinite(x):
@@ -649,34 +789,5 @@ def _cli_value(value: Any) -> str:
     return str(value)
 
 
-def _check_kind(kind: Any, given: dict[str, Any]) -> str:
-    """The kind, with every option given checked to apply to it."""
-    if kind not in KINDS:
-        raise GenerationError(f"unknown kind {kind!r}; known kinds: {', '.join(KINDS)}")
-    for key, value in given.items():
-        if value is not None and key not in _KIND_OPTIONS[kind] and key not in _COMMON_OPTIONS:
-            applies = [k for k, opts in _KIND_OPTIONS.items() if key in opts]
-            raise GenerationError(
-                f"option '{key}' does not apply to kind '{kind}' "
-                f"(it applies to: {', '.join(applies)}); options for {kind}: "
-                f"{', '.join(_KIND_OPTIONS[kind] + _COMMON_OPTIONS)}"
-            )
-    return kind
-
-
-def _option(name: str, check: Callable[..., Any], value: Any, **limits: Any) -> Any:
-    """``check(value, **limits)`` with the option's name in a :class:`GenerationError`."""
-    try:
-        return check(value, **limits)
-    except ValueError as exc:
-        raise GenerationError(f"{name} {exc}") from None
-
-
-def _check_range(name: str, value: Any, number: bool) -> tuple[Any, Any]:
-    if isinstance(value, str) or not isinstance(value, Sequence) or len(value) != 2:
-        raise GenerationError(f"{name} must be a pair (min, max), got {value!r}")
-    check = check_number if number else check_integer
-    lo, hi = _option(f"{name}[0]", check, value[0]), _option(f"{name}[1]", check, value[1])
-    if lo > hi:
-        raise GenerationError(f"{name} needs min <= max, got ({lo}, {hi})")
-    return lo, hi
+#: The kinds defined here, in order (:data:`GENERATORS` holds every registered kind).
+KINDS: tuple[str, ...] = tuple(GENERATORS)

@@ -25,7 +25,8 @@ from ..errors import ProblemError, RrtpsoError, UsageError
 from ..model.occupancy import is_map_yaml
 from ..model.problem import input_files
 from ..model.yamlfile import open_input
-from .results_file import ResultsFile, latest_rows, read_rows, resolved_source, row_key
+from .record import RunKey, RunRecord, resolved_source
+from .results_file import ResultsFile, latest_rows, read_rows
 
 __all__ = [
     "Task",
@@ -62,11 +63,11 @@ class Task:
     digest: str | None = None
 
     @property
-    def key(self) -> tuple[str, str, int, float | None]:
-        """Identifies the row in a results file (for resuming): the problem file resolved
-        (:func:`~rrtpso_ompl.harness.results_file.row_key`), however it was spelled."""
-        source = self.source if self.source is not None else resolved_source(self.file)
-        return (source, self.planner, self.seed, self.time_limit)
+    def key(self) -> RunKey:
+        """The identity of the task's run, that of its row
+        (:attr:`~rrtpso_ompl.harness.record.RunRecord.key`: the problem file resolved, however
+        it was spelled): how resuming finds the runs done."""
+        return RunKey.of(self.file, self.planner, self.seed, self.time_limit, source=self.source)
 
 
 def expand_inputs(items: Sequence[str]) -> list[tuple[str, str | None]]:
@@ -220,13 +221,13 @@ def prepare_task(task: Task) -> None:
         _LOADED[task.file] = exc
 
 
-def run_task(task: Task) -> dict[str, Any]:
+def run_task(task: Task) -> RunRecord:
     """Solve one task and return its row. Never raises for a bad problem: that is the row.
 
-    The row has the keys of ``rrtpso solve --json`` (``problem, planner, status, solved, length,
-    time, seed, path`` and the per-stage figures) plus ``file``, ``run``, ``wall`` (s) and
-    ``error`` (None, or the message for a bad file or planner), and ``budget``, the time limit
-    the task asked for (None: the file's).
+    The row (:class:`~rrtpso_ompl.harness.record.RunRecord`) has the figures of ``rrtpso solve
+    --json`` (``problem, planner, status, solved, length, time, seed, path`` and the per-stage
+    figures) plus ``file``, ``run``, ``wall`` (s) and ``error`` (None, or the message for a bad
+    file or planner), and ``budget``, the time limit the task asked for (None: the file's).
     """
     from ..ompl_setup import set_ompl_log_level
     from ..planners.solve import solve
@@ -250,32 +251,22 @@ def run_task(task: Task) -> dict[str, Any]:
         return error_row(task, str(exc))
     except RrtpsoError as exc:  # unknown planner, bad parameter
         return error_row(task, f"{task.file}: {exc}")
-    row = {**base, **result.to_dict(), **base}
+    solved = result.to_dict()
     if not task.keep_path:
-        row.pop("path", None)
-    row["wall"] = time.perf_counter() - t0
-    row["error"] = None
-    return row
+        solved.pop("path", None)
+    return RunRecord.from_solve(base, solved, wall=time.perf_counter() - t0)
 
 
 def _base_row(task: Task) -> dict[str, Any]:
+    """The keys a task gives its row, whatever the solve returns."""
     return {"file": task.file, "planner": task.planner, "seed": task.seed, "run": task.run,
-            "budget": task.time_limit, "source": task.key[0],
+            "budget": task.time_limit, "source": task.key.source,
             "inputs_sha256": task.digest}  # fmt: skip
 
 
-def error_row(task: Task, message: str) -> dict[str, Any]:
+def error_row(task: Task, message: str) -> RunRecord:
     """The row of a task that produced no result: ``status`` "error" and the reason."""
-    return {
-        **_base_row(task),
-        "problem": None,
-        "status": "error",
-        "solved": False,
-        "length": None,
-        "time": 0.0,
-        "path": [],
-        "error": message,
-    }
+    return RunRecord(**_base_row(task), status="error", path=[], error=message)
 
 
 def _timeout(task: Task) -> float:
@@ -299,7 +290,7 @@ def _warm() -> None:
     default_registry()  # imports OMPL's modules and every plugin, creates no OMPL object
 
 
-def _row_of(task: Task, result: Any) -> dict[str, Any]:
+def _row_of(task: Task, result: Any) -> RunRecord:
     from .workers import ChildFailure
 
     if isinstance(result, ChildFailure):
@@ -310,7 +301,7 @@ def _row_of(task: Task, result: Any) -> dict[str, Any]:
 # ----------------------------------------------------------------------------------------------
 # Executors
 # ----------------------------------------------------------------------------------------------
-def _local_results(tasks: list[Task], jobs: int) -> Iterator[dict[str, Any]]:
+def _local_results(tasks: list[Task], jobs: int) -> Iterator[RunRecord]:
     from .workers import run_local
 
     for task, result in run_local(tasks, run_task, jobs, warm=_warm, prepare=prepare_task,
@@ -318,7 +309,7 @@ def _local_results(tasks: list[Task], jobs: int) -> Iterator[dict[str, Any]]:
         yield _row_of(task, result)
 
 
-def _run_isolated(task: Task) -> dict[str, Any]:
+def _run_isolated(task: Task) -> RunRecord:
     """``run_task`` in a process of its own, inside a long-lived Dask worker: the worker may run
     threads, so the process is forked from a fork server that has done the imports (which the
     Dask worker keeps), not from the worker itself."""
@@ -327,7 +318,7 @@ def _run_isolated(task: Task) -> dict[str, Any]:
     return _row_of(task, run_spawned(run_task, task, _timeout(task), warm=True))
 
 
-def _dask_results(tasks: list[Task], scheduler: str | Any) -> Iterator[dict[str, Any]]:
+def _dask_results(tasks: list[Task], scheduler: str | Any) -> Iterator[RunRecord]:
     try:
         from distributed import Client, as_completed
     except ImportError as exc:  # pragma: no cover - depends on the optional extra
@@ -356,10 +347,10 @@ def run_batch(
     overwrite: bool = False,
     executor: str = "local",
     scheduler: Any = None,
-    progress: Callable[[dict[str, Any]], None] | None = None,
+    progress: Callable[[RunRecord], None] | None = None,
     on_start: Callable[[int, int], None] | None = None,
     optimum: bool = True,
-) -> list[dict[str, Any]]:
+) -> list[RunRecord]:
     """Run ``tasks`` and stream their rows to ``out`` (JSON lines) as they finish.
 
     Parameters
@@ -389,7 +380,7 @@ def run_batch(
 
     Returns
     -------
-    list of dict
+    list of RunRecord
         One row per run (the kept ones and the new ones).
 
     Raises
@@ -404,8 +395,8 @@ def run_batch(
     if executor == "dask" and scheduler is None:
         raise ValueError("the dask executor needs a scheduler address")
     with ResultsFile(out, resume=resume, overwrite=overwrite) as results:
-        kept = [r for r in results.kept if not r.get("error")]
-        done = {row_key(r): r.get("inputs_sha256") for r in kept}
+        kept = [r for r in results.kept if not r.is_error]
+        done = {r.key: r.inputs_sha256 for r in kept}
         todo = [t for t in tasks if not _done(t, done)]
         if on_start is not None:
             on_start(len(todo), len(tasks) - len(todo))
@@ -418,7 +409,7 @@ def run_batch(
         try:
             for row in stream:
                 if optima is not None:
-                    optima.annotate(row)
+                    row = optima.annotate(row)
                 results.append(row)
                 rows.append(row)
                 if progress is not None:
@@ -428,7 +419,7 @@ def run_batch(
     return latest_rows(rows)
 
 
-def _done(task: Task, done: Mapping[tuple[Any, ...], str | None]) -> bool:
+def _done(task: Task, done: Mapping[RunKey, str | None]) -> bool:
     """Whether a kept row is the task's run, of the same problem content (rows written before
     rows had ``inputs_sha256`` match on the key alone)."""
     if task.key not in done:
@@ -454,10 +445,6 @@ class _Optima:
                 self._cache[file] = None  # the row already says why
         return self._cache[file]
 
-    def annotate(self, row: dict[str, Any]) -> None:
-        opt = None if row.get("error") else self.length(row["file"])
-        row["optimum"] = opt
-        # Only a solved path has a ratio: an approximate one stops short of the goal and can be
-        # shorter than the optimum.
-        length = row.get("length") if row.get("solved") else None
-        row["ratio"] = length / opt if length is not None and opt else None
+    def annotate(self, row: RunRecord) -> RunRecord:
+        """The row with its problem's optimum and its ratio to it."""
+        return row.with_optimum(None if row.is_error else self.length(row.file))

@@ -48,9 +48,10 @@ from typing import Any
 
 from ..errors import UsageError
 from ..outputs import atomic_path, make_folders, remove_folders, write_text_atomic
-from ..planners.result import BenchmarkRun
 from .batch import Task, check_task_count, expand_inputs, make_tasks, run_batch
 from .ompl_log import Experiment, PlannerRuns, build_database, write_log
+from .record import RunRecord
+from .report import markdown_table
 
 __all__ = [
     "BenchResult",
@@ -146,7 +147,7 @@ class SummaryRow:
 class BenchResult:
     """What :func:`run_bench` produced."""
 
-    rows: list[dict[str, Any]]
+    rows: list[RunRecord]
     summary: list[SummaryRow]
     out_dir: Path
     logs: list[Path] = field(default_factory=list)
@@ -167,7 +168,7 @@ def run_bench(
     executor: str = "local",
     scheduler: Any = None,
     resume: bool = False,
-    progress: Callable[[dict[str, Any]], None] | None = None,
+    progress: Callable[[RunRecord], None] | None = None,
     on_start: Callable[[int, int], None] | None = None,
     command: str | None = None,
     simplify: bool | None = None,
@@ -220,8 +221,8 @@ def run_bench(
     except BaseException:
         remove_folders(made)  # a folder made for a bench that wrote nothing
         raise
-    errors = sorted({r["error"] for r in rows if r.get("error")})
-    good = [r for r in rows if not r.get("error")]
+    errors = sorted({r.error for r in rows if r.error})
+    good = [r for r in rows if not r.is_error]
     experiments = to_experiments(good, planners, runs, seed)
     for stale in _our_logs(out):  # from an earlier bench into the same folder
         stale.unlink()
@@ -277,36 +278,35 @@ def _free_log_name(out: Path, name: str) -> Path:
 # ----------------------------------------------------------------------------------------------
 # Rows -> OMPL experiments
 # ----------------------------------------------------------------------------------------------
-def run_properties(row: Mapping[str, Any]) -> dict[str, Any]:
+def run_properties(row: RunRecord) -> dict[str, Any]:
     """One batch row as OMPL run properties: the planner's own figures (its ``benchmark`` run),
     the checks of the harness and the ratio to the optimum."""
-    run = BenchmarkRun.from_dict(row.get("benchmark") or {"time": row.get("time") or 0.0})
-    solved = bool(row.get("solved"))
-    final = row.get("length") if solved else None
-    has_path = row.get("status") in ("exact", "approximate")
-    optimum = row.get("optimum")
+    run = row.benchmark_run
+    solved = bool(row.solved)
+    final = row.length if solved else None
+    has_path = row.status in ("exact", "approximate")
+    optimum = row.optimum
     return {
         "time": run.time,
         "solved": solved,
-        "status": row.get("ompl_status") or "Unknown status",
-        "correct solution": bool(row.get("valid")),
+        "status": row.ompl_status or "Unknown status",
+        "correct solution": bool(row.valid),
         "solution length": run.solution_length if has_path else None,
         "simplified solution length": run.simplified_length if solved else None,
         "simplification time": run.simplification_time,
         "total time": run.total_time,
-        "solution clearance": row.get("clearance") if solved else None,
+        "solution clearance": row.clearance if solved else None,
         "length over optimum": final / optimum if final is not None and optimum else None,
-        "seed": row.get("seed"),
+        "seed": row.seed,
         **{name: value for name, (_, value) in run.properties.items()},
     }
 
 
-def _planner_properties(rows: Iterable[Mapping[str, Any]]) -> list[tuple[str, str]]:
+def _planner_properties(rows: Iterable[RunRecord]) -> list[tuple[str, str]]:
     """The run properties of one planner's block: the common ones, then its own (typed)."""
     own: dict[str, str] = {}
     for r in rows:
-        for name, (ptype, _) in BenchmarkRun.from_dict(r.get("benchmark") or {"time": 0.0}
-                                                       ).properties.items():  # fmt: skip
+        for name, (ptype, _) in r.benchmark_run.properties.items():
             own.setdefault(name, ptype)
     return RUN_PROPERTIES + [(n, own[n]) for n in sorted(own) if n not in _COMMON_NAMES]
 
@@ -322,34 +322,33 @@ def _experiment_name(problem: str, budget: float) -> str:
 
 
 def to_experiments(
-    rows: Iterable[Mapping[str, Any]],
+    rows: Iterable[RunRecord],
     planners: Sequence[str],
     runs: int,
     seed: int,
 ) -> list[Experiment]:
     """Group rows (not error rows) into one experiment per problem and budget."""
-    groups: dict[tuple[str, float], list[Mapping[str, Any]]] = defaultdict(list)
-    for r in rows:  # one problem file, however its rows spelled it (``source``: resolved)
-        file = r.get("source") or r["file"]
-        groups[(file, float(r.get("budget") or r.get("time_limit") or 0.0))].append(r)
+    groups: dict[tuple[str, float], list[RunRecord]] = defaultdict(list)
+    for r in rows:  # one problem file, however its rows spelled it (the run's identity)
+        groups[(r.key.source, r.effective_budget)].append(r)
     names: dict[str, int] = {}
     experiments = []
     host = re.sub(r"\s+", "_", socket.gethostname()) or "localhost"
     for (_, budget), group in sorted(groups.items(), key=lambda kv: (kv[0][1], kv[0][0])):
-        file = group[0]["file"]  # as the command line named it
-        name = _experiment_name(group[0].get("problem") or Path(file).stem, budget)
+        file = group[0].file  # as the command line named it
+        name = _experiment_name(group[0].problem or Path(file).stem, budget)
         names[name] = names.get(name, 0) + 1
         if names[name] > 1:  # two files with the same problem name
             name = f"{name}_{names[name]}"
         blocks = []
         for planner in planners:
-            mine = sorted((r for r in group if r["planner"] == planner), key=lambda r: r["seed"])
+            mine = sorted((r for r in group if r.planner == planner), key=lambda r: r.seed)
             if not mine:
                 continue
             # The configuration, not the run: the seed and the budget are run/experiment data.
             settings = {
                 k: v
-                for k, v in (mine[0].get("params") or {}).items()
+                for k, v in mine[0].params.items()
                 if v is not None and k not in ("seed", "budget")
             }
             blocks.append(
@@ -359,13 +358,10 @@ def to_experiments(
                     run_properties=_planner_properties(mine),
                     runs=[run_properties(r) for r in mine],
                     progress_properties=PROGRESS_PROPERTIES,
-                    progress=[
-                        [tuple(p) for p in (r.get("benchmark") or {}).get("progress", [])]
-                        for r in mine
-                    ],
+                    progress=[list(r.benchmark.progress if r.benchmark else []) for r in mine],
                 )
             )
-        optimum = group[0].get("optimum")
+        optimum = group[0].optimum
         props: dict[str, object] = {"time budget": float(budget)}
         if optimum is not None:
             props["optimum"] = float(optimum)
@@ -376,7 +372,7 @@ def to_experiments(
                 time_limit=float(budget),
                 run_count=runs,
                 seed=seed,
-                total_time=sum(r.get("wall") or 0.0 for r in group),
+                total_time=sum(r.wall or 0.0 for r in group),
                 host=host,
                 setup=f"problem file: {file}\nplanners: {', '.join(planners)}\n{_HARNESS}",
                 properties=props,
@@ -399,22 +395,21 @@ def _quartiles(xs: list[float]) -> tuple[float | None, float | None]:
     return q[0], q[2]
 
 
-def summarise(rows: Iterable[Mapping[str, Any]], planners: Sequence[str]) -> list[SummaryRow]:
+def summarise(rows: Iterable[RunRecord], planners: Sequence[str]) -> list[SummaryRow]:
     """Per problem, budget and planner: success rate, length over optimum, time."""
-    groups: dict[tuple[str, float, str], list[Mapping[str, Any]]] = defaultdict(list)
+    groups: dict[tuple[str, float, str], list[RunRecord]] = defaultdict(list)
     for r in rows:
-        if r.get("error"):
+        if r.is_error:
             continue
-        budget = float(r.get("budget") or r.get("time_limit") or 0.0)
-        groups[(r.get("problem") or r["file"], budget, r["planner"])].append(r)
+        groups[(r.problem or r.file, r.effective_budget, r.planner)].append(r)
     order = {p: i for i, p in enumerate(planners)}
     out = []
     for (problem, budget, planner), group in sorted(
         groups.items(), key=lambda kv: (kv[0][0], kv[0][1], order.get(kv[0][2], 99))
     ):
         props = [run_properties(r) for r in group]
-        ok = [r for r in group if r.get("solved")]
-        optimum = group[0].get("optimum")
+        ok = [r for r in group if r.solved]
+        optimum = group[0].optimum
         ratios = sorted(p["length over optimum"] for p in props if p["length over optimum"])
         raw = sorted(
             p["solution length"] / optimum
@@ -431,7 +426,7 @@ def summarise(rows: Iterable[Mapping[str, Any]], planners: Sequence[str]) -> lis
                 solved=len(ok),
                 success=len(ok) / len(group),
                 optimum=optimum,
-                median_length=_median([r["length"] for r in ok]),
+                median_length=_median([r.length for r in ok]),
                 median_ratio=_median(ratios),
                 q1_ratio=q1,
                 q3_ratio=q3,
@@ -492,29 +487,68 @@ def overview_markdown(summary: Sequence[SummaryRow]) -> str:
     """
     planners = list(dict.fromkeys(s.planner for s in summary))
     budgets = sorted({s.budget for s in summary})
+    first = planners[0] if planners else ""
+    lost, total = _cells_lost(summary, first, budgets)
+    return "\n".join(
+        [
+            "## Overview",
+            "",
+            "Per planner and budget, over all problems: the median of each problem's median "
+            "excess length over the exact optimum, the success rate over all runs, and the median "
+            "of each problem's median time (planning plus simplification or PSO).",
+            "",
+            _overview_table(summary, planners, budgets, _final_cell),
+            "",
+            "The same excess before simplification (`solution length` in the log: RRTstarPSO's "
+            "RRT* stage, a stock planner's raw path):",
+            "",
+            _overview_table(summary, planners, budgets, _raw_cell),
+            "",
+            f"{first} has the shortest median path in {total - len(lost)} of {total} problem x "
+            "budget cells. In the others, the shortest median path was:",
+            "",
+            *(lost or ["- none"]),
+            "",
+        ]
+    )
 
-    def cells(planner: str, budget: float) -> list[SummaryRow]:
+
+def _overview_table(
+    summary: Sequence[SummaryRow],
+    planners: Sequence[str],
+    budgets: Sequence[float],
+    cell: Callable[[list[SummaryRow]], str],
+) -> str:
+    """A table of planners x budgets; ``cell`` makes each cell from the summary rows (one per
+    problem) of its planner and budget."""
+
+    def pooled(planner: str, budget: float) -> list[SummaryRow]:
         return [s for s in summary if s.planner == planner and s.budget == budget]
 
-    head = "| planner | " + " | ".join(f"{b:g} s" for b in budgets) + " |"
-    rule = "|---|" + "---|" * len(budgets)
-    final, raw = [head, rule], [head, rule]
-    for planner in planners:
-        row, raw_row = [planner], [planner]
-        for budget in budgets:
-            mine = cells(planner, budget)
-            runs = sum(s.runs for s in mine)
-            ratio = _median([s.median_ratio for s in mine if s.median_ratio is not None])
-            time = _median([s.median_time for s in mine if s.median_time is not None])
-            success = sum(s.solved for s in mine) / runs if runs else 0.0
-            row.append(f"{_excess(ratio)}, {success:.0%}, {_fmt(time, '.2f')} s")
-            raw_row.append(
-                _excess(_median([s.median_raw_ratio for s in mine if s.median_raw_ratio]))
-            )
-        final.append("| " + " | ".join(row) + " |")
-        raw.append("| " + " | ".join(raw_row) + " |")
-    first = planners[0] if planners else ""
-    beaten, total = [], 0
+    rows = [[p, *(cell(pooled(p, b)) for b in budgets)] for p in planners]
+    return markdown_table(["planner", *(f"{b:g} s" for b in budgets)], rows)
+
+
+def _final_cell(cells: list[SummaryRow]) -> str:
+    """Median over problems of the median excess, success over all runs, median time."""
+    runs = sum(s.runs for s in cells)
+    ratio = _median([s.median_ratio for s in cells if s.median_ratio is not None])
+    time = _median([s.median_time for s in cells if s.median_time is not None])
+    success = sum(s.solved for s in cells) / runs if runs else 0.0
+    return f"{_excess(ratio)}, {success:.0%}, {_fmt(time, '.2f')} s"
+
+
+def _raw_cell(cells: list[SummaryRow]) -> str:
+    """Median over problems of the median excess before simplification."""
+    return _excess(_median([s.median_raw_ratio for s in cells if s.median_raw_ratio]))
+
+
+def _cells_lost(
+    summary: Sequence[SummaryRow], first: str, budgets: Sequence[float]
+) -> tuple[list[str], int]:
+    """The problem x budget cells in which ``first`` has not the shortest median path (one line
+    each: who has it, and by how much), and how many cells have any solved run."""
+    lost, total = [], 0
     for budget in budgets:
         for problem in dict.fromkeys(s.problem for s in summary if s.budget == budget):
             cell = {s.planner: s.median_ratio for s in summary
@@ -524,35 +558,13 @@ def overview_markdown(summary: Sequence[SummaryRow]) -> str:
             total += 1
             best = min(cell, key=cell.__getitem__)
             if first not in cell:
-                beaten.append(f"- {budget:g} s, {problem}: {best}; {first} solved no run")
-                continue
-            if best != first:
+                lost.append(f"- {budget:g} s, {problem}: {best}; {first} solved no run")
+            elif best != first:
                 margin = 100 * (cell[first] - cell[best])
-                beaten.append(
+                lost.append(
                     f"- {budget:g} s, {problem}: {best}, shorter by {margin:.3f} % of the optimum"
                 )
-    return "\n".join(
-        [
-            "## Overview",
-            "",
-            "Per planner and budget, over all problems: the median of each problem's median "
-            "excess length over the exact optimum, the success rate over all runs, and the median "
-            "of each problem's median time (planning plus simplification or PSO).",
-            "",
-            *final,
-            "",
-            "The same excess before simplification (`solution length` in the log: RRTstarPSO's "
-            "RRT* stage, a stock planner's raw path):",
-            "",
-            *raw,
-            "",
-            f"{first} has the shortest median path in {total - len(beaten)} of {total} problem x "
-            "budget cells. In the others, the shortest median path was:",
-            "",
-            *(beaten or ["- none"]),
-            "",
-        ]
-    )
+    return lost, total
 
 
 def report_markdown(
@@ -572,25 +584,26 @@ def report_markdown(
     ]
     planners = list(dict.fromkeys(s.planner for s in summary))
     for budget in sorted({s.budget for s in summary}):
-        cells = {(s.problem, s.planner): s for s in summary if s.budget == budget}
-        problems = list(dict.fromkeys(s.problem for s in summary if s.budget == budget))
-        lines += [f"## Budget {budget:g} s", ""]
-        lines.append("| problem | optimum | " + " | ".join(planners) + " |")
-        lines.append("|---|---:|" + "---:|" * len(planners))
-        for problem in problems:
-            opt = next((s.optimum for s in summary if s.problem == problem), None)
-            row = [problem, _fmt(opt, ".2f")]
-            for planner in planners:
-                s = cells.get((problem, planner))
-                if s is None:
-                    row.append("")
-                    continue
-                row.append(
-                    f"{_fmt(s.median_ratio, '.4f')} ({_fmt(s.q1_ratio, '.3f')}–"
-                    f"{_fmt(s.q3_ratio, '.3f')}) [{s.success:.0%}], {_fmt(s.median_time, '.2f')}"
-                )
-            lines.append("| " + " | ".join(row) + " |")
-        lines.append("")
+        lines += [f"## Budget {budget:g} s", "", _budget_table(summary, planners, budget), ""]
     if errors:
         lines += ["## Errors", ""] + [f"- {e}" for e in errors] + [""]
     return "\n".join(lines)
+
+
+def _budget_table(summary: Sequence[SummaryRow], planners: Sequence[str], budget: float) -> str:
+    """Problems x planners at one budget: median ratio (quartiles) [success], median time."""
+    cells = {(s.problem, s.planner): s for s in summary if s.budget == budget}
+    rows = []
+    for problem in dict.fromkeys(s.problem for s in summary if s.budget == budget):
+        opt = next((s.optimum for s in summary if s.problem == problem), None)
+        row = [problem, _fmt(opt, ".2f")]
+        for planner in planners:
+            s = cells.get((problem, planner))
+            row.append(
+                ""
+                if s is None
+                else f"{_fmt(s.median_ratio, '.4f')} ({_fmt(s.q1_ratio, '.3f')}–"
+                f"{_fmt(s.q3_ratio, '.3f')}) [{s.success:.0%}], {_fmt(s.median_time, '.2f')}"
+            )
+        rows.append(row)
+    return markdown_table(["problem", "optimum", *planners], rows, align="-r" + "r" * len(planners))

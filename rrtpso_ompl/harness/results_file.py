@@ -26,9 +26,9 @@ import contextlib
 import json
 import os
 import sys
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import Any, BinaryIO, NoReturn
 
 from ..errors import OutputError, UsageError
 from ..outputs import (
@@ -40,6 +40,7 @@ from ..outputs import (
     remove_folders,
     stdout_closed,
 )
+from .record import ROW_KEYS, RunKey, RunRecord, resolved_source
 
 try:  # advisory locks; absent on Windows, where a second writer is not detected
     import fcntl
@@ -55,12 +56,9 @@ __all__ = [
     "latest_rows",
     "read_rows",
     "resolved_source",
-    "row_key",
 ]
 
-#: Keys every row of a batch has (error rows included): what makes a line recognisably ours.
-ROW_KEYS = ("file", "planner", "seed", "run", "status")
-#: How every row's line begins (:meth:`ResultsFile.append` puts ``file`` first): an unterminated
+#: How every row's line begins (:meth:`RunRecord.to_json` puts ``file`` first): an unterminated
 #: last line is a row cut short only when it begins so, or is a beginning of this.
 ROW_START = b'{"file": '
 #: Attempts at opening and locking the file while other batches create and remove it.
@@ -81,40 +79,20 @@ def is_torn_row(tail: bytes) -> bool:
     return is_row(obj)  # a whole row whose newline was not written
 
 
-def resolved_source(file: str) -> str:
-    """A problem file's path resolved: absolute, links followed (the ``source`` of its rows)."""
-    try:
-        return os.path.realpath(file)
-    except (OSError, ValueError):
-        return file
-
-
-def row_key(row: Mapping[str, Any]) -> tuple[Any, ...]:
-    """What identifies a run: ``(source, planner, seed, budget)``.
-
-    ``source`` is the problem file resolved (:func:`resolved_source`), so that ``probs/p.yaml``
-    and ``/abs/probs/p.yaml`` name the same run; a row written before rows had ``source`` is
-    resolved from its ``file`` (relative to the working directory).
-    """
-    source = row.get("source")
-    if source is None and isinstance(row.get("file"), str):
-        source = resolved_source(row["file"])
-    return (source, row.get("planner"), row.get("seed"), row.get("budget"))
-
-
-def latest_rows(rows: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
-    """One row per run, the last written (a retried error row is superseded by its retry), in
-    the order the runs first appear."""
-    latest: dict[tuple[Any, ...], dict[str, Any]] = {}
+def latest_rows(rows: Iterable[RunRecord]) -> list[RunRecord]:
+    """One row per run (:attr:`RunRecord.key`), the last written (a retried error row is
+    superseded by its retry), in the order the runs first appear."""
+    latest: dict[RunKey, RunRecord] = {}
     for row in rows:
-        latest.pop(row_key(row), None)  # re-insert: the retry takes the place of its run
-        latest[row_key(row)] = dict(row)
+        latest.pop(row.key, None)  # re-insert: the retry takes the place of its run
+        latest[row.key] = row
     return list(latest.values())
 
 
-def read_rows(path: str | Path) -> list[dict[str, Any]]:
+def read_rows(path: str | Path) -> list[RunRecord]:
     """The complete rows of a results file, one per run (:func:`latest_rows`); a torn last line
-    and lines that are not rows are skipped."""
+    and lines that are not rows are skipped. Rows of earlier versions are read too
+    (:meth:`RunRecord.from_json`)."""
     p = Path(path)
     if not p.exists():
         return []
@@ -125,9 +103,20 @@ def read_rows(path: str | Path) -> list[dict[str, Any]]:
                 obj = json.loads(line)
             except (json.JSONDecodeError, UnicodeDecodeError):
                 continue
-            if is_row(obj):
-                rows.append(obj)
+            record = _record(obj)
+            if record is not None:
+                rows.append(record)
     return latest_rows(rows)
+
+
+def _record(obj: Any) -> RunRecord | None:
+    """The record of a parsed line, or None when it is not a row of this package."""
+    if not is_row(obj):
+        return None
+    try:
+        return RunRecord.from_json(obj)
+    except ValueError:
+        return None
 
 
 class ResultsFile:
@@ -161,7 +150,7 @@ class ResultsFile:
         self.resume = resume
         self.overwrite = overwrite
         self.flag = flag
-        self.kept: list[dict[str, Any]] = []
+        self.kept: list[RunRecord] = []
         self._fh: BinaryIO | None = None
         self._fd: int | None = None
         self._target: Path | None = None
@@ -246,7 +235,7 @@ class ResultsFile:
             return False
         return (ours.st_dev, ours.st_ino) == (now.st_dev, now.st_ino)
 
-    def _take_over(self) -> list[dict[str, Any]]:
+    def _take_over(self) -> list[RunRecord]:
         """Check what the file holds and prepare it for appending; the rows to keep."""
         content = self._read()
         if not content:
@@ -272,7 +261,7 @@ class ResultsFile:
             os.ftruncate(self._fd, len(content) - len(torn))
         return latest_rows(rows)
 
-    def _refuse(self, why: str) -> None:
+    def _refuse(self, why: str) -> NoReturn:
         raise UsageError(
             f"{self.flag} {self.path}: not a results file of rrtpso batch or bench ({why}); it is "
             "left as it is: choose another file"
@@ -286,7 +275,7 @@ class ResultsFile:
             offset += len(chunk)
         return b"".join(chunks)
 
-    def _rows(self, lines: list[bytes]) -> list[dict[str, Any]]:
+    def _rows(self, lines: list[bytes]) -> list[RunRecord]:
         rows = []
         for number, line in enumerate(lines, start=1):
             if not line.strip():
@@ -295,14 +284,16 @@ class ResultsFile:
                 obj = json.loads(line)
             except (json.JSONDecodeError, UnicodeDecodeError):
                 obj = None
-            if not is_row(obj):
+            record = _record(obj)
+            if record is None:
                 self._refuse(f"line {number} is not one of its rows")
-            rows.append(obj)
+            rows.append(record)
         return rows
 
     # -- writing -------------------------------------------------------------------------------
-    def append(self, row: Mapping[str, Any]) -> None:
-        """Write one row as one whole line, ``file`` first (:data:`ROW_START`).
+    def append(self, row: RunRecord) -> None:
+        """Write one row as one whole line (:meth:`RunRecord.to_json`: ``file`` first,
+        :data:`ROW_START`).
 
         Raises
         ------
@@ -310,9 +301,7 @@ class ResultsFile:
             When the line cannot be written (the disk is full, the reader of a stream went away);
             a file is cut back to the rows before it, so it stays valid line by line.
         """
-        if "file" in row and next(iter(row)) != "file":
-            row = {"file": row["file"], **row}
-        data = json_line(row).encode("utf-8")
+        data = json_line(row.to_json()).encode("utf-8")
         if self._fh is not None:
             try:
                 self._fh.write(data)

@@ -101,7 +101,7 @@ class _ParentGone(Exception):
     """The pipe to the parent closed (or spoke) while a child ran: the parent is gone."""
 
 
-def run_once_in_child(fn: Callable[[Any], dict[str, Any]], task: Any, timeout: float,
+def run_once_in_child(fn: Callable[[Any], Any], task: Any, timeout: float,
                       watch: Connection | None = None) -> Any:  # fmt: skip
     """``fn(task)`` in a forked child (a spawned process without ``os.fork``); its return value,
     or an :class:`ChildFailure` describing how the child ended.

@@ -221,16 +221,74 @@ def load_map(path: str | Path, unknown_blocks: bool = True) -> OccupancyMap:
     """
     path = Path(path)
     source = str(path)
+    keys = _map_keys(source, _read_map_yaml(path))
+    image_path = map_image_path(path, keys.image)
+    grey, alpha, maxval = _read_image(source, image_path)
+    _check_extent(source, keys, grey.shape)
+    state = _states(grey, alpha, maxval, keys.mode, keys.negate, keys.occupied_thresh,
+                    keys.free_thresh)  # fmt: skip
+    # The boxes are merged from the states on first use (OccupancyMap.boxes).
+    return OccupancyMap(
+        source=source,
+        image=str(image_path),
+        resolution=keys.resolution,
+        origin=keys.origin,
+        state=state,
+        unknown_blocks=unknown_blocks,
+        mode=keys.mode,
+        negate=keys.negate,
+        occupied_thresh=keys.occupied_thresh,
+        free_thresh=keys.free_thresh,
+    )
+
+
+@dataclass(frozen=True)
+class _MapKeys:
+    """The keys of a map YAML, checked and with their defaults."""
+
+    image: str
+    resolution: float
+    origin: tuple[float, float]
+    negate: bool
+    occupied_thresh: float
+    free_thresh: float
+    mode: str
+
+
+def _read_map_yaml(path: Path) -> dict:
+    """The map YAML's top-level mapping."""
     doc = read_yaml_file(path)
     if not isinstance(doc, dict):
-        raise ProblemError(source, "", f"a map YAML must be a mapping, got {describe(doc)}")
+        raise ProblemError(str(path), "", f"a map YAML must be a mapping, got {describe(doc)}")
+    return doc
+
+
+def _map_keys(source: str, doc: dict) -> _MapKeys:
+    """Every key of the map YAML checked, in the order of the format (the first wrong one is
+    reported)."""
     for key in ("image", "resolution", "origin"):
         if doc.get(key) is None:
             raise ProblemError(source, key, "required key is missing")
     image = doc["image"]
     if not isinstance(image, str) or not image.strip():
         raise ProblemError(source, "image", f"must be a file name, got {describe(image)}")
-    resolution = _number(source, "resolution", doc["resolution"])
+    resolution = _resolution(source, doc["resolution"])
+    origin = _origin(source, doc["origin"])
+    negate = _negate(source, doc.get("negate", _DEFAULTS["negate"]))
+    occ, free = _thresholds(source, doc)
+    mode = _get(doc, "mode")
+    if mode not in MODES:
+        raise ProblemError(
+            source, "mode", f"must be one of {', '.join(MODES)}, got {describe(mode)}"
+        )
+    if "\0" in image:
+        raise ProblemError(source, "image", "the file name holds a NUL byte")
+    return _MapKeys(image, resolution, origin, negate, occ, free, mode)
+
+
+def _resolution(source: str, value: Any) -> float:
+    """Metres per cell: positive, at most the largest length."""
+    resolution = _number(source, "resolution", value)
     if not resolution > 0.0:
         raise ProblemError(
             source, "resolution", f"must be > 0 (metres per cell), got {resolution:g}"
@@ -242,7 +300,11 @@ def load_map(path: str | Path, unknown_blocks: bool = True) -> OccupancyMap:
             f"must be at most {MAX_COORDINATE:g} (the largest length: exact checks allow for "
             f"round-off of 1e-9 of the workspace's scale), got {resolution:g}",
         )
-    origin = doc["origin"]
+    return resolution
+
+
+def _origin(source: str, origin: Any) -> tuple[float, float]:
+    """``[x, y]`` or ``[x, y, yaw]`` with yaw 0: the image's lower-left corner."""
     if not isinstance(origin, list | tuple) or len(origin) not in (2, 3):
         raise ProblemError(source, "origin", f"must be [x, y, yaw], got {describe(origin)}")
     ox, oy, *rest = (_number(source, f"origin[{i}]", v) for i, v in enumerate(origin))
@@ -257,13 +319,22 @@ def load_map(path: str | Path, unknown_blocks: bool = True) -> OccupancyMap:
             f"a rotated map (yaw {yaw:g} rad) is not supported: the checks are exact for "
             "axis-aligned cells; rotate the image and set yaw to 0",
         )
-    negate = doc.get("negate", _DEFAULTS["negate"])
+    return ox, oy
+
+
+def _negate(source: str, negate: Any) -> bool:
+    """``negate``: 0 or 1 (a boolean or null accepted)."""
     if negate is None:
         negate = 0
     if isinstance(negate, bool):
         negate = int(negate)
     if not isinstance(negate, numbers.Integral) or negate not in (0, 1):
         raise ProblemError(source, "negate", f"must be 0 or 1, got {describe(negate)}")
+    return bool(negate)
+
+
+def _thresholds(source: str, doc: dict) -> tuple[float, float]:
+    """``occupied_thresh`` and ``free_thresh``: in [0, 1], free below occupied."""
     occ = _number(source, "occupied_thresh", _get(doc, "occupied_thresh"))
     free = _number(source, "free_thresh", _get(doc, "free_thresh"))
     for key, v in (("occupied_thresh", occ), ("free_thresh", free)):
@@ -273,40 +344,23 @@ def load_map(path: str | Path, unknown_blocks: bool = True) -> OccupancyMap:
         raise ProblemError(
             source, "free_thresh", f"must be below occupied_thresh ({occ:g}), got {free:g}"
         )
-    mode = _get(doc, "mode")
-    if mode not in MODES:
-        raise ProblemError(
-            source, "mode", f"must be one of {', '.join(MODES)}, got {describe(mode)}"
-        )
-    if "\0" in image:
-        raise ProblemError(source, "image", "the file name holds a NUL byte")
-    image_path = map_image_path(path, image)
-    grey, alpha, maxval = _read_image(source, image_path)
-    h, w = grey.shape
-    for i, (corner, cells) in enumerate(((ox, w), (oy, h))):
-        end = corner + cells * resolution
+    return occ, free
+
+
+def _check_extent(source: str, keys: _MapKeys, shape: tuple[int, int]) -> None:
+    """The map's far corner stays within the coordinate limit."""
+    h, w = shape
+    for i, (corner, cells) in enumerate(((keys.origin[0], w), (keys.origin[1], h))):
+        end = corner + cells * keys.resolution
         if abs(end) > MAX_COORDINATE:
             axis = "xy"[i]
             raise ProblemError(
                 source,
                 "resolution",
-                f"{cells} cells of {resolution:g} from origin {corner:g} reach {axis} = {end:g}, "
-                f"beyond +-{MAX_COORDINATE:g} (the coordinate limit: exact checks allow for "
-                "round-off of 1e-9 of the workspace's scale)",
+                f"{cells} cells of {keys.resolution:g} from origin {corner:g} reach {axis} = "
+                f"{end:g}, beyond +-{MAX_COORDINATE:g} (the coordinate limit: exact checks allow "
+                "for round-off of 1e-9 of the workspace's scale)",
             )
-    state = _states(grey, alpha, maxval, mode, bool(negate), occ, free)
-    return OccupancyMap(
-        source=source,
-        image=str(image_path),
-        resolution=resolution,
-        origin=(ox, oy),
-        state=state,
-        unknown_blocks=unknown_blocks,
-        mode=mode,
-        negate=bool(negate),
-        occupied_thresh=occ,
-        free_thresh=free,
-    )
 
 
 def map_image_path(map_yaml: str | Path, image: str) -> Path:

@@ -25,8 +25,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import types
 import typing
-from collections.abc import Callable, Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
@@ -63,6 +64,12 @@ class ParamSpec:
         For OMPL planners: the setter method to call (``"setRange"``).
     getter : str or None
         For OMPL planners: the matching getter, used to check defaults against OMPL.
+    optional : bool
+        Whether None is a value: "not given", resolved by the owner from other values (the
+        ``doc`` says how), such as a radius that defaults to a fraction of a size.
+    length : int or None
+        For a tuple of values of ``type`` (such as a range ``(min, max)``): how many; ``low``,
+        ``high`` and ``choices`` apply to each. None for one value.
     """
 
     name: str
@@ -75,6 +82,8 @@ class ParamSpec:
     choices: tuple[Any, ...] | None = None
     setter: str | None = None
     getter: str | None = None
+    optional: bool = False
+    length: int | None = None
 
     def convert(self, value: Any, owner: str = "", text: bool = True) -> Any:
         """Validate ``value`` (a Python value or a command-line string) and convert it.
@@ -96,13 +105,29 @@ class ParamSpec:
             Naming the parameter, the expected type and range, and the value given.
         """
         try:
-            if not text and isinstance(value, str) and self.type is not str:
-                kind = {bool: "a boolean", int: "an integer"}.get(self.type, "a number")
-                raise ValueError(f"must be {kind}, got {describe(value)}{number_hint(value)}")
-            return self._convert(self._parse(value))
+            if value is None and self.optional:
+                return None
+            if self.length is not None:
+                return self._convert_tuple(value, text)
+            return self._convert_one(value, text)
         except ValueError as exc:
             of = f" of {owner}" if owner else ""
             raise ParameterError(f"parameter '{self.name}'{of} {exc}", self.name) from None
+
+    def _convert_one(self, value: Any, text: bool) -> Any:
+        if not text and isinstance(value, str) and self.type is not str:
+            kind = {bool: "a boolean", int: "an integer"}.get(self.type, "a number")
+            raise ValueError(f"must be {kind}, got {describe(value)}{number_hint(value)}")
+        return self._convert(self._parse(value))
+
+    def _convert_tuple(self, value: Any, text: bool) -> tuple[Any, ...]:
+        """``length`` values, from a sequence (or, on the command line, ``"2 6"`` or ``"2,6"``)."""
+        if text and isinstance(value, str):
+            value = value.replace(",", " ").split()
+        if isinstance(value, str) or not isinstance(value, Sequence) or len(value) != self.length:
+            shape = "a pair" if self.length == 2 else f"{self.length} values"
+            raise ValueError(f"must be {shape} of {self.type.__name__}, got {describe(value)}")
+        return tuple(self._convert_one(v, text) for v in value)
 
     def _parse(self, value: Any) -> Any:
         """A command-line string to a Python value of the declared type."""
@@ -146,6 +171,8 @@ class ParamSpec:
         """The allowed range as text, e.g. ``[0, 1]``."""
         if self.choices is not None:
             return "{" + ", ".join(map(str, self.choices)) + "}"
+        if self.type is str:
+            return "any text"
         if self.type is bool:
             return "{false, true}"
 
@@ -154,7 +181,14 @@ class ParamSpec:
 
         lo = "-inf" if self.low is None else text(self.low)
         hi = "inf" if self.high is None else text(self.high)
-        return f"[{lo}, {hi}]"
+        return f"[{lo}, {hi}]" + (" each" if self.length is not None else "")
+
+    def type_text(self) -> str:
+        """The type as listings show it: ``float``, ``(int, int)``, ``float or None``."""
+        name = self.type.__name__
+        if self.length is not None:
+            name = "(" + ", ".join([name] * self.length) + ")"
+        return f"{name} or None" if self.optional else name
 
 
 @dataclass(frozen=True)
@@ -282,7 +316,7 @@ class ParamTable:
         rows = ["| name | type | default | unit | range | meaning |", "|---|---|---|---|---|---|"]
         for p in self:
             rows.append(
-                f"| `{p.name}` | {p.type.__name__} | {p.default} | {p.unit or '–'} | "
+                f"| `{p.name}` | {p.type_text()} | {p.default} | {p.unit or '–'} | "
                 f"{p.range_text()} | {p.doc} |"
             )
         return "\n".join(rows)
@@ -292,7 +326,7 @@ class ParamTable:
         lines = ["Parameters", "----------"]
         for p in self:
             unit = f", in {p.unit}" if p.unit else ""
-            lines.append(f"{p.name} : {p.type.__name__}, default {p.default!r}")
+            lines.append(f"{p.name} : {p.type_text()}, default {p.default!r}")
             lines.append(f"    {p.doc} Range {p.range_text()}{unit}.")
         return "\n".join(lines)
 
@@ -318,6 +352,24 @@ def param(
     its unit and its range. The name and type come from the field itself."""
     spec = {"doc": doc, "unit": unit, "low": low, "high": high, "choices": choices}
     return dataclasses.field(default=default, metadata={_PARAM_KEY: spec})
+
+
+def _field_type(hint: Any, where: str) -> tuple[type, bool, int | None]:
+    """``(type, optional, length)`` of a field's annotation: ``float``, ``float | None``,
+    ``tuple[int, int]``, ``tuple[float, float] | None``."""
+    optional = False
+    if typing.get_origin(hint) in (typing.Union, types.UnionType):
+        rest = [a for a in typing.get_args(hint) if a is not type(None)]
+        if len(rest) != 1 or len(typing.get_args(hint)) != 2:
+            raise TypeError(f"{where}: a field is one type, or one type or None")
+        hint, optional = rest[0], True
+    length = None
+    if typing.get_origin(hint) is tuple:
+        items = typing.get_args(hint)
+        if not items or Ellipsis in items or len(set(items)) != 1:
+            raise TypeError(f"{where}: a tuple field holds values of one type, a fixed number")
+        hint, length = items[0], len(items)
+    return (_TYPES.get(hint, hint) if isinstance(hint, str) else hint), optional, length
 
 
 def _validate_fields(self: Any) -> None:
@@ -368,9 +420,9 @@ def declared(cls: type[_T] | None = None, *, rules: Iterable[Rule] = ()) -> Any:
             meta = f.metadata.get(_PARAM_KEY)
             if meta is None:
                 raise TypeError(f"{klass.__name__}.{f.name}: declare it with param(...)")
-            kind = hints[f.name]
-            kind = _TYPES.get(kind, kind) if isinstance(kind, str) else kind
-            specs.append(ParamSpec(f.name, kind, f.default, **meta))
+            kind, optional, length = _field_type(hints[f.name], f"{klass.__name__}.{f.name}")
+            specs.append(ParamSpec(f.name, kind, f.default, **meta, optional=optional,
+                                   length=length))  # fmt: skip
         table = ParamTable(*specs, rules=(*dict.fromkeys(inherited), *rules))
 
         def from_values(k: Any, values: Mapping[str, Any]) -> Any:

@@ -9,6 +9,7 @@ gives the same bytes.
 from __future__ import annotations
 
 import re
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -16,10 +17,13 @@ import yaml
 from helpers import PROBLEMS
 
 from rrtpso_ompl.groundtruth.generate import (
+    GENERATORS,
     KINDS,
+    CirclesOptions,
     GenerationError,
     default_decimals,
     generate,
+    generate_command,
     generate_to_file,
     grid_path,
     is_solvable,
@@ -177,36 +181,41 @@ def test_maze_is_a_perfect_maze(cells, algorithm):
     ("kind", "options", "message"),
     [
         ("hexagons", {}, "unknown kind 'hexagons'; known kinds: circles, polygons, maze"),
-        ("circles", {"n": 0}, "n must be >= 1, got 0"),
-        ("circles", {"n": 2.5}, "n must be an integer"),
+        ("circles", {"n": 0}, "parameter 'n' must be in [1, 100000], got 0"),
+        ("circles", {"n": 2.5}, "parameter 'n' must be an integer, got float 2.5"),
         ("circles", {"seed": -1}, "seed must be >= 0"),
         ("circles", {"cells": 4}, "option 'cells' does not apply to kind 'circles'"),
         ("maze", {"n": 4}, "option 'n' does not apply to kind 'maze'"),
         ("polygons", {"wall": 1.0}, "option 'wall' does not apply"),
-        ("circles", {"size": 0}, "size must be > 0"),
-        ("circles", {"robot_radius": -1}, "robot_radius must be >= 0"),
-        ("circles", {"robot_radius": 6}, "less than the start's inset"),
-        ("circles", {"radius_range": (5, 2)}, "radius_range needs min <= max"),
-        ("circles", {"radius_range": 3}, "radius_range must be a pair"),
-        ("circles", {"radius_range": (0, 2)}, "radius_range must be positive"),
-        ("circles", {"gap": -1}, "gap must be >= 0"),
-        ("polygons", {"vertices": (2, 5)}, "a polygon needs at least 3"),
-        ("maze", {"cells": 1}, "cells must be >= 2"),
-        ("maze", {"cells": 4, "wall": 30}, "must be less than the cell size"),
+        ("circles", {"size": 0}, "must satisfy size > 0, got size = 0.0"),
+        ("circles", {"robot_radius": -1}, "parameter 'robot_radius' must be in [0, inf]"),
+        ("circles", {"robot_radius": 6}, "robot_radius < 0.05 size (the start's inset"),
+        ("circles", {"radius_range": (5, 2)}, "min <= max < size / 2, got radius_range = (5.0, 2"),
+        ("circles", {"radius_range": 3}, "parameter 'radius_range' must be a pair of float"),
+        ("circles", {"radius_range": (0, 2)}, "0 < radius_range min"),
+        ("circles", {"radius_range": (2, 60)}, "max < size / 2"),
+        ("circles", {"gap": -1}, "parameter 'gap' must be in [0, inf], got -1.0"),
+        ("polygons", {"vertices": (2, 5)}, "parameter 'vertices' must be in [3, inf] each, got 2"),
+        ("polygons", {"vertices": (6, 5)}, "vertices min <= max"),
+        ("maze", {"cells": 1}, "parameter 'cells' must be in [2, 200], got 1"),
+        ("maze", {"cells": 4, "wall": 30}, "0 < wall < size / cells (the cell size)"),
         ("maze", {"cells": 4, "robot_radius": 12}, "does not fit the maze corridors"),
-        ("maze", {"algorithm": "prim"}, "algorithm must be one of dfs, kruskal"),
-        ("circles", {"max_attempts": 0}, "max_attempts must be >= 1"),
-        ("circles", {"decimals": 20}, "decimals must be <= 12"),
-        ("circles", {"resolution": 0}, "resolution must be > 0"),
-        ("circles", {"resolution": 60}, "resolution must be at most size / 2"),
-        ("circles", {"name": ""}, "name must be a non-empty string"),
+        ("maze", {"algorithm": "prim"}, "parameter 'algorithm' must be one of ['dfs', 'kruskal']"),
+        ("circles", {"max_attempts": 0}, "parameter 'max_attempts' must be in [1, inf], got 0"),
+        ("circles", {"decimals": 20}, "parameter 'decimals' must be in [0, 12], got 20"),
+        ("circles", {"resolution": 0}, "0 < resolution <= size / 2, got resolution = 0.0"),
+        ("circles", {"resolution": 60}, "0 < resolution <= size / 2, got resolution = 60.0"),
+        ("circles", {"name": ""}, "name is not empty"),
+        ("circles", {"name": 3}, "parameter 'name' must be a string"),
     ],
-)
-def test_bad_options_raise_value_error(kind, options, message):
+)  # fmt: skip
+def test_bad_options_raise_one_generation_error_naming_the_option(kind, options, message):
     options = dict(options)
     seed = options.pop("seed", 1)
-    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
+    with pytest.raises(GenerationError) as info:
         generate(kind, seed, **options)
+    assert message in str(info.value)
+    assert isinstance(info.value, ValueError)  # as before the options were declared
 
 
 def test_overfull_field_raises_generation_error():
@@ -356,6 +365,14 @@ def test_generate_command_is_deterministic_and_checks_options(tmp_path):
          str(tmp_path / "c.yaml")], capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert bad.returncode == 2 and "cells" in bad.stderr and not (tmp_path / "c.yaml").exists()
+    # A generation that fails says so once, naming the kind once.
+    failed = subprocess.run(
+        [*rrtpso_exe(), "generate", "circles", "--seed", "1", "--n", "60", "--robot-radius", "4.5",
+         "--max-attempts", "2", "--out", str(tmp_path / "d.yaml")],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert failed.returncode == 2 and "no certified-solvable problem" in failed.stderr
+    assert failed.stderr.count("generate circles:") == 1 and not (tmp_path / "d.yaml").exists()
 
 
 def test_thousands_of_obstacles_stay_feasible():
@@ -373,3 +390,133 @@ def test_thousands_of_obstacles_stay_feasible():
     assert "A collision-free path of length" in data["description"]
     world = World.from_problem(problem)
     assert world.point_free(*problem.start) and world.point_free(*problem.goal)
+
+
+# ----------------------------------------------------------------------------------------------
+# Options declared once: the flags, the header's command and the docs derive from them
+# ----------------------------------------------------------------------------------------------
+def _generate_parser():
+    import argparse
+
+    from rrtpso_ompl.cli.main import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    return sub.choices["generate"]
+
+
+def test_every_option_of_every_kind_is_one_flag_of_rrtpso_generate():
+    flags = {a.dest: a for a in _generate_parser()._actions}
+    kinds = next(a for a in _generate_parser()._actions if a.dest == "kind").choices
+    assert list(kinds) == list(GENERATORS) == list(KINDS)
+    for cls in GENERATORS.values():
+        for spec in cls.PARAMS:
+            flag = flags[spec.name]
+            assert flag.option_strings == [f"--{spec.name.replace('_', '-')}"]
+            assert flag.type is spec.type and spec.doc in flag.help
+            assert flag.nargs == spec.length  # a range is two numbers
+            assert flag.choices == spec.choices and flag.default is None
+    # Nothing but the options, the seed, the output and --overwrite.
+    options = {n for cls in GENERATORS.values() for n in cls.PARAMS.names()}
+    assert set(flags) - options == {"help", "verbose", "quiet", "kind", "seed", "out", "overwrite"}
+
+
+def test_the_header_command_regenerates_the_file_through_the_command_line(tmp_path):
+    """Every option the header names is a flag: the header's command run as written gives the
+    same bytes (before the flags were derived, --resolution, --max-attempts and --decimals were
+    written into the header but were no flags of rrtpso generate)."""
+    import shlex
+    import subprocess
+
+    from helpers import rrtpso_exe
+
+    options = {"cells": 5, "resolution": 1.0, "max_attempts": 7, "decimals": 2, "name": "m5",
+               "algorithm": "kruskal"}  # fmt: skip
+    first = generate_to_file("maze", 3, tmp_path / "a.yaml", **options)
+    command = first.read_text().splitlines()[0].removeprefix("# Generated by: ")
+    assert command == (
+        "rrtpso generate maze --seed 3 --resolution 1.0 --max-attempts 7 "
+        "--decimals 2 --name m5 --cells 5 --algorithm kruskal --out FILE"
+    )
+    args = [*shlex.split(command)[1:-1], str(tmp_path / "b.yaml")]
+    proc = subprocess.run([*rrtpso_exe(), *args], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "b.yaml").read_bytes() == first.read_bytes()
+
+
+def test_the_header_names_the_options_that_differ_from_their_defaults(tmp_path):
+    """The same problem, however its options were spelled, is the same file."""
+    a = generate_to_file("circles", 2, tmp_path / "a.yaml", n=15, size=100, gap=0.0)
+    b = generate_to_file("circles", 2, tmp_path / "b.yaml", n=15.0, radius_range=None)
+    assert a.read_bytes() == b.read_bytes()
+    assert a.read_text().startswith("# Generated by: rrtpso generate circles --seed 2 --n 15 --out")
+    options = CirclesOptions.from_options({"n": 15, "radius_range": (2, 6), "gap": None})
+    assert generate_command(options, 4) == (
+        "rrtpso generate circles --seed 4 --n 15 --radius-range 2.0 6.0"
+    )
+
+
+def test_a_kind_is_one_class_and_one_registration(tmp_path):
+    """A new kind (a field of squares) declared and registered here is generated, named in
+    headers, and has its flags, like the built-in ones."""
+    from rrtpso_ompl.groundtruth.generate import GeneratorOptions, register_kind
+    from rrtpso_ompl.planners.params import declared, param
+
+    @register_kind
+    @declared
+    class SquaresOptions(GeneratorOptions):
+        """A row of squares across the middle, with a gap (a test kind)."""
+
+        KIND: ClassVar[str] = "squares"
+        squares: int = param(3, "Number of squares.", low=1, high=20)
+
+        def resolved(self):
+            return self._resolve(self.size / 200, robot_radius=self.robot_radius or 1.0)
+
+        def start_goal(self):
+            return np.array([5.0, 5.0]), np.array([self.size - 5, self.size - 5])
+
+        def draw(self, rng):
+            side = self.size / (2 * self.squares + 1)
+            y = float(rng.uniform(0.3, 0.6)) * self.size
+            return [
+                {"type": "rectangle", "min": [(2 * k + 1) * side, y],
+                 "max": [(2 * k + 2) * side, y + side]}
+                for k in range(self.squares)
+            ]  # fmt: skip
+
+        def describe(self):
+            return f"{self.squares} squares."
+
+    try:
+        data = generate("squares", 1, squares=4)
+        assert len(data["obstacles"]) == 4 and data["description"].startswith("4 squares.")
+        path = generate_to_file("squares", 1, tmp_path / "s.yaml", squares=4)
+        assert path.read_text().startswith("# Generated by: rrtpso generate squares --seed 1 "
+                                           "--squares 4 --out FILE")  # fmt: skip
+        with pytest.raises(GenerationError, match="option 'cells' does not apply to kind 'sq"):
+            generate("squares", 1, cells=3)
+        flags = {a.dest: a for a in _generate_parser()._actions}
+        assert flags["squares"].help == "squares: Number of squares. Default: 3."
+        assert "squares" in next(a for a in _generate_parser()._actions if a.dest == "kind").choices
+    finally:
+        del GENERATORS["squares"]
+
+
+def test_the_docs_show_the_declared_options():
+    """problems/README.md's option tables are the declarations (regenerate them with python
+    benchmarks/param_tables.py --update problems/README.md)."""
+    text = (PROBLEMS / "README.md").read_text()
+    for kind, cls in GENERATORS.items():
+        block = f"<!-- generate:{kind} -->\n{cls.PARAMS.markdown()}\n<!-- /generate:{kind} -->"
+        assert block in text, f"the options of {kind} in problems/README.md are not the declared"
+
+
+def test_importing_the_ground_truth_loads_no_ompl():
+    """Ground truth is geometry: importing it in a fresh interpreter loads no OMPL."""
+    import subprocess
+    import sys
+
+    code = "import sys, rrtpso_ompl.groundtruth; print(' '.join(sorted(sys.modules)))"
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120, check=True)  # fmt: skip
+    assert not [m for m in proc.stdout.split() if m.split(".")[0] == "ompl"]

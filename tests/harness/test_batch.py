@@ -82,15 +82,15 @@ def test_resume_skips_done_rows_and_retries_a_torn_line(folder, tmp_path):
     good = str(folder / "a_circle.yaml")
     tasks = make_tasks([good], ["RRTConnect"], runs=3, seed=5, time_limit=0.1)
     rows = run_batch(tasks[:2], out)
-    assert [r["seed"] for r in rows] == [5, 6]
+    assert [r.seed for r in rows] == [5, 6]
     # Simulate an interrupted write at the end of the file.
     with out.open("a") as fh:
         fh.write('{"file": "' + good + '", "planner": "RRTC')
     seen = []
     rows = run_batch(tasks, out, resume=True, on_start=lambda n, skipped: seen.append((n, skipped)))
     assert seen == [(1, 2)]
-    assert sorted(r["seed"] for r in rows) == [5, 6, 7]
-    assert sorted(r["seed"] for r in read_rows(out)) == [5, 6, 7]
+    assert sorted(r.seed for r in rows) == [5, 6, 7]
+    assert sorted(r.seed for r in read_rows(out)) == [5, 6, 7]
     assert all(json.loads(line) for line in out.read_text().splitlines())
 
 
@@ -101,7 +101,7 @@ def test_same_seed_same_row_in_a_fresh_process(tmp_path):
     tasks = make_tasks([problem], ["PSO"], seed=3, time_limit=5.0, params=params)
     a = run_batch(tasks, tmp_path / "a.jsonl")[0]
     b = run_batch(tasks, tmp_path / "b.jsonl", jobs=2)[0]
-    assert a["solved"] == b["solved"] and a["path"] == b["path"]
+    assert a.solved == b.solved and a.path == b.path
 
 
 def test_ctrl_c_leaves_a_valid_partial_file(folder, tmp_path):
@@ -126,7 +126,7 @@ def test_ctrl_c_leaves_a_valid_partial_file(folder, tmp_path):
     assert again.returncode in (0, 1), again.stderr
     assert f"{len(lines)} rows already done" in again.stderr
     rows = read_rows(out)
-    assert sorted(r["seed"] for r in rows) == list(range(1, 9))
+    assert sorted(r.seed for r in rows) == list(range(1, 9))
 
 
 def test_dask_local_cluster_runs_the_same_batch(folder, tmp_path):
@@ -139,8 +139,8 @@ def test_dask_local_cluster_runs_the_same_batch(folder, tmp_path):
     with cluster, distributed.Client(cluster) as client:
         rows = run_batch(tasks, tmp_path / "d.jsonl", executor="dask", scheduler=client)
     assert len(rows) == 4
-    assert sum(bool(r["error"]) for r in rows) == 2
-    assert all(r["solved"] for r in rows if not r["error"])
+    assert sum(r.is_error for r in rows) == 2
+    assert all(r.solved for r in rows if not r.is_error)
     assert len(read_rows(tmp_path / "d.jsonl")) == 4
 
 
@@ -160,28 +160,29 @@ def test_dask_process_workers_fork_warm_runs_with_the_same_paths(tmp_path):
     pytest.importorskip("distributed")
     problem = str(PROBLEMS / "static" / "single_circle.yaml")
     tasks = make_tasks([problem], ["RRTConnect", "RRT"], runs=2, seed=3, time_limit=1.0)
-    on_dask = {(r["planner"], r["seed"]): r for r in _cluster_batch(tasks, tmp_path / "d.jsonl")}
-    local = {(r["planner"], r["seed"]): r
+    on_dask = {(r.planner, r.seed): r for r in _cluster_batch(tasks, tmp_path / "d.jsonl")}
+    local = {(r.planner, r.seed): r
              for r in run_batch(tasks, tmp_path / "l.jsonl", jobs=2, optimum=False)}  # fmt: skip
-    assert len(on_dask) == 4 and not any(r["error"] for r in on_dask.values())
+    assert len(on_dask) == 4 and not any(r.is_error for r in on_dask.values())
     for key, row in local.items():
-        assert on_dask[key]["path"] == row["path"], key
+        assert on_dask[key].path == row.path, key
 
 
 def test_only_a_solved_row_gets_a_ratio():
     """An approximate path stops short of the goal, so it can be shorter than the optimum: it
     gets the optimum but no ratio (seen on the maze at 0.2 s: ratio 0.39 before the fix)."""
     from rrtpso_ompl.harness.batch import _Optima
+    from rrtpso_ompl.harness.record import RunRecord
 
     maze = str(PROBLEMS / "static" / "maze.yaml")
     optima = _Optima()
-    approximate = {"file": maze, "error": None, "solved": False, "length": 79.2}
-    solved = {"file": maze, "error": None, "solved": True, "length": 210.0}
-    for row in (approximate, solved):
-        optima.annotate(row)
-    assert approximate["optimum"] == pytest.approx(204.30, abs=0.01)
-    assert approximate["ratio"] is None
-    assert solved["ratio"] == pytest.approx(210.0 / solved["optimum"])
+    row = RunRecord(file=maze, planner="RRT", seed=1, run=0, status="approximate", length=79.2)
+    approximate = optima.annotate(row)
+    solved = optima.annotate(RunRecord(file=maze, planner="RRT", seed=1, run=0, status="exact",
+                                       solved=True, length=210.0))  # fmt: skip
+    assert approximate.optimum == pytest.approx(204.30, abs=0.01)
+    assert approximate.ratio is None
+    assert solved.ratio == pytest.approx(210.0 / solved.optimum)
 
 
 def test_an_unsolvable_file_is_an_unsolved_row_and_exit_1(tmp_path):
@@ -196,11 +197,12 @@ def test_an_unsolvable_file_is_an_unsolved_row_and_exit_1(tmp_path):
     proc = batch(str(wall), str(PROBLEMS / "static" / "single_circle.yaml"),
                  "--planner", "RRTConnect", "--time", "0.1", "--out", str(out))  # fmt: skip
     assert proc.returncode == 1, proc.stderr
-    rows = {r["problem"]: r for r in read_rows(out)}
-    assert rows["single_circle"]["solved"]
+    rows = {r.problem: r for r in read_rows(out)}
+    assert rows["single_circle"].solved
     walled = next(r for name, r in rows.items() if name != "single_circle")
-    assert not walled["solved"] and walled["error"] is None
-    assert walled["optimum"] is None and walled["ratio"] is None
+    assert not walled.solved and walled.error is None
+    assert walled.optimum is None and walled.ratio is None
+    assert walled.to_json()["optimum"] is None  # written as null: looked up, not connected
 
 
 def test_the_old_evaluation_package_still_imports_and_warns():

@@ -13,6 +13,7 @@ from helpers import PROBLEMS, rrtpso_exe
 from rrtpso_ompl.groundtruth.optimum import shortest_path
 from rrtpso_ompl.harness.batch import read_rows
 from rrtpso_ompl.harness.bench import run_bench, run_properties, summarise
+from rrtpso_ompl.harness.record import RunRecord
 from rrtpso_ompl.model.problem import load_problem
 from rrtpso_ompl.planners.result import BenchmarkRun
 
@@ -175,34 +176,35 @@ def test_property_mapping_takes_each_planner_s_own_figures():
     is guessed from the keys of ``stages``."""
     swarm = BenchmarkRun(time=0.85, solution_length=700.0, simplification_time=0.15,
                          simplified_length=650.0, properties={"pso rounds": ("INTEGER", 3)})
-    pso_row = {"solved": True, "status": "exact", "ompl_status": "Exact solution", "valid": True,
-               "length": 650.0, "time": 1.0, "optimum": 647.5, "seed": 3, "clearance": 0.1,
-               "stages": {"pso_length": 650.0, "pso_time": 0.15},
+    ids = {"file": "f", "planner": "A", "run": 0}
+    pso_row = {**ids, "solved": True, "status": "exact", "ompl_status": "Exact solution",
+               "valid": True, "length": 650.0, "time": 1.0, "optimum": 647.5, "seed": 3,
+               "clearance": 0.1, "stages": {"pso_length": 650.0, "pso_time": 0.15},
                "benchmark": swarm.to_dict()}  # fmt: skip
-    p = run_properties(pso_row)
+    p = run_properties(RunRecord.from_json(pso_row))
     assert p["time"] == pytest.approx(0.85) and p["simplification time"] == 0.15
     assert p["solution length"] == 700.0 and p["simplified solution length"] == 650.0
     assert p["length over optimum"] == pytest.approx(650 / 647.5) and p["total time"] == 1.0
     assert p["pso rounds"] == 3
     # A planner whose stats have pso_* keys but no simplification stage (the PSO baseline).
     baseline = {**pso_row, "benchmark": BenchmarkRun(time=1.0, solution_length=650.0).to_dict()}
-    p = run_properties(baseline)
+    p = run_properties(RunRecord.from_json(baseline))
     assert p["time"] == 1.0 and p["simplification time"] is None
     assert p["solution length"] == 650.0 and p["simplified solution length"] is None
-    stock = {"solved": True, "status": "exact", "ompl_status": "Exact solution", "valid": True,
-             "length": 660.0, "time": 1.0, "optimum": 647.5, "seed": 3,
+    stock = {**ids, "solved": True, "status": "exact", "ompl_status": "Exact solution",
+             "valid": True, "length": 660.0, "time": 1.0, "optimum": 647.5, "seed": 3,
              "benchmark": BenchmarkRun(time=1.0, solution_length=720.0, simplification_time=0.01,
                                        simplified_length=660.0).to_dict()}  # fmt: skip
-    p = run_properties(stock)
+    p = run_properties(RunRecord.from_json(stock))
     assert p["time"] == 1.0 and p["total time"] == pytest.approx(1.01)
     assert p["solution length"] == 720.0 and p["simplified solution length"] == 660.0
-    failed = {"solved": False, "status": "none", "ompl_status": "Timeout", "valid": False,
+    failed = {**ids, "solved": False, "status": "none", "ompl_status": "Timeout", "valid": False,
               "length": None, "time": 1.0, "optimum": 647.5, "seed": 4, "stages": {}}  # fmt: skip
-    p = run_properties(failed)
+    p = run_properties(RunRecord.from_json(failed))
     assert not p["solved"] and p["solution length"] is None and p["length over optimum"] is None
     summary = summarise(
-        [{**pso_row, "file": "f", "problem": "p", "planner": "A", "budget": 1.0},
-         {**failed, "file": "f", "problem": "p", "planner": "A", "budget": 1.0}], ["A"]
+        [RunRecord.from_json({**pso_row, "problem": "p", "budget": 1.0}),
+         RunRecord.from_json({**failed, "problem": "p", "budget": 1.0})], ["A"]
     )  # fmt: skip
     (s,) = summary
     assert s.runs == 2 and s.solved == 1 and s.success == 0.5
@@ -219,7 +221,7 @@ def test_dask_local_cluster_runs_a_bench(tmp_path):
     with cluster, distributed.Client(cluster) as client:
         result = run_bench([problem], ["RRTConnect"], tmp_path, runs=2, times=[0.1],
                            executor="dask", scheduler=client)  # fmt: skip
-    assert len(result.rows) == 2 and all(r["solved"] for r in result.rows)
+    assert len(result.rows) == 2 and all(r.solved for r in result.rows)
     assert result.database is not None and result.database.exists()
     assert [s.planner for s in result.summary] == ["RRTConnect"]
 

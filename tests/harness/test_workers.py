@@ -78,20 +78,20 @@ def test_same_seed_same_path_as_a_separate_solve(tmp_path):
     rows = run_batch(tasks, tmp_path / "r.jsonl", jobs=2, optimum=False)
     for row in rows:
         extra = [
-            a for k, v in params.get(row["planner"], {}).items() for a in ("--param", f"{k}={v}")
+            a for k, v in params.get(row.planner, {}).items() for a in ("--param", f"{k}={v}")
         ]
-        out = tmp_path / f"{row['planner']}_{row['seed']}.json"
-        subprocess.run([*rrtpso_exe(), "solve", problem, "--planner", row["planner"], "--seed",
-                        str(row["seed"]), "--time", "5", *extra, "--json", str(out)],
+        out = tmp_path / f"{row.planner}_{row.seed}.json"
+        subprocess.run([*rrtpso_exe(), "solve", problem, "--planner", row.planner, "--seed",
+                        str(row.seed), "--time", "5", *extra, "--json", str(out)],
                        check=False, capture_output=True, timeout=60)  # fmt: skip
         alone = json.loads(out.read_text())
-        assert alone["path"] == row["path"], row["planner"]
+        assert alone["path"] == row.path, row.planner
 
 
 def test_error_rows_name_the_task():
     task = Task(file="x.yaml", planner="RRTstar", seed=3, run=0, time_limit=1.0)
     row = error_row(task, "x.yaml: it broke")
-    assert row["status"] == "error" and row["seed"] == 3 and row["error"] == "x.yaml: it broke"
+    assert row.status == "error" and row.seed == 3 and row.error == "x.yaml: it broke"
 
 
 # ----------------------------------------------------------------------------------------------

@@ -133,3 +133,40 @@ def test_declared_option_sets_are_dataclasses_with_one_declaration_per_field():
         @declared
         class Bad:
             x: int = 3
+
+
+def test_declared_fields_may_be_optional_or_fixed_tuples():
+    """A default that depends on other values is None (the doc says what it stands for), and a
+    range is a pair, each value checked against the declared range (issue 23: the generator's
+    radius_range and vertices)."""
+    from rrtpso_ompl.planners.params import declared, param
+
+    @declared
+    class Field:
+        """A field of obstacles."""
+
+        radius: float | None = param(None, "A radius. Default: a tenth of the size.", low=0.0)
+        span: tuple[int, int] = param((3, 8), "Least and most corners.", low=3)
+
+    assert Field().radius is None and Field(radius=2.0).radius == 2.0
+    span = Field.PARAMS["span"]
+    assert (span.length, span.type, Field.PARAMS["radius"].optional) == (2, int, True)
+    assert span.convert("4 6") == (4, 6) == span.convert("4,6") == span.convert([4.0, 6])
+    with pytest.raises(ParameterError, match="'span' of Field must be a pair of int, got int 3"):
+        Field(span=3)
+    with pytest.raises(ParameterError, match=r"'span' of Field must be in \[3, inf\] each, got 2"):
+        Field(span=(2, 5))
+    with pytest.raises(ParameterError, match="must be an integer, got str '4'"):
+        span.convert(["4", "6"], text=False)  # a YAML file's values are typed
+    with pytest.raises(ParameterError, match=r"'radius' of Field must be in \[0, inf\]"):
+        Field(radius=-1.0)
+    table = Field.PARAMS.markdown()
+    assert "| `radius` | float or None | None |" in table
+    assert "| `span` | (int, int) | (3, 8) | – | [3, inf] each |" in table
+    assert "radius : float or None, default None" in Field.__doc__
+
+    with pytest.raises(TypeError, match="one type, or one type or None"):
+
+        @declared
+        class Either:
+            x: int | str = param(3, "Either.")
