@@ -40,9 +40,9 @@ def _task(tmp_path, **kw) -> Task:
 def _result() -> SolveResult:
     return SolveResult(
         problem="p", planner="RRTstarPSO", status="exact", ompl_status="Exact solution",
-        solved=True, length=12.5, time=0.49, seed=3, path=np.array([[0.0, 0.0], [12.5, 0.0]]),
+        length=12.5, time=0.49, seed=3, path=np.array([[0.0, 0.0], [12.5, 0.0]]),
         time_limit=0.5, params={"iterations": 50}, stages={"pso_time": 0.1}, clearance=0.25,
-        valid=True, benchmark=BenchmarkRun(time=0.39, solution_length=13.0,
+        benchmark=BenchmarkRun(time=0.39, solution_length=13.0,
                                            simplification_time=0.1, simplified_length=12.5,
                                            properties={"iterations": ("INTEGER", 80)},
                                            progress=[(0.1, 14.0), (0.39, 13.0)]),
