@@ -170,16 +170,29 @@ class Grid:
         """(query, cell) pairs to unique (query, id) pairs through the CSR arrays."""
         if not len(cells):
             return np.empty(0, dtype=np.intp), np.empty(0, dtype=np.intp)
-        key = np.unique(query.astype(np.int64) * (self.nx * self.ny) + cells)
+        key = _unique_ints(query.astype(np.int64) * (self.nx * self.ny) + cells)
         query, cells = np.divmod(key, self.nx * self.ny)
         start, stop = self.offsets[cells], self.offsets[cells + 1]
         counts = stop - start
         q = np.repeat(query, counts)
         k = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
         ids = self.ids[np.repeat(start, counts) + k]
-        key = np.unique(q * max(self.n_items, 1) + ids)
+        key = _unique_ints(q.astype(np.int64) * max(self.n_items, 1) + ids)
         q, ids = np.divmod(key, max(self.n_items, 1))
         return q.astype(np.intp), ids.astype(np.intp)
+
+
+def _unique_ints(key: np.ndarray) -> np.ndarray:
+    """``np.unique`` of an integer array, by sorting: numpy 2's hash-based ``np.unique`` is an
+    order of magnitude slower on the millions of keys a bulk query makes (4.8 s against 0.3 s for
+    2 million int64, numpy 2.4), and it was the exact optimum's hot spot."""
+    if len(key) < 2:
+        return key.copy()
+    key = np.sort(key)
+    keep = np.empty(len(key), dtype=bool)
+    keep[0] = True
+    np.not_equal(key[1:], key[:-1], out=keep[1:])
+    return key[keep]
 
 
 def _csr(i0, i1, j0, j1, counts, nx: int, n_cells: int) -> tuple[np.ndarray, np.ndarray]:
