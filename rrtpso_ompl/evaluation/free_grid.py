@@ -89,6 +89,8 @@ class FreeGrid:
         self.h = float(h)
         self.free = np.asarray(free, dtype=bool)
         self._core = ~self.free
+        #: Share of core cells (the raster's rejection is worth running only with some).
+        self.core_share = float(self._core.mean()) if self._core.size else 0.0
         self.ny, self.nx = self.free.shape
         self.start = np.asarray(start, dtype=float)
         self.goal = np.asarray(goal, dtype=float)
@@ -242,10 +244,13 @@ class FreeGrid:
         n8 = np.ceil(np.hypot(dx, dy) / self.H) + 1.0
         n4 = (np.abs(dx) + np.abs(dy)) / self.H + 3.0
         ok = np.ones(n8.shape, dtype=bool)
-        for k, n in ((0, n8), (1, n4), (2, n8), (3, n4)):
-            a, b = ranges_a[..., k, :], ranges_b[..., k, :]
-            ok &= b[..., 0] - a[..., 1] <= n
-            ok &= a[..., 0] - b[..., 1] <= n
+        # inf - inf (NaN, compared False) only where a point's cells are all unreachable: no
+        # free segment touches it.
+        with np.errstate(invalid="ignore"):
+            for k, n in ((0, n8), (1, n4), (2, n8), (3, n4)):
+                a, b = ranges_a[..., k, :], ranges_b[..., k, :]
+                ok &= b[..., 0] - a[..., 1] <= n
+                ok &= a[..., 0] - b[..., 1] <= n
         return ok
 
     # ------------------------------------------------------------------------------------------
