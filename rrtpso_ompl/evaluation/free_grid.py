@@ -273,6 +273,78 @@ class FreeGrid:
             out[alive[self._hits(a[alive], b[alive], spacing)]] = True
         return out
 
+    def segments_near_blocked(self, a: np.ndarray, b: np.ndarray, threshold: float) -> np.ndarray:
+        """Which segments come closer than ``threshold`` to a blocked cell (booleans): the exact
+        test of a world made only of the lattice's boxes, straight from the cells.
+
+        Samples at most a cell apart leave every point of a segment within half a cell of one,
+        so a cell closer than ``threshold`` to the segment lies within
+        ``ceil(threshold / h + 1/2)`` cells of a sample's; the distance to each blocked cell
+        found there is the world's own segment-box formula, so the answer is the world's
+        (``World.segments_free`` is its negation, bounds apart). Only for thresholds of up to
+        :data:`MAX_BAND` cells minus a half (:attr:`band_ok`).
+        """
+        from ..model.world import _segment_box_distance_v
+
+        a = np.asarray(a, dtype=float).reshape(-1, 2)
+        b = np.asarray(b, dtype=float).reshape(-1, 2)
+        out = np.zeros(len(a), dtype=bool)
+        if not len(a) or self.blocked is None:
+            return out
+        k = math.ceil(threshold / self.h + 0.5)
+        off = np.arange(-k, k + 1)
+        di, dj = (v.ravel() for v in np.meshgrid(off, off))
+        d = b - a
+        n = np.ceil(np.hypot(d[:, 0], d[:, 1]) / self.h).astype(np.intp) + 1
+        starts = np.concatenate([[0], np.cumsum(n)])
+        cut = np.searchsorted(starts, np.arange(0, starts[-1], _BAND_CHUNK))
+        bounds = np.unique(np.concatenate([cut, [len(a)]]))
+        blocked = self.blocked
+        for s0, s1 in itertools.pairwise(bounds.tolist()):
+            nn = n[s0:s1]
+            seg = np.repeat(np.arange(s0, s1), nn)
+            t = (np.arange(nn.sum()) - np.repeat(np.cumsum(nn) - nn, nn)) / np.maximum(
+                nn[seg - s0] - 1, 1)  # fmt: skip
+            i = np.floor((a[seg, 0] + t * d[seg, 0] - self.x0) / self.h).astype(np.intp)
+            j = np.floor((a[seg, 1] + t * d[seg, 1] - self.y0) / self.h).astype(np.intp)
+            # Only samples with a blocked cell in their window need the window.
+            near = self._near_blocked(k)
+            inside = (i >= 0) & (i < self.nx) & (j >= 0) & (j < self.ny)
+            look = np.zeros(len(i), dtype=bool)
+            look[inside] = near[j[inside], i[inside]]
+            look |= ~inside  # a sample just outside the raster: look anyway
+            i, j, seg = i[look], j[look], seg[look]
+            ii = (i[:, None] + di[None, :]).ravel()
+            jj = (j[:, None] + dj[None, :]).ravel()
+            ss = np.repeat(seg, len(di))
+            inside = (ii >= 0) & (ii < self.nx) & (jj >= 0) & (jj < self.ny)
+            ii, jj, ss = ii[inside], jj[inside], ss[inside]
+            hit = blocked[jj, ii]
+            ii, jj, ss = ii[hit], jj[hit], ss[hit]
+            if not len(ss):
+                continue
+            # Each (segment, cell) pair once: neighbouring samples see the same cells.
+            key = _sorted_unique((ss.astype(np.int64) * self.ny + jj) * self.nx + ii)
+            ss, rest = np.divmod(key, self.ny * self.nx)
+            jj, ii = np.divmod(rest, self.nx)
+            x0 = self.x0 + ii * self.h
+            y0 = self.y0 + jj * self.h
+            box = np.column_stack([x0, y0, x0 + self.h, y0 + self.h])
+            dist = _segment_box_distance_v(a[ss], b[ss], box)
+            out[ss[dist < threshold]] = True
+        return out
+
+    def _near_blocked(self, k: int) -> np.ndarray:
+        """Cells with a blocked cell within ``k`` cells each way (cached per ``k``)."""
+        cache = self.__dict__.setdefault("_near_cache", {})
+        if k not in cache:
+            cache[k] = ndimage.maximum_filter(self.blocked, size=2 * k + 1, mode="constant")
+        return cache[k]
+
+    def band_ok(self, threshold: float) -> bool:
+        """Whether :meth:`segments_near_blocked` serves this threshold."""
+        return self.blocked is not None and threshold / self.h + 0.5 <= MAX_BAND
+
     def _hits(self, a: np.ndarray, b: np.ndarray, spacing: float) -> np.ndarray:
         """Which segments have a sample (``spacing`` apart, ends excluded) in a core cell."""
         out = np.zeros(len(a), dtype=bool)
@@ -293,6 +365,23 @@ class FreeGrid:
             hit[inside] = self._core[j[inside], i[inside]]
             out[seg[hit]] = True
         return out
+
+
+#: Most cells each way around a sample that :meth:`FreeGrid.segments_near_blocked` looks at.
+MAX_BAND = 2
+#: Samples per vectorised step of :meth:`FreeGrid.segments_near_blocked`.
+_BAND_CHUNK = 100_000
+
+
+def _sorted_unique(key: np.ndarray) -> np.ndarray:
+    """``np.unique`` by sorting (numpy 2's hash-based one is much slower on large arrays)."""
+    if len(key) < 2:
+        return key
+    key = np.sort(key)
+    keep = np.empty(len(key), dtype=bool)
+    keep[0] = True
+    np.not_equal(key[1:], key[:-1], out=keep[1:])
+    return key[keep]
 
 
 def _box_lattice(world: World) -> tuple[tuple[float, float], float, np.ndarray] | None:
