@@ -108,3 +108,12 @@ def test_bench_logs_its_rows(tmp_path):
     assert runs[0]["solution_length"] == pytest.approx(exact[0]["length"])
     assert runs[0]["time"] > 0 and runs[0]["graph_nodes"] > 0
     assert runs[0]["length_over_optimum"] == pytest.approx(1.0, abs=2e-4)
+
+
+def test_documented_parameter_table_matches_the_registry():
+    """docs/planners.md is generated from the registry (python benchmarks/param_tables.py)."""
+    from helpers import REPO
+
+    text = (REPO / "docs" / "planners.md").read_text()
+    table = default_registry().get("Exact").params.markdown()
+    assert f"<!-- params:Exact -->\n{table}\n<!-- /params:Exact -->" in text
