@@ -868,66 +868,66 @@ class _TangentSearch:
         gap = dist - c[i, 2] - c[j, 2]
         beta = np.arcsin(np.clip((c[i, 2] + c[j, 2]) / np.maximum(dist, 1e-300), 0.0, 1.0))
         phi = np.mod(np.arctan2(d[:, 1], d[:, 0]), _TWO_PI)
+        # Profiles only for the circles with many pairs (else the tangent-level filters are
+        # cheaper than the table).
+        count = np.bincount(row, minlength=len(batch))
+        busy = np.flatnonzero(count >= _SHADOW_WORTH)
+        if not len(busy):
+            return row, j
+        tables = self._shadow_tables(batch[busy])  # (senses, busy, levels, bins)
+        slot = np.full(len(batch), -1, dtype=np.intp)
+        slot[busy] = np.arange(len(busy))
+        mine = np.flatnonzero(slot[row] >= 0)
+        lo = np.floor((phi[mine] - beta[mine] - 1e-9) / _SHADOW_BIN).astype(np.intp)
+        hi = np.floor((phi[mine] + beta[mine] + 1e-9) / _SHADOW_BIN).astype(np.intp)
+        reach = np.max([_range_max(t, slot[row[mine]], lo, hi) for t in tables], axis=0)
         keep = np.ones(len(row), dtype=bool)
-        order = np.argsort(row, kind="stable")
-        cuts = np.searchsorted(row[order], np.arange(len(batch) + 1))
-        for b in range(len(batch)):
-            mine = order[cuts[b] : cuts[b + 1]]
-            if len(mine) < _SHADOW_WORTH:
-                continue  # few pairs: the tangent-level filters are cheaper than the table
-            tables = self._shadow_tables(int(batch[b]))
-            if tables is None:
-                continue
-            lo = np.floor((phi[mine] - beta[mine] - 1e-9) / _SHADOW_BIN).astype(np.intp)
-            hi = np.floor((phi[mine] + beta[mine] + 1e-9) / _SHADOW_BIN).astype(np.intp)
-            reach = np.max([_range_max(t, lo, hi) for t in tables], axis=0)
-            keep[mine] = gap[mine] < reach
+        keep[mine] = gap[mine] < reach
         return row[keep], j[keep]
 
-    def _shadow_tables(self, i: int):
-        """Range-maximum tables of circle ``i``'s bound per bin of directions, one per sense, or
-        None when no near disc casts a shadow (:meth:`_shadowed`)."""
+    def _shadow_tables(self, circles: np.ndarray) -> list[np.ndarray]:
+        """Range-maximum tables of each circle's bound per bin of directions, one per sense:
+        arrays ``(circles, levels, bins)`` (:meth:`_shadowed`)."""
         w = self.world
-        if not w.n_obstacles:
-            return None
-        c, rho = self.circles[i, :2], float(self.circles[i, 2])
-        reach = rho + _SHADOW_CELLS * w._grid.h
-        _, ids = w._grid.pairs_in_boxes(c - reach, c + reach)
-        kind = w._kind_of(ids)
-        circ = w.circles[ids[kind == 0]]
-        discs = [np.column_stack([circ[:, :2], circ[:, 2] + w.threshold])]
-        box = w.boxes[ids[kind == 1] - w._n_circles]
-        if len(box):
-            half = 0.5 * np.minimum(box[:, 2] - box[:, 0], box[:, 3] - box[:, 1])
-            discs.append(np.column_stack([0.5 * (box[:, :2] + box[:, 2:]), half + w.threshold]))
-        disc = np.vstack(discs)
-        rel = disc[:, :2] - c
-        dist = np.hypot(rel[:, 0], rel[:, 1])
-        # Strictly inside (grazing tangents stay candidates); the circle's own obstacle, at
-        # distance 0, blocks nothing a tangent to it could use.
-        r = disc[:, 2] - 4.0 * w.tol
-        use = (r > 0) & (dist > 0)
-        if not use.any():
-            return None
-        theta, dist, r = np.arctan2(rel[use, 1], rel[use, 0]), dist[use], r[use]
-        tables = []
-        for sense in (1.0, -1.0) if rho > 0 else (0.0,):
-            lo = np.clip((sense * rho - r) / dist, -1.0, 1.0)
-            hi = np.clip((sense * rho + r) / dist, -1.0, 1.0)
-            ok = hi > lo
-            a0 = theta[ok] + np.arcsin(lo[ok])
-            a1 = theta[ok] + np.arcsin(hi[ok])
-            first = np.ceil(a0 / _SHADOW_BIN + 1e-9).astype(np.intp)
-            last = np.floor(a1 / _SHADOW_BIN - 1e-9).astype(np.intp) - 1
-            n = np.maximum(last - first + 1, 0)
-            bins = np.full(_SHADOW_BINS, np.inf)
-            if n.sum():
-                k = np.repeat(first, n) + (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n))
-                np.minimum.at(bins, np.mod(k, _SHADOW_BINS), np.repeat(dist[ok], n))
-            tables.append(_sparse_max(bins))
-        if all(np.isinf(t[0]).all() for t in tables):
-            return None
-        return tables
+        c, rho = self.circles[circles, :2], self.circles[circles, 2]
+        bins = np.full((2, len(circles), _SHADOW_BINS), np.inf)
+        if w.n_obstacles:
+            reach = (rho + _SHADOW_CELLS * w._grid.h)[:, None]
+            query, ids = w._grid.pairs_in_boxes(c - reach, c + reach)
+            kind = w._kind_of(ids)
+            disc = np.empty((len(ids), 3))
+            x = kind == 0
+            disc[x] = w.circles[ids[x]]
+            disc[x, 2] += w.threshold
+            x = kind == 1
+            box = w.boxes[ids[x] - w._n_circles]
+            disc[x, :2] = 0.5 * (box[:, :2] + box[:, 2:])
+            disc[x, 2] = 0.5 * np.minimum(box[:, 2] - box[:, 0], box[:, 3] - box[:, 1])
+            disc[x, 2] += w.threshold
+            use = kind != 2  # polygons cast no shadow here
+            # Strictly inside (grazing tangents stay candidates); the circle's own obstacle, at
+            # distance 0, blocks nothing a tangent to it could use.
+            rel = disc[:, :2] - c[query]
+            dist = np.hypot(rel[:, 0], rel[:, 1])
+            r = disc[:, 2] - 4.0 * w.tol
+            use &= (r > 0) & (dist > 0)
+            q, theta = query[use], np.arctan2(rel[use, 1], rel[use, 0])
+            dist, r, rq = dist[use], r[use], rho[query[use]]
+            for k, sense in enumerate((1.0, -1.0)):
+                lo = np.clip((sense * rq - r) / dist, -1.0, 1.0)
+                hi = np.clip((sense * rq + r) / dist, -1.0, 1.0)
+                ok = hi > lo
+                first = np.ceil((theta[ok] + np.arcsin(lo[ok])) / _SHADOW_BIN + 1e-9)
+                last = np.floor((theta[ok] + np.arcsin(hi[ok])) / _SHADOW_BIN - 1e-9) - 1
+                first, last = first.astype(np.intp), last.astype(np.intp)
+                n = np.maximum(last - first + 1, 0)
+                if not n.sum():
+                    continue
+                step = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+                cell = np.repeat(q[ok], n) * _SHADOW_BINS + np.mod(np.repeat(first, n) + step,
+                                                                   _SHADOW_BINS)  # fmt: skip
+                np.minimum.at(bins[k].reshape(-1), cell, np.repeat(dist[ok], n))
+        return [_sparse_max(bins[0]), _sparse_max(bins[1])]
 
     def _blocked_near(self, cand: _Tangents) -> np.ndarray:
         """Tangents that come too close to an obstacle near the circle they leave (booleans; the
@@ -1007,36 +1007,38 @@ _SHADOW_BINS = 1024
 _SHADOW_BIN = _TWO_PI / _SHADOW_BINS
 _SHADOW_CELLS = 8.0
 #: A circle's shadow profile is built when it has at least this many candidate pairs.
-_SHADOW_WORTH = 200
+_SHADOW_WORTH = 100
 #: The raster's rejection is run when at least this share of its cells is core.
 _RASTER_WORTH = 0.02
 
 
 def _sparse_max(values: np.ndarray) -> np.ndarray:
-    """Range-maximum table of a circular array: row k holds the maxima of windows of 2^k."""
-    n = len(values)
+    """Range-maximum tables of circular arrays ``(n, bins)``: ``(n, levels, bins)``, level k
+    holding the maxima of windows of 2^k."""
+    m = values.shape[-1]
     rows = [values]
     step = 1
-    while 2 * step <= n:
+    while 2 * step <= m:
         prev = rows[-1]
-        ahead = np.concatenate([prev[step:], prev[:step]])
+        ahead = np.concatenate([prev[:, step:], prev[:, :step]], axis=1)
         rows.append(np.maximum(prev, ahead))
         step *= 2
-    return np.stack(rows)
+    return np.stack(rows, axis=1)
 
 
-def _range_max(table: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """Maxima of the circular array over the index ranges ``lo..hi`` (``hi >= lo``; a range of
-    the whole circle or more gives the maximum of all)."""
-    n = table.shape[1]
+def _range_max(table: np.ndarray, which: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """Maxima of the circular arrays ``which`` over the index ranges ``lo..hi`` (``hi >= lo``;
+    a range of the whole circle or more gives the maximum of all)."""
+    m = table.shape[-1]
     length = hi - lo + 1
-    out = np.full(len(lo), table[-1].max())
-    part = length < n
+    out = table[:, -1].max(axis=1)[which]
+    part = length < m
     if part.any():
         k = np.floor(np.log2(length[part])).astype(np.intp)
-        a = np.mod(lo[part], n)
-        b = np.mod(hi[part] - (1 << k) + 1, n)
-        out[part] = np.maximum(table[k, a], table[k, b])
+        a = np.mod(lo[part], m)
+        b = np.mod(hi[part] - (1 << k) + 1, m)
+        w = which[part]
+        out[part] = np.maximum(table[w, k, a], table[w, k, b])
     return out
 
 
