@@ -44,7 +44,8 @@ from ..model.world import World
 __all__ = ["FreeGrid", "Stopped"]
 
 _SQRT2 = math.sqrt(2.0)
-#: Cells of the raster over a world without a map (per side of the longer side of the bounds).
+#: Most cells of the raster over a world without a map, along the longer side of the bounds (16
+#: times the square root of the number of obstacles, at least 32).
 GENERIC_CELLS = 192
 #: Most cells of the breadth-first search: finer rasters are searched in blocks of k x k cells.
 MAX_SEARCH_CELLS = 300_000
@@ -112,8 +113,8 @@ class FreeGrid:
     def for_world(cls, world: World, start, goal, goal_tolerance: float = 0.0,
                   terminate=None) -> FreeGrid:  # fmt: skip
         """The raster of a world: the lattice of its boxes when they have one (a map's cells;
-        then :attr:`blocked` holds the cells the boxes cover), else :data:`GENERIC_CELLS` cells
-        per side through the world's exact clearance.
+        then :attr:`blocked` holds the cells the boxes cover), else 32 to :data:`GENERIC_CELLS`
+        cells per side (more with more obstacles) through the world's exact clearance.
 
         Circles and polygons on top of a lattice of boxes are left out of the raster: that only
         makes more cells possibly free, which keeps both uses exact. ``terminate`` is polled
@@ -136,7 +137,10 @@ class FreeGrid:
             grid.blocked = blocked
             return grid
         (xmin, ymin), (xmax, ymax) = world.bounds
-        h = max(xmax - xmin, ymax - ymin) / GENERIC_CELLS
+        # A few cells per obstacle: a handful of obstacles needs no fine raster (its set-up,
+        # the exact clearance at every centre, would cost more than the search).
+        side = int(np.clip(round(16.0 * math.sqrt(world.n_obstacles + 1)), 32, GENERIC_CELLS))
+        h = max(xmax - xmin, ymax - ymin) / side
         nx = max(1, math.ceil((xmax - xmin) / h))
         ny = max(1, math.ceil((ymax - ymin) / h))
         gx, gy = np.meshgrid(xmin + (np.arange(nx) + 0.5) * h, ymin + (np.arange(ny) + 0.5) * h)
