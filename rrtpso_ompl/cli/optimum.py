@@ -16,9 +16,9 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         parents=parents,
         help="compute the exact shortest path (the reference for path-length ratios)",
         description="Compute the exact shortest path for the problem's disc robot among its "
-        "circles and polygons: a tangent graph with arcs around the inflated obstacles, searched "
-        "with Dijkstra's algorithm (docs/benchmarking.md). Moving obstacles are ignored. Exit "
-        "status 0 when a path exists, 1 when none does.",
+        "circles, polygons and map cells: a tangent graph with arcs around the inflated "
+        "obstacles, searched with A* and geodesic lower bounds (docs/benchmarking.md). Moving "
+        "obstacles are ignored. Exit status 0 when a path exists, 1 when none does.",
     )
     o.add_argument("problem", help="problem file (YAML)")
     o.add_argument("--json", metavar="OUT", help='write {"length": ..., "path": [...], ...}')

@@ -9,23 +9,42 @@ segments tangent to these circles and arcs along them (the tangent or "reduced v
 LaValle, *Planning Algorithms*, 2006, section 6.2.4; Latombe 1991 for the polygonal case):
 
 1. **Circles**: the start and the goal (radius 0), every obstacle circle (``r + R``), every convex
-   vertex of a polygon and every convex corner of the union of the boxes (``R``; for a map, the
-   corners where exactly one of the four cells around a grid point is blocked).
+   vertex of a polygon and every convex corner of the union of the boxes (``R``). When the boxes
+   lie on one lattice (a map's merged cells), the corners come straight from the cells: the grid
+   points where exactly one of the four cells around is blocked. A vertex's circle carries its
+   *cone*: a path wraps it only between the outward normals of its two edges (a quarter circle
+   at a map corner), elsewhere it would enter an edge's offset.
 2. **A\* over tangents, built as it goes.** A node is a tangent point on a circle and the sense
    (clockwise or counter-clockwise) in which the path wraps that circle; from it the path follows
    the circle in that sense and leaves along a common tangent (two outer and two inner per pair of
    circles) to another circle. An edge (arc, then tangent) is kept when the arc and the tangent
    segment are free: exact distances to the candidate obstacles the spatial index names, the
-   bounds for the arc's extreme points. The heuristic is the straight distance to the goal.
-3. **Pruning that keeps exactness.** A valid path of length ``C`` (the grid certificate of
-   :func:`~rrtpso_ompl.groundtruth.certify.grid_path`) bounds the optimum, so a circle that cannot
-   touch the ellipse ``|x - start| + |x - goal| <= C`` is never a candidate, and an edge whose end
-   already needs more than ``C`` is never checked. Only the tangents of the circles A\* expands are
-   ever built, instead of those of every pair: 10,000 circles take seconds, not terabytes.
+   bounds for the arc's extreme points (no test where nothing else is near the circle).
+3. **A conservative raster** (:mod:`.free_grid`): the cells that may hold a free configuration,
+   a superset of the free space. Breadth-first step counts over them from the start's cell and
+   the goal's give *geodesic lower bounds* (a maze's corridors, not the straight line), used as
+   A\*'s heuristic and for pruning; they also prove a problem unsolvable when the goal's cell is
+   not reached. The heuristic is admissible but not consistent, so a node whose cost improves
+   after its expansion is expanded again; A\* with an admissible heuristic and re-expansion
+   returns the optimum.
+4. **Pruning that keeps exactness.** The search runs in rounds of growing bounds ``C`` (multiples
+   of the lower bound at the start): a circle that no path within ``C`` can touch (the geodesic
+   ellipse ``LB_start + LB_goal <= C``) is never a candidate, nor is a tangent that no path within
+   ``C`` can use; a round that finds nothing proves the optimum longer than its bound, and the
+   next looks further. A tangent is free or not whatever node leaves along it, so each circle's
+   free tangents are found once, for a batch of circles at a time (those A\* will likely expand
+   next), through filters that each drop only what could not be used, cheapest first: circle pairs
+   beyond the bound; pairs whose step counts differ by more than a free segment between them
+   allows (the counts change by at most a step per cell along a free segment); directions
+   outside the cones; pairs in the shadow of the discs near the first circle; tangents beyond the
+   bound; then the exact tests (obstacles near the circle first, then the world's), with the
+   raster's sound rejection (a sample in a cell where nothing is free) in between on maps.
+5. **Dominance.** Where a circle's arc is free, a node reached at no more cost earlier on the
+   arc, in the same sense, covers a later one: the later one is not expanded.
 
 Every edge is a piece of a valid path (touching an obstacle is allowed, as everywhere in this
 package), so the result is never shorter than the true optimum; and the true optimum is a path of
-this graph, which A\* with a consistent heuristic searches exactly, so the result is exact up to
+this graph, which the search covers within its final bound, so the result is exact up to
 floating-point round-off. The box bounds add no circles: from inside, the box is convex, and so is
 every corner where an obstacle meets it, and a shortest path bends only around corners that are
 convex seen from the obstacle.
@@ -33,7 +52,11 @@ convex seen from the obstacle.
 The free configuration space is closed (touching allowed). For a point robot (``R = 0``) a path
 grazing a polygon corner would touch it with zero clearance, which the package's segment test
 counts as entering; the corners are therefore rounded with a radius of twice the touch tolerance
-(``2e-9`` of the workspace size), which changes the length by less than that.
+(``2e-9`` of the workspace size), which changes the length by less than that. Two map cells that
+touch only at a corner therefore close the diagonal between them.
+
+Nothing here imports OMPL: :func:`shortest_path_in_world` needs only a
+:class:`~rrtpso_ompl.model.World` and a query.
 """
 
 from __future__ import annotations
@@ -42,6 +65,7 @@ import heapq
 import itertools
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -51,8 +75,16 @@ from ..errors import RrtpsoError
 from ..model.geometry import point_segment_distance
 from ..model.problem import Problem
 from ..model.world import World
+from .free_grid import FreeGrid, Stopped
 
-__all__ = ["MAX_NODES", "OptimumResult", "OptimumTooLarge", "Piece", "shortest_path"]
+__all__ = [
+    "MAX_NODES",
+    "OptimumResult",
+    "OptimumTooLarge",
+    "Piece",
+    "shortest_path",
+    "shortest_path_in_world",
+]
 
 _TWO_PI = 2.0 * math.pi
 
@@ -138,9 +170,14 @@ class OptimumResult:
         False only with a ``goal_tolerance`` disc that is not wholly free, where the length is
         that of the best path to the goal point's tangents (an upper bound).
     n_nodes, n_edges : int
-        Size of the tangent graph.
+        Size of the tangent graph of the last round.
     time : float
         Seconds spent.
+    stopped : bool
+        The search was stopped (its ``terminate`` callback) before it knew: ``length`` is None
+        and says nothing.
+    rounds : int
+        Rounds of growing bounds the search took (module docstring).
     """
 
     problem: str
@@ -150,6 +187,8 @@ class OptimumResult:
     n_nodes: int = 0
     n_edges: int = 0
     time: float = 0.0
+    stopped: bool = False
+    rounds: int = 0
 
     @property
     def found(self) -> bool:
@@ -197,7 +236,7 @@ class OptimumResult:
             "problem": self.problem,
             "exact": self.exact,
             "pieces": [p.to_dict() for p in self.pieces],
-            "graph": {"nodes": self.n_nodes, "edges": self.n_edges},
+            "graph": {"nodes": self.n_nodes, "edges": self.n_edges, "rounds": self.rounds},
             "time": self.time,
         }
 
@@ -212,7 +251,11 @@ class OptimumTooLarge(RrtpsoError):
 
 # ----------------------------------------------------------------------------------------------
 def shortest_path(
-    problem: Problem, world: World | None = None, upper_bound: float | None = None
+    problem: Problem,
+    world: World | None = None,
+    upper_bound: float | None = None,
+    *,
+    terminate: Callable[[], bool] | None = None,
 ) -> OptimumResult:
     """The shortest collision-free path of ``problem`` for its disc robot (moving obstacles
     ignored).
@@ -224,67 +267,130 @@ def shortest_path(
     world : World, optional
         Its static world, when already built.
     upper_bound : float, optional
-        The length of any valid path (it prunes the search); by default the grid certificate's.
+        The length of any valid path, or ``inf``: the search never looks beyond it. By default
+        none is needed: the search runs in rounds of growing bounds (module docstring).
+    terminate : callable, optional
+        Polled between expansions; when it returns True the search stops and the result has
+        ``stopped`` set and no path.
 
     Returns
     -------
     OptimumResult
-        ``length`` None when no path exists.
+        ``length`` None when no path exists (or when stopped).
 
     Raises
     ------
     OptimumTooLarge
         When the search would create more than :data:`MAX_NODES` tangent nodes.
     """
-    t0 = time.perf_counter()
     world = world or World.from_problem(problem)
+    return shortest_path_in_world(
+        world, problem.start[:2], problem.goal[:2], float(problem.goal_tolerance),
+        upper_bound=upper_bound, terminate=terminate, name=problem.name, source=problem.source,
+    )  # fmt: skip
+
+
+def shortest_path_in_world(
+    world: World,
+    start,
+    goal,
+    goal_tolerance: float = 0.0,
+    *,
+    upper_bound: float | None = None,
+    terminate: Callable[[], bool] | None = None,
+    name: str = "",
+    source: str = "<world>",
+) -> OptimumResult:
+    """:func:`shortest_path` for a :class:`~rrtpso_ompl.model.World` and a query (what the
+    ``Exact`` planner has: no problem file).
+
+    Parameters
+    ----------
+    world : World
+        Obstacles, bounds and robot radius.
+    start, goal : (float, float)
+        The query, problem units.
+    goal_tolerance : float
+        Radius of the goal disc (0: the goal point).
+    upper_bound, terminate
+        As for :func:`shortest_path`.
+    name, source : str
+        The problem's name (for the result) and where it came from (for messages).
+    """
+    t0 = time.perf_counter()
     radius = max(world.robot_radius, 2.0 * world.tol)  # see the module docstring for R = 0
     if radius != world.robot_radius:
         world = world.with_robot_radius(radius)
-    start = np.asarray(problem.start[:2], dtype=float)
-    goal = np.asarray(problem.goal[:2], dtype=float)
-    goal_tol = float(problem.goal_tolerance)
-    if math.dist(start, goal) <= goal_tol or np.array_equal(start, goal):
-        still = Piece("line", tuple(map(float, start)), tuple(map(float, start)))
-        return OptimumResult(problem.name, 0.0, [still], True, 1, 0, time.perf_counter() - t0)
-    if upper_bound is None:
-        upper_bound = _grid_bound(problem, world)
-    circles = _node_circles(problem, world, start, goal, radius)
-    search = _TangentSearch(world, circles, goal_tol, upper_bound, problem.source)
-    found = search.run()
+    start = np.asarray(start, dtype=float)[:2]
+    goal = np.asarray(goal, dtype=float)[:2]
+    goal_tol = float(goal_tolerance)
     exact = goal_tol == 0.0 or bool(
         world.point_clearance(goal[None])[0] >= goal_tol + world.threshold
     )
-    if found is None:
-        return OptimumResult(problem.name, None, [], exact, search.n_nodes, search.n_edges,
-                             time.perf_counter() - t0)  # fmt: skip
-    length, pieces = found
-    pieces = _merge_arcs([p for p in pieces if p.length > 0.0] or pieces[:1])
-    return OptimumResult(
-        problem=problem.name,
-        length=length,
-        pieces=pieces,
-        exact=exact,
-        n_nodes=search.n_nodes,
-        n_edges=search.n_edges,
-        time=time.perf_counter() - t0,
-    )
+    if math.dist(start, goal) <= goal_tol or np.array_equal(start, goal):
+        still = Piece("line", tuple(map(float, start)), tuple(map(float, start)))
+        return OptimumResult(name, 0.0, [still], True, 1, 0, time.perf_counter() - t0)
+    stop = terminate if terminate is not None else (lambda: False)
+    if stop():
+        return OptimumResult(name, None, [], exact, 0, 0, time.perf_counter() - t0, True, 0)
+    try:
+        grid = FreeGrid.for_world(world, start, goal, goal_tol, terminate)
+    except Stopped:
+        return OptimumResult(name, None, [], exact, 0, 0, time.perf_counter() - t0, True, 0)
+
+    def result(found, search=None, stopped=False, rounds=0) -> OptimumResult:
+        nodes, edges = (search.n_nodes, search.n_edges) if search is not None else (0, 0)
+        if found is None:
+            return OptimumResult(name, None, [], exact, nodes, edges,
+                                 time.perf_counter() - t0, stopped, rounds)  # fmt: skip
+        length, pieces = found
+        pieces = _merge_arcs([p for p in pieces if p.length > 0.0] or pieces[:1])
+        return OptimumResult(name, length, pieces, exact, nodes, edges,
+                             time.perf_counter() - t0, False, rounds)  # fmt: skip
+
+    if not grid.connected:  # a proof: no chain of possibly-free cells joins them
+        return result(None)
+    if stop():
+        return result(None, stopped=True)
+    nodes = _NodeCircles.build(world, grid, start, goal, radius)
+    cap = math.inf if upper_bound is None else float(upper_bound)
+    lower = float(grid.lower_bound(1, start[None])[0])
+    search = None
+    kind = "lattice" if grid.blocked is not None else "generic"
+    for k, bound in enumerate(_bounds(lower, cap, world.tol, kind)):
+        search = _TangentSearch(world, grid, nodes, goal_tol, bound, source, terminate)
+        found = search.run()
+        if search.stopped:
+            return result(None, search, stopped=True, rounds=k + 1)
+        if found is not None or bound >= cap:
+            return result(found, search, rounds=k + 1)
+    return result(None, search)  # pragma: no cover - the last bound is the cap
 
 
-def _grid_bound(problem: Problem, world: World) -> float:
-    """The length of a certified grid path (an upper bound on the optimum), or ``inf``."""
-    from .certify import GRID_POINTS, grid_path
+#: The rounds' bounds, as multiples of the lower bound on the optimum: a round that finds no
+#: path within its bound proves the optimum longer, and the next one looks further. On a map's
+#: lattice the geodesic bound is a few percent short (it counts cells) and a loose bound costs
+#: little (the step counts and the raster bound the candidates); among circles and polygons it
+#: is often within a fraction of a percent, and the width of the ellipse drives the cost.
+_ROUND_FACTORS = {
+    "lattice": (1.08, 1.3, 2.0, 4.0, 8.0),
+    "generic": (1.005, 1.02, 1.08, 1.3, 2.0, 4.0, 8.0),
+}
 
-    (xmin, ymin), (xmax, ymax) = problem.bounds
-    side = max(xmax - xmin, ymax - ymin)
-    for factor in (1, 2, 4):
-        try:
-            path = grid_path(problem, side / (GRID_POINTS * factor))
-        except RrtpsoError:  # a grid that fine would be too large
+
+def _bounds(lower: float, cap: float, tol: float, kind: str):
+    """The bound of each round, ending with ``cap``."""
+    for factor in _ROUND_FACTORS[kind]:
+        b = lower * factor + 10.0 * tol
+        if b >= cap:
             break
-        if path is not None and world.path_valid(path):
-            return float(np.hypot(*np.diff(path, axis=0).T).sum())
-    return math.inf
+        yield b
+    yield cap
+
+
+def _loosen(bound: float, tol: float) -> float:
+    """A bound with room for round-off (lengths add up over many pieces)."""
+    return bound * (1.0 + 1e-9) + 10.0 * tol if math.isfinite(bound) else math.inf
 
 
 def _merge_arcs(pieces: list[Piece]) -> list[Piece]:
@@ -302,107 +408,259 @@ def _merge_arcs(pieces: list[Piece]) -> list[Piece]:
     return out
 
 
-def _node_circles(problem: Problem, world: World, start, goal, radius: float) -> np.ndarray:
-    """(k, 3) circles ``(cx, cy, rho)``: start, goal, inflated obstacle circles, the convex
-    vertices of polygons and the convex corners of the union of the boxes."""
-    rows = [np.array([[*start, 0.0], [*goal, 0.0]])]
+# ----------------------------------------------------------------------------------------------
+@dataclass
+class _NodeCircles:
+    """The circles a shortest path can wrap, with what is known of their free arcs.
+
+    Attributes
+    ----------
+    circles : (k, 3) ndarray
+        ``(cx, cy, rho)``: start and goal (radius 0) first, then the inflated obstacle circles,
+        the convex polygon vertices and the convex corners of the boxes or map cells.
+    lo, width : (k,) ndarray
+        The arc a path may wrap starts at angle ``lo`` and runs counter-clockwise through
+        ``width`` (``2 pi``: the whole circle). At a convex vertex it is the cone of the outward
+        normals of its two edges: a path that wraps the vertex elsewhere would enter an edge's
+        offset.
+    sure : (k,) bool
+        Every point of that arc is free (nothing but the circle's own obstacle is within its
+        reach), so arcs need no exact test.
+    """
+
+    circles: np.ndarray
+    lo: np.ndarray
+    width: np.ndarray
+    sure: np.ndarray
+
+    @classmethod
+    def build(cls, world: World, grid: FreeGrid, start, goal, radius: float) -> _NodeCircles:
+        rows = [np.array([[*start, 0.0], [*goal, 0.0]])]
+        lo, width = [np.zeros(2)], [np.full(2, _TWO_PI)]
+        c = world.circles
+        rows.append(np.column_stack([c[:, :2], c[:, 2] + radius]))
+        lo.append(np.zeros(len(c)))
+        width.append(np.full(len(c), _TWO_PI))
+        circle_sure = _lonely_circles(world)
+        for p in world.polygons:
+            if np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]) < 0:
+                p = p[::-1]  # counter-clockwise
+            e0 = p - np.roll(p, 1, axis=0)
+            e1 = np.roll(p, -1, axis=0) - p
+            turn = e0[:, 0] * e1[:, 1] - e0[:, 1] * e1[:, 0]
+            convex = turn > 0.0  # only convex vertices can bend a shortest path
+            # Outward normals of a counter-clockwise ring point to the right of each edge.
+            a0 = np.arctan2(-e0[convex, 0], e0[convex, 1])
+            a1 = np.arctan2(-e1[convex, 0], e1[convex, 1])
+            rows.append(np.column_stack([p[convex], np.full(int(convex.sum()), radius)]))
+            lo.append(np.mod(a0, _TWO_PI))
+            width.append(np.mod(a1 - a0, _TWO_PI))
+        n_fixed = sum(len(r) for r in rows)
+        if grid.blocked is not None:
+            corners, q_lo, sure = _lattice_corners(grid, radius, world.tol)
+            if len(world.circles) or world.polygons:
+                sure[:] = False  # other obstacles may be near the arcs
+        else:
+            corners, q_lo = _convex_box_corners(world)
+            sure = np.zeros(len(corners), dtype=bool)
+        rows.append(np.column_stack([corners, np.full(len(corners), radius)]))
+        lo.append(q_lo)
+        width.append(np.full(len(corners), 0.5 * math.pi))
+        others = np.zeros(n_fixed - 2 - len(circle_sure), dtype=bool)  # polygon vertices
+        all_sure = np.concatenate([np.ones(2, dtype=bool), circle_sure, others, sure])
+        return cls(np.vstack(rows), np.concatenate(lo), np.concatenate(width), all_sure)
+
+
+def _lonely_circles(world: World) -> np.ndarray:
+    """Which obstacle circles no other obstacle comes near and whose grown circle lies in the
+    bounds: that whole circle is free, so arcs along it need no exact test (any box or polygon
+    in reach counts as near)."""
     c = world.circles
-    rows.append(np.column_stack([c[:, :2], c[:, 2] + radius]))
-    for p in world.polygons:
-        prev, nxt = np.roll(p, 1, axis=0), np.roll(p, -1, axis=0)
-        e0, e1 = p - prev, nxt - p
-        turn = e0[:, 0] * e1[:, 1] - e0[:, 1] * e1[:, 0]
-        area2 = np.sum(p[:, 0] * nxt[:, 1] - nxt[:, 0] * p[:, 1])
-        # Convex vertices turn the way the ring runs; only they can bend a shortest path.
-        convex = p[turn * np.sign(area2) > 0.0]
-        rows.append(np.column_stack([convex, np.full(len(convex), radius)]))
-    corners = _convex_box_corners(world)
-    rows.append(np.column_stack([corners, np.full(len(corners), radius)]))
-    return np.vstack(rows)
+    if not len(c):
+        return np.zeros(0, dtype=bool)
+    thr = world.threshold
+    reach = (c[:, 2] + 2.0 * thr + 8.0 * world.tol)[:, None]
+    query, ids = world._grid.pairs_in_boxes(c[:, :2] - reach, c[:, :2] + reach)
+    other = ids != query  # circles come first among the ids: id == own index
+    query, ids = query[other], ids[other]
+    kind = world._kind_of(ids)
+    near = np.zeros(len(c), dtype=bool)
+    near[query[kind != 0]] = True
+    k = kind == 0
+    q, o = query[k], ids[k]
+    gap = np.hypot(*(c[o, :2] - c[q, :2]).T) - c[q, 2] - c[o, 2]
+    near[q[gap < 2.0 * thr + 8.0 * world.tol]] = True
+    # And the grown circle must lie in the bounds (an arc may not leave them).
+    (xmin, ymin), (xmax, ymax) = world.bounds
+    rho = c[:, 2] + world.robot_radius
+    inside = (c[:, 0] - rho >= xmin) & (c[:, 0] + rho <= xmax)
+    inside &= (c[:, 1] - rho >= ymin) & (c[:, 1] + rho <= ymax)
+    return ~near & inside
 
 
-def _convex_box_corners(world: World) -> np.ndarray:
+def _lattice_corners(grid: FreeGrid, radius: float, tol: float):
+    """Convex corners of the blocked cells of a lattice raster (a map's), straight from the
+    cells: the grid points where exactly one of the four cells around is blocked (cells outside
+    the raster count as free).
+
+    Returns the corners, the angle where the quarter of free directions starts (the normals
+    of the blocked cell's two edges at the corner) and whether nothing else is blocked within
+    twice the radius (the corner's arc is then free: no exact arc test is needed).
+    """
+    blocked = grid.blocked
+    b = np.pad(blocked, 1, constant_values=False)
+    sw, se, nw, ne = b[:-1, :-1], b[:-1, 1:], b[1:, :-1], b[1:, 1:]
+    count = sw.astype(np.int8) + se + nw + ne
+    j, i = np.nonzero(count == 1)
+    # The free quarter is opposite the blocked cell: SW blocked -> normals east to north, etc.
+    q_lo = np.select([sw[j, i], se[j, i], ne[j, i]], [0.0, 0.5 * math.pi, math.pi], 1.5 * math.pi)
+    h = grid.h
+    corners = np.column_stack([grid.x0 + i * h, grid.y0 + j * h])
+    # Blocked cells within 2 R of a corner (a window of w cells each way): only its own?
+    w = max(1, math.ceil((2.0 * radius + 4.0 * tol) / h))
+    sat = np.pad(np.cumsum(np.cumsum(blocked, axis=0), axis=1), ((1, 0), (1, 0)))
+    ny, nx = blocked.shape
+    j0, j1 = np.clip(j - w, 0, ny), np.clip(j + w, 0, ny)
+    i0, i1 = np.clip(i - w, 0, nx), np.clip(i + w, 0, nx)
+    inside = sat[j1, i1] - sat[j0, i1] - sat[j1, i0] + sat[j0, i0]
+    return corners, q_lo, inside == 1
+
+
+def _convex_box_corners(world: World) -> tuple[np.ndarray, np.ndarray]:
     """Corners of boxes where exactly one of the four quadrants around them is covered by boxes:
-    the convex corners of their union (shared edges and inner corners drop out)."""
+    the convex corners of their union (shared edges and inner corners drop out), with the angle
+    where their quarter of free directions starts."""
     b = world.boxes
     if not len(b):
-        return np.empty((0, 2))
+        return np.empty((0, 2)), np.empty(0)
     corners = np.unique(np.vstack([b[:, [0, 1]], b[:, [2, 1]], b[:, [2, 3]], b[:, [0, 3]]]),
                         axis=0)  # fmt: skip
     eps = 1e-6 * float(np.min(np.minimum(b[:, 2] - b[:, 0], b[:, 3] - b[:, 1])))
     covered = np.zeros(len(corners), dtype=int)
+    q_lo = np.zeros(len(corners))
     boxes_only = World(world.bounds, boxes=world.boxes)  # circles and polygons do not count
-    for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1)):
+    # Quadrants NE, NW, SW, SE; the free quarter is opposite the covered one.
+    quadrants = ((1, 1), (-1, 1), (-1, -1), (1, -1))
+    opposites = (math.pi, 1.5 * math.pi, 0.0, 0.5 * math.pi)
+    for (sx, sy), opposite in zip(quadrants, opposites, strict=True):
         x, y = corners[:, 0] + sx * eps, corners[:, 1] + sy * eps
-        covered += boxes_only.in_polygons(x, y)
-    return corners[covered == 1]
+        inside = boxes_only.in_polygons(x, y)
+        covered += inside
+        q_lo[inside] = opposite
+    keep = covered == 1
+    return corners[keep], q_lo[keep]
 
 
 class _TangentSearch:
-    """A* over tangent nodes, built as it goes (see the module docstring)."""
+    """A* over tangent nodes within one bound, built as it goes (see the module docstring)."""
 
-    def __init__(self, world: World, circles: np.ndarray, goal_tol: float, bound: float,
-                 source: str) -> None:  # fmt: skip
+    def __init__(self, world: World, grid: FreeGrid, nodes: _NodeCircles, goal_tol: float,
+                 bound: float, source: str, terminate) -> None:  # fmt: skip
         self.world = world
+        self.grid = grid
         self.goal_tol = goal_tol
         self.source = source
-        start, goal = circles[0, :2], circles[1, :2]
+        self.terminate = terminate
+        self.stopped = False
+        self.bound = _loosen(bound, world.tol)
+        self.eps = 1e-12 * max(1.0, bound if math.isfinite(bound) else 1.0)
+        c = nodes.circles
+        start, goal = c[0, :2], c[1, :2]
         self.start, self.goal = start, goal
-        self.bound = bound * (1.0 + 1e-9) + 10.0 * world.tol if math.isfinite(bound) else math.inf
-        # Only circles that can touch the ellipse |x - start| + |x - goal| <= bound matter.
-        reach = np.hypot(*(circles[:, :2] - start).T) + np.hypot(*(circles[:, :2] - goal).T)
-        keep = reach - 2.0 * circles[:, 2] <= self.bound
-        keep[:2] = True
-        self.circles = circles[keep]
+        # Only circles on which a path within the bound can pass: the geodesic ellipse.
+        lb_s = grid.circle_lower_bound(0, c)
+        lb_g = grid.circle_lower_bound(1, c)
+        through = lb_s + lb_g  # inf: the circle cannot be reached at all
+        keep = np.flatnonzero(((through <= self.bound) & np.isfinite(through))
+                              | (np.arange(len(c)) < 2))  # fmt: skip
+        self.circles = c[keep]
+        self.lo, self.width, self.sure = nodes.lo[keep], nodes.width[keep], nodes.sure[keep]
+        self.lb_s, self.lb_g = lb_s[keep], lb_g[keep]
+        self.steps = grid.step_ranges(self.circles)
+        self._cache: dict[int, _Tangents] = {}
+        self._cached = np.zeros(len(self.circles), dtype=bool)
+        self._cached[1] = True  # the goal: never expanded
+        self._cells_only = (grid.band_ok(world.threshold) and not len(world.circles)
+                            and not world.polygons)  # fmt: skip
         self.n_nodes = 0
         self.n_edges = 0
-        # Node arrays grow as nodes are created.
+        cap = 1024
+        self.g = np.empty(cap)
+        self.h = np.empty(cap)
+        # Per node: (x, y), circle, angle, sense, parent, leave point, signed sweep.
         self.xy: list[tuple[float, float]] = []
         self.circle: list[int] = []
         self.angle: list[float] = []
         self.sense: list[int] = []
-        self.g: list[float] = []
         self.parent: list[int] = []
-        self.leave: list[tuple[float, float]] = []  # the tangent's start on the parent's circle
-        self.sweep: list[float] = []  # the parent's arc to it, signed (counter-clockwise > 0)
-        self.goal_end: list[tuple[float, float] | None] = []
-        self.key: dict[int, int] = {}  # (from circle, to circle, which tangent) -> node
-        self._cache: dict[int, _Tangents] = {}  # circle -> its usable free tangents
+        self.leave: list[tuple[float, float]] = []
+        self.sweep: list[float] = []
+        self._expanded: dict[tuple[int, int], list[tuple[float, float]]] = {}
 
     # ------------------------------------------------------------------------------------------
     def run(self) -> tuple[float, list[Piece]] | None:
-        start = self._add(-1, tuple(self.circles[0, :2]), 0, 0.0, 0, 0.0, -1,
-                          (0.0, 0.0), 0.0)  # fmt: skip
-        heap = [(self._h(start), start)]
-        closed: set[int] = set()
+        h0 = float(self.grid.lower_bound(1, self.start[None])[0])
+        xy = (float(self.start[0]), float(self.start[1]))
+        s = self._add(xy, 0, 0.0, 0, 0.0, -1, (0.0, 0.0), 0.0, h0)
+        heap = [(self.h[s], s)]
+        done = np.full(1024, math.inf)  # g at which each node was last expanded
         while heap:
             f, u = heapq.heappop(heap)
-            if u in closed or f > self.g[u] + self._h(u) + 1e-12:
-                continue
-            closed.add(u)
+            g_u = self.g[u]
+            if f > g_u + self.h[u] + self.eps:
+                continue  # a stale entry: the node was improved since
+            if u < len(done) and done[u] <= g_u + self.eps:
+                continue  # expanded already with this g (the heuristic is not consistent)
+            if self.terminate is not None and self.terminate():
+                self.stopped = True
+                return None
             if self.circle[u] == 1:
-                return self.g[u], self._pieces(u)
+                return float(g_u), self._pieces(u)
+            if self._dominated(u):
+                continue
+            if u >= len(done):
+                done = np.concatenate([done, np.full(len(done), math.inf)])
+            done[u] = g_u
             for v in self._expand(u):
-                heapq.heappush(heap, (self.g[v] + self._h(v), v))
+                heapq.heappush(heap, (self.g[v] + self.h[v], v))
         return None
 
-    def _h(self, u: int) -> float:
-        d = math.dist(self.xy[u], self.goal)
-        return max(d - self.goal_tol, 0.0)
+    def _dominated(self, u: int) -> bool:
+        """Whether a node expanded earlier on the same circle and sense reaches ``u``'s point along
+        a free arc at no more cost (then everything ``u`` leads to, it led to already)."""
+        i, s = self.circle[u], self.sense[u]
+        if not self.sure[i] or self.width[i] >= _TWO_PI:
+            return False
+        key = (i, s)
+        rho = float(self.circles[i, 2])
+        pos = (self.angle[u] - self.lo[i]) % _TWO_PI
+        g = float(self.g[u])
+        seen = self._expanded.setdefault(key, [])
+        for g_a, pos_a in seen:
+            ahead = (pos - pos_a) * s
+            if ahead >= -1e-12 and g_a + rho * max(ahead, 0.0) <= g + self.eps:
+                return True
+        seen.append((g, pos))
+        return False
 
-    def _add(self, key, xy, circle, angle, sense, g, parent, leave, sweep, goal_end=None) -> int:
-        k = len(self.xy)
+    def _add(self, xy, circle, angle, sense, g, parent, leave, sweep, h) -> int:
+        k = self.n_nodes
         if k >= MAX_NODES:
             raise OptimumTooLarge(
                 f"{self.source}: the search for the exact optimum passed {MAX_NODES:,} tangent "
                 "nodes; the problem is too large for it"
             )
-        self.key[key] = k
-        for store, value in ((self.xy, xy), (self.circle, circle), (self.angle, angle),
-                             (self.sense, sense), (self.g, g), (self.parent, parent),
-                             (self.leave, leave), (self.sweep, sweep),
-                             (self.goal_end, goal_end)):  # fmt: skip
-            store.append(value)
+        if k >= len(self.g):
+            self.g = np.concatenate([self.g, np.empty(len(self.g))])
+            self.h = np.concatenate([self.h, np.empty(len(self.h))])
+        self.g[k], self.h[k] = g, h
+        self.xy.append(xy)
+        self.circle.append(circle)
+        self.angle.append(angle)
+        self.sense.append(sense)
+        self.parent.append(parent)
+        self.leave.append(leave)
+        self.sweep.append(sweep)
         self.n_nodes = k + 1
         return k
 
@@ -410,133 +668,290 @@ class _TangentSearch:
     def _expand(self, u: int) -> list[int]:
         """Create or improve the nodes reached from ``u`` by an arc and a free tangent."""
         i = self.circle[u]
-        cand = self._free_tangents(i)
+        cand = self._free_tangents(i, float(self.g[u]), float(self.g[u] + self.h[u]))
         if not len(cand.j):
             return []
-        # The path keeps wrapping circle i the way it arrived, then leaves on the tangent.
-        rho_i = self.circles[i, 2]
+        rho_i = float(self.circles[i, 2])
+        s = self.sense[u]
         if rho_i > 0:
-            cand = cand.take(np.flatnonzero(cand.sense_i == self.sense[u]))
-            sweep = np.mod(self.sense[u] * (cand.angle_i - self.angle[u]), _TWO_PI)
+            idx = np.flatnonzero(cand.sense_i == s)
+            if self.width[i] < _TWO_PI:
+                # The arc stays on the circle's free arc: from u's point on, in u's sense.
+                pos_u = (self.angle[u] - self.lo[i]) % _TWO_PI
+                ahead = s * (cand.pos_i[idx] - pos_u)
+                idx = idx[ahead >= -1e-9]
+                sweep = np.maximum(s * (cand.pos_i[idx] - pos_u), 0.0)
+            else:
+                sweep = np.mod(s * (cand.angle_i[idx] - self.angle[u]), _TWO_PI)
         else:
-            sweep = np.zeros(len(cand.j))
-        g = self.g[u] + rho_i * sweep + cand.seg
-        idx = np.flatnonzero(g + cand.h <= self.bound)
+            idx = np.arange(len(cand.j))
+            sweep = np.zeros(len(idx))
+        g = self.g[u] + rho_i * sweep + cand.seg[idx]
+        ok = g + cand.h[idx] <= self.bound
+        idx, g, sweep = idx[ok], g[ok], sweep[ok]
         if not len(idx):
             return []
         # No better than a node already reached by this tangent: nothing to do.
-        keys = cand.key[idx].tolist()
-        best = np.array([self.g[self.key[k]] if k in self.key else math.inf for k in keys])
-        better = g[idx] < best - 1e-12
-        idx = idx[better]
-        if rho_i > 0 and len(idx):
-            idx = idx[self._arcs_ok(u, sweep[idx])]
+        node = cand.node[idx]
+        best = np.where(node >= 0, self.g[np.maximum(node, 0)], math.inf)
+        better = g < best - self.eps
+        idx, g, sweep, node = idx[better], g[better], sweep[better], node[better]
+        if rho_i > 0 and len(idx) and not self.sure[i]:
+            ok = self._arcs_ok(u, sweep)
+            idx, g, sweep, node = idx[ok], g[ok], sweep[ok], node[ok]
         self.n_edges += len(idx)
         out = []
-        for k in idx.tolist():
-            key = int(cand.key[k])
+        for k, gk, sw, v in zip(idx.tolist(), g.tolist(), sweep.tolist(), node.tolist(),
+                                strict=True):  # fmt: skip
             leave = (float(cand.p[k, 0]), float(cand.p[k, 1]))
-            signed = float(self.sense[u] * sweep[k]) if rho_i > 0 else 0.0
-            if key in self.key:
-                v = self.key[key]
-                self.g[v], self.parent[v], self.leave[v], self.sweep[v] = g[k], u, leave, signed
+            signed = s * sw if rho_i > 0 else 0.0
+            if v >= 0:
+                self.g[v] = gk
+                self.parent[v], self.leave[v], self.sweep[v] = u, leave, signed
             else:
-                xy = (float(cand.q[k, 0]), float(cand.q[k, 1]))
-                v = self._add(key, xy, int(cand.j[k]), float(cand.angle_j[k]),
-                              int(cand.sense_j[k]), float(g[k]), u, leave, signed)  # fmt: skip
+                v = self._add((float(cand.q[k, 0]), float(cand.q[k, 1])), int(cand.j[k]),
+                              float(cand.angle_j[k]), int(cand.sense_j[k]), gk, u, leave,
+                              signed, float(cand.h[k]))  # fmt: skip
+                cand.node[k] = v
             out.append(v)
         return out
 
-    def _free_tangents(self, i: int) -> _Tangents:
+    def _free_tangents(self, i: int, g: float, f: float) -> _Tangents:
         """The tangents from circle ``i`` that some path within the bound could use and that are
         free (segment and end points in bounds), computed once per circle.
 
         Whether a tangent segment is free does not depend on the node it leaves from, so each
-        circle's are found once: drop those no path within the bound can use (start to the
-        tangent, the tangent, the straight line on to the goal: already longer), then those
-        the obstacles next to circle ``i`` surely block (:func:`_occluded`, a cheap angular
-        test), then test the rest exactly.
+        circle's are found once, and together with those of the circles the search will likely
+        expand next (up to :data:`_BATCH` in one vectorised pass, which costs little more than
+        a pass over one): those whose lower bound from the start is nearest to ``g`` and whose
+        lower bound through them is below or near ``f``.
         """
         cached = self._cache.get(i)
         if cached is not None:
             return cached
-        cand = _tangents_from(self.circles, i)
+        todo = np.flatnonzero(~self._cached)
+        todo = todo[todo != i]
+        if len(todo) >= _BATCH:
+            key = np.abs(self.lb_s[todo] - g) + np.maximum(
+                self.lb_s[todo] + self.lb_g[todo] - f, 0.0)  # fmt: skip
+            todo = todo[np.argpartition(key, _BATCH - 2)[: _BATCH - 1]]
+        self._prepare(np.concatenate([[i], todo]).astype(np.intp))
+        return self._cache[i]
+
+    def _prepare(self, batch: np.ndarray) -> None:
+        """Fill the cache of each circle of ``batch`` with its usable free tangents.
+
+        The filters, cheapest first, each exact or dropping only what no path within the bound
+        can use: circle pairs too far apart for the bound; tangents leaving or reaching a vertex
+        outside its cone of free directions; tangents no path within the bound can use (lower
+        bounds from the start to the tangent and from its end to the goal); tangents with a
+        sample in a core cell of the raster; then the exact test, first against the obstacles
+        near the circle they leave (where most blocked tangents are blocked), then the world's
+        test of the whole segment.
+        """
+        c = self.circles
+        ci = c[batch]
+        # A first sieve over the whole (batch x circles) matrix, with cheap over-estimates of
+        # distances (|dx| + |dy|) and under-estimates (max(|dx|, |dy|)): the bound through the
+        # pair, and the 8-connected step counts to the goal (see FreeGrid.step_ranges).
+        dx = np.abs(c[None, :, 0] - ci[:, None, 0])
+        dy = np.abs(c[None, :, 1] - ci[:, None, 1])
+        spread = ci[:, None, 2] + c[None, :, 2]
+        reach = np.maximum(dx, dy) + self.lb_g[None, :] <= (
+            self.bound - self.lb_s[batch])[:, None] + spread  # fmt: skip
+        n = (dx + dy + 2.0 * spread) * (1.0 / self.grid.H) + 2.0
+        lo_i, hi_i = self.steps[batch, 2, 0][:, None], self.steps[batch, 2, 1][:, None]
+        lo_j, hi_j = self.steps[None, :, 2, 0], self.steps[None, :, 2, 1]
+        with np.errstate(invalid="ignore"):  # inf - inf: a circle no free path reaches: drop
+            reach &= (lo_j - hi_i <= n) & (lo_i - hi_j <= n)
+        reach[:, 0] = False
+        reach[np.arange(len(batch)), batch] = False
+        row, j = np.nonzero(reach)
+        # Then the exact distances and every step count, pair by pair.
+        i = batch[row]
+        d = c[j, :2] - c[i, :2]
+        spread = c[i, 2] + c[j, 2]
+        gap = np.hypot(d[:, 0], d[:, 1]) - spread
+        ok = self.lb_s[i] + np.maximum(gap, 0.0) + self.lb_g[j] <= self.bound
+        ok &= self.grid.visible_pairs(self.steps[i], self.steps[j], np.abs(d[:, 0]) + spread,
+                                      np.abs(d[:, 1]) + spread)  # fmt: skip
+        row, j = self._directions_ok(batch, row[ok], j[ok])
+        row, j = self._shadowed(batch, row, j)
+        cand = _tangents_from(c, batch[row], j)
+        i = cand.i
+        cand.pos_i = np.mod(cand.angle_i - self.lo[i], _TWO_PI)
+        wi, wj = self.width[i], self.width[cand.j]
+        pos_j = np.mod(cand.angle_j - self.lo[cand.j], _TWO_PI)
+        cone = ((wi >= _TWO_PI) | (cand.pos_i <= wi + 1e-7)) & (
+            (wj >= _TWO_PI) | (pos_j <= wj + 1e-7))  # fmt: skip
+        cand = cand.take(np.flatnonzero(cone))
         cand.q = self._ends(cand, cand.j == 1)
         cand.seg = np.hypot(*(cand.q - cand.p).T)
-        cand.h = np.maximum(np.hypot(*(cand.q - self.goal).T) - self.goal_tol, 0.0)
-        lower = np.hypot(*(cand.p - self.start).T) + cand.seg + cand.h
-        cand = cand.take(np.flatnonzero(lower <= self.bound))
-        if len(cand.j):
-            cand = cand.take(np.flatnonzero(~self._occluded(i, cand)))
-        if len(cand.j):
-            w = self.world
-            ok = w.points_in_bounds(cand.p) & w.points_in_bounds(cand.q)
-            idx = np.flatnonzero(ok)
-            idx = idx[w.segments_free(cand.p[idx], cand.q[idx])]
-            cand = cand.take(idx)
-        cand.key = (i * len(self.circles) + cand.j.astype(np.int64)) * 4 + cand.t
-        self._cache[i] = cand
-        return cand
+        cand.h = self.grid.lower_bound(1, cand.q)
+        lower = self.grid.lower_bound(0, cand.p) + cand.seg + cand.h
+        w = self.world
+        ok = lower <= self.bound
+        ok &= w.points_in_bounds(cand.p) & w.points_in_bounds(cand.q)
+        cand = cand.take(np.flatnonzero(ok))
+        if len(cand.j) and self.grid.core_share >= _RASTER_WORTH:
+            cand = cand.take(np.flatnonzero(~self.grid.blocked_segments(cand.p, cand.q)))
+        if len(cand.j) and self._cells_only:
+            # A world of the lattice's cells alone: the exact test straight from the cells.
+            near = self.grid.segments_near_blocked(cand.p, cand.q, w.threshold)
+            cand = cand.take(np.flatnonzero(~near))
+        else:
+            if len(cand.j):
+                cand = cand.take(np.flatnonzero(~self._blocked_near(cand)))
+            if len(cand.j):
+                cand = cand.take(np.flatnonzero(w.segments_free(cand.p, cand.q)))
+        cand.node = np.full(len(cand.j), -1, dtype=np.intp)
+        order = np.argsort(cand.i, kind="stable")
+        cand = cand.take(order)
+        cuts = np.searchsorted(cand.i, batch, side="left"), np.searchsorted(cand.i, batch, "right")
+        for k, circle in enumerate(batch.tolist()):
+            self._cache[circle] = cand.take(slice(int(cuts[0][k]), int(cuts[1][k])))
+        self._cached[batch] = True
 
-    def _occluded(self, i: int, cand: _Tangents) -> np.ndarray:
-        """Tangents from circle ``i`` surely blocked by a disc next to it (booleans).
+    def _directions_ok(self, batch: np.ndarray, row: np.ndarray, j: np.ndarray):
+        """The pairs ``(batch[row], j)`` that can have a tangent leaving the first circle and
+        reaching the second within their cones of free directions.
 
-        A tangent leaving circle ``i`` (centre ``c``, radius ``rho``) in direction ``phi`` with
-        sense ``s`` runs on the line ``cross(x - c, u(phi)) = s rho``. A disc of radius ``r`` at
-        distance ``D`` and bearing ``theta`` from ``c`` cuts that line where
-        ``|D sin(phi - theta) - s rho| < r``, an interval of directions; the nearest point of
-        the line to the disc's centre lies ``D cos(phi - theta) <= D`` ahead. So a tangent
-        whose direction falls in the interval (with ``cos >= 0``) and that is at least ``D``
-        long passes closer than ``r`` to the centre: blocked. The discs are the inflated
-        circles near ``i`` and the discs inscribed in the inflated boxes near it; their
-        intervals, merged per sense into the least ``D`` over each piece of the circle of
-        directions, answer every tangent in one ``searchsorted``.
+        A path wrapping a circle at the outward normal ``n`` travels along ``n +- pi / 2``, so a
+        tangent leaving a vertex whose cone is ``[lo, lo + w]`` heads into one of the two arcs of
+        directions ``[lo + pi / 2, lo + w + pi / 2]`` and ``[lo - pi / 2, lo + w - pi / 2]``,
+        and it arrives at the other circle in the same way. The tangent's direction differs from
+        that of the line of centres by at most ``asin((rho_i + rho_j) / d)``.
         """
-        w = self.world
-        ci, rho = self.circles[i, :2], float(self.circles[i, 2])
-        discs = self._near_discs(ci, rho)
-        blocked = np.zeros(len(cand.j), dtype=bool)
-        if not len(discs):
-            return blocked
-        rel = discs[:, :2] - ci
-        dist = np.hypot(rel[:, 0], rel[:, 1])
-        # Circle i's own obstacle (at distance 0) blocks nothing a tangent to it could use.
-        discs, rel, dist = discs[dist > 0], rel[dist > 0], dist[dist > 0]
-        theta = np.arctan2(rel[:, 1], rel[:, 0])
-        if not len(discs):
-            return blocked
-        r = discs[:, 2] - 2.0 * w.tol  # strictly inside: grazing tangents stay candidates
-        d = cand.q - cand.p
-        phi = np.mod(np.arctan2(d[:, 1], d[:, 0]), _TWO_PI)
-        for s in (-1, 1) if rho > 0 else (0,):
-            mine = np.flatnonzero(cand.sense_i == s) if rho > 0 else np.arange(len(phi))
-            if not len(mine):
+        i = batch[row]
+        c = self.circles
+        d = c[j, :2] - c[i, :2]
+        dist = np.hypot(d[:, 0], d[:, 1])
+        slack = np.arcsin(np.clip((c[i, 2] + c[j, 2]) / np.maximum(dist, 1e-300), 0.0, 1.0))
+        slack += 1e-7
+        phi = np.arctan2(d[:, 1], d[:, 0])
+        ok = np.ones(len(i), dtype=bool)
+        for k in (i, j):
+            w = self.width[k]
+            cone = w < _TWO_PI
+            if not cone.any():
                 continue
-            lo = np.clip((s * rho - r) / dist, -1.0, 1.0)
-            hi = np.clip((s * rho + r) / dist, -1.0, 1.0)
-            use = (r > 0) & (hi > lo)
-            a0 = np.mod(theta[use] + np.arcsin(lo[use]), _TWO_PI)
-            width = np.arcsin(hi[use]) - np.arcsin(lo[use])
-            need = _least_over_intervals(a0, width, dist[use], phi[mine])
-            blocked[mine] = cand.seg[mine] >= need
-        return blocked
+            inside = np.zeros(len(i), dtype=bool)
+            for turn in (0.5 * math.pi, -0.5 * math.pi):
+                off = np.mod(phi - (self.lo[k] + turn) + slack, _TWO_PI)
+                inside |= off <= w + 2.0 * slack
+            ok &= ~cone | inside
+        return row[ok], j[ok]
 
-    def _near_discs(self, c: np.ndarray, rho: float) -> np.ndarray:
-        """(k, 3) discs inside the inflated obstacles within a few index cells of a circle."""
+    def _shadowed(self, batch: np.ndarray, row: np.ndarray, j: np.ndarray):
+        """The pairs ``(batch[row], j)`` not wholly in the shadow of the obstacles near the first
+        circle.
+
+        A tangent leaving circle ``i`` (centre ``c``, radius ``rho``) in direction ``phi``, in
+        the sense ``s``, runs on the line ``cross(x - c, u(phi)) = s rho``, whose distance to a
+        disc centre at distance ``D`` and bearing ``theta`` from ``c`` is
+        ``|D sin(phi - theta) - s rho|``; the foot of that distance lies ``D cos(phi - theta)
+        <= D`` ahead. So a disc of radius ``r`` (a circle obstacle, or the disc inscribed in a
+        box, grown by the clearance threshold) blocks every tangent of sense ``s`` whose
+        direction has ``|D sin(phi - theta) - s rho| < r`` (and ``cos >= 0``) once it is ``D``
+        long: an interval of directions per disc and sense. The least of those lengths over the
+        intervals that cover a whole bin of directions bounds how far a free tangent can go in
+        that bin. The tangents to circle ``j`` lie within ``asin((rho + rho_j) / d)`` of the
+        line of centres and are at least the gap between the circles long, so when that gap
+        reaches the largest bound over those bins, in both senses, none of them is free.
+        """
+        if not len(row):
+            return row, j
+        c = self.circles
+        i = batch[row]
+        d = c[j, :2] - c[i, :2]
+        dist = np.hypot(d[:, 0], d[:, 1])
+        gap = dist - c[i, 2] - c[j, 2]
+        beta = np.arcsin(np.clip((c[i, 2] + c[j, 2]) / np.maximum(dist, 1e-300), 0.0, 1.0))
+        phi = np.mod(np.arctan2(d[:, 1], d[:, 0]), _TWO_PI)
+        # Profiles only for the circles with many pairs (else the tangent-level filters are
+        # cheaper than the table).
+        count = np.bincount(row, minlength=len(batch))
+        busy = np.flatnonzero(count >= _SHADOW_WORTH)
+        if not len(busy):
+            return row, j
+        tables = self._shadow_tables(batch[busy])  # (senses, busy, levels, bins)
+        slot = np.full(len(batch), -1, dtype=np.intp)
+        slot[busy] = np.arange(len(busy))
+        mine = np.flatnonzero(slot[row] >= 0)
+        lo = np.floor((phi[mine] - beta[mine] - 1e-9) / _SHADOW_BIN).astype(np.intp)
+        hi = np.floor((phi[mine] + beta[mine] + 1e-9) / _SHADOW_BIN).astype(np.intp)
+        reach = np.max([_range_max(t, slot[row[mine]], lo, hi) for t in tables], axis=0)
+        keep = np.ones(len(row), dtype=bool)
+        keep[mine] = gap[mine] < reach
+        return row[keep], j[keep]
+
+    def _shadow_tables(self, circles: np.ndarray) -> list[np.ndarray]:
+        """Range-maximum tables of each circle's bound per bin of directions, one per sense:
+        arrays ``(circles, levels, bins)`` (:meth:`_shadowed`)."""
         w = self.world
-        if not w.n_obstacles:
-            return np.empty((0, 3))
-        reach = rho + 2.0 * w._grid.h
-        _, ids = w._grid.pairs_in_boxes(c - reach, c + reach)
-        kind = w._kind_of(ids)
-        circ = w.circles[ids[kind == 0]]
-        out = [np.column_stack([circ[:, :2], circ[:, 2] + w.threshold])]
-        box = w.boxes[ids[kind == 1] - w._n_circles]
-        if len(box):
-            half = 0.5 * np.minimum(box[:, 2] - box[:, 0], box[:, 3] - box[:, 1])
-            mid = 0.5 * (box[:, :2] + box[:, 2:])
-            out.append(np.column_stack([mid, half + w.threshold]))
-        return np.vstack(out)
+        c, rho = self.circles[circles, :2], self.circles[circles, 2]
+        bins = np.full((2, len(circles), _SHADOW_BINS), np.inf)
+        if w.n_obstacles:
+            reach = (rho + _SHADOW_CELLS * w._grid.h)[:, None]
+            query, ids = w._grid.pairs_in_boxes(c - reach, c + reach)
+            kind = w._kind_of(ids)
+            disc = np.empty((len(ids), 3))
+            x = kind == 0
+            disc[x] = w.circles[ids[x]]
+            disc[x, 2] += w.threshold
+            x = kind == 1
+            box = w.boxes[ids[x] - w._n_circles]
+            disc[x, :2] = 0.5 * (box[:, :2] + box[:, 2:])
+            disc[x, 2] = 0.5 * np.minimum(box[:, 2] - box[:, 0], box[:, 3] - box[:, 1])
+            disc[x, 2] += w.threshold
+            use = kind != 2  # polygons cast no shadow here
+            # Strictly inside (grazing tangents stay candidates); the circle's own obstacle, at
+            # distance 0, blocks nothing a tangent to it could use.
+            rel = disc[:, :2] - c[query]
+            dist = np.hypot(rel[:, 0], rel[:, 1])
+            r = disc[:, 2] - 4.0 * w.tol
+            use &= (r > 0) & (dist > 0)
+            q, theta = query[use], np.arctan2(rel[use, 1], rel[use, 0])
+            dist, r, rq = dist[use], r[use], rho[query[use]]
+            for k, sense in enumerate((1.0, -1.0)):
+                lo = np.clip((sense * rq - r) / dist, -1.0, 1.0)
+                hi = np.clip((sense * rq + r) / dist, -1.0, 1.0)
+                ok = hi > lo
+                first = np.ceil((theta[ok] + np.arcsin(lo[ok])) / _SHADOW_BIN + 1e-9)
+                last = np.floor((theta[ok] + np.arcsin(hi[ok])) / _SHADOW_BIN - 1e-9) - 1
+                first, last = first.astype(np.intp), last.astype(np.intp)
+                n = np.maximum(last - first + 1, 0)
+                if not n.sum():
+                    continue
+                step = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+                cell = np.repeat(q[ok], n) * _SHADOW_BINS + np.mod(np.repeat(first, n) + step,
+                                                                   _SHADOW_BINS)  # fmt: skip
+                np.minimum.at(bins[k].reshape(-1), cell, np.repeat(dist[ok], n))
+        return [_sparse_max(bins[0]), _sparse_max(bins[1])]
+
+    def _blocked_near(self, cand: _Tangents) -> np.ndarray:
+        """Tangents that come too close to an obstacle near the circle they leave (booleans; the
+        world's exact distance formulas, against the obstacles the index holds within a few
+        index cells of that circle)."""
+        w = self.world
+        blocked = np.zeros(len(cand.j), dtype=bool)
+        if w.n_obstacles <= _NEAR_ALL:
+            return blocked  # few obstacles: the world's own test is as cheap
+        circles, inverse = np.unique(cand.i, return_inverse=True)
+        c, rho = self.circles[circles, :2], self.circles[circles, 2]
+        reach = (rho + 2.0 * w._grid.h)[:, None]
+        query, ids = w._grid.pairs_in_boxes(c - reach, c + reach)
+        count = np.bincount(query, minlength=len(circles))
+        first = np.concatenate([[0], np.cumsum(count)])[:-1]
+        n = count[inverse]
+        if not n.sum() or n.sum() > _NEAR_PAIRS:
+            return blocked
+        seg = np.repeat(np.arange(len(cand.j)), n)
+        k = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+        obs = ids[np.repeat(first[inverse], n) + k]
+        d = w._pair_distance(seg, obs, cand.p, cand.q)
+        blocked[seg[d < w.threshold]] = True
+        return blocked
 
     def _arcs_ok(self, u: int, sweep: np.ndarray) -> np.ndarray:
         """Which arcs along node ``u``'s circle, from its angle through ``sweep``, are free."""
@@ -580,21 +995,70 @@ class _TangentSearch:
         return pieces
 
 
+#: Worlds with at most this many obstacles skip the near-obstacle pass (the world's own test,
+#: without an index, is as cheap).
+_NEAR_ALL = 24
+#: Most (tangent, obstacle) pairs of the near-obstacle pass.
+_NEAR_PAIRS = 2_000_000
+#: Most circles whose tangents one vectorised pass finds.
+_BATCH = 32
+#: Bins of directions of a circle's shadow profile, and how far (index cells) its discs are.
+_SHADOW_BINS = 1024
+_SHADOW_BIN = _TWO_PI / _SHADOW_BINS
+_SHADOW_CELLS = 8.0
+#: A circle's shadow profile is built when it has at least this many candidate pairs.
+_SHADOW_WORTH = 100
+#: The raster's rejection is run when at least this share of its cells is core.
+_RASTER_WORTH = 0.02
+
+
+def _sparse_max(values: np.ndarray) -> np.ndarray:
+    """Range-maximum tables of circular arrays ``(n, bins)``: ``(n, levels, bins)``, level k
+    holding the maxima of windows of 2^k."""
+    m = values.shape[-1]
+    rows = [values]
+    step = 1
+    while 2 * step <= m:
+        prev = rows[-1]
+        ahead = np.concatenate([prev[:, step:], prev[:, :step]], axis=1)
+        rows.append(np.maximum(prev, ahead))
+        step *= 2
+    return np.stack(rows, axis=1)
+
+
+def _range_max(table: np.ndarray, which: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """Maxima of the circular arrays ``which`` over the index ranges ``lo..hi`` (``hi >= lo``;
+    a range of the whole circle or more gives the maximum of all)."""
+    m = table.shape[-1]
+    length = hi - lo + 1
+    out = table[:, -1].max(axis=1)[which]
+    part = length < m
+    if part.any():
+        k = np.floor(np.log2(length[part])).astype(np.intp)
+        a = np.mod(lo[part], m)
+        b = np.mod(hi[part] - (1 << k) + 1, m)
+        w = which[part]
+        out[part] = np.maximum(table[w, k, a], table[w, k, b])
+    return out
+
+
 class _Tangents:
     """The common tangents from one circle to many: arrays of the same length.
 
     ``q`` is where each tangent ends (its tangent point, or where it enters the goal disc);
-    ``seg``, ``h`` and ``key`` (the tangent's length, its end's distance to the goal and the key
-    of the node it reaches) are filled in by the search.
+    ``pos_i`` is the tangent point's angle from the start of circle i's free arc; ``seg``, ``h``
+    and ``node`` (the tangent's length, the lower bound from its end to the goal, and the node
+    it reaches, -1 before it is reached) are filled in by the search.
     """
 
-    _FIELDS = ("j", "t", "p", "q", "angle_i", "angle_j", "sense_i", "sense_j", "seg", "h", "key")
+    _FIELDS = ("i", "j", "t", "p", "q", "angle_i", "angle_j", "sense_i", "sense_j", "pos_i",
+               "seg", "h", "node")  # fmt: skip
 
-    def __init__(self, j, t, p, q, angle_i, angle_j, sense_i, sense_j) -> None:
-        self.j, self.t, self.p, self.q = j, t, p, q
+    def __init__(self, i, j, t, p, q, angle_i, angle_j, sense_i, sense_j) -> None:
+        self.i, self.j, self.t, self.p, self.q = i, j, t, p, q
         self.angle_i, self.angle_j = angle_i, angle_j
         self.sense_i, self.sense_j = sense_i, sense_j
-        self.seg = self.h = self.key = None
+        self.pos_i = self.seg = self.h = self.node = None
 
     def take(self, idx: np.ndarray) -> _Tangents:
         out = _Tangents.__new__(_Tangents)
@@ -604,35 +1068,13 @@ class _Tangents:
         return out
 
 
-def _least_over_intervals(
-    a0: np.ndarray, width: np.ndarray, value: np.ndarray, phi: np.ndarray
-) -> np.ndarray:
-    """For each angle ``phi`` in [0, 2 pi), the least ``value`` of the intervals
-    ``[a0, a0 + width]`` (angles modulo 2 pi, open at both ends) that contain it; ``inf`` where
-    none does."""
-    if not len(a0):
-        return np.full(len(phi), np.inf)
-    # Each interval also once shifted down a turn, so those that wrap past 2 pi are found.
-    lo = np.concatenate([a0, a0 - _TWO_PI])
-    hi = lo + np.concatenate([width, width])
-    val = np.concatenate([value, value])
-    edges = np.unique(np.concatenate([lo, hi, [0.0, _TWO_PI]]))
-    mids = 0.5 * (edges[:-1] + edges[1:])
-    inside = (lo[None, :] < mids[:, None]) & (mids[:, None] < hi[None, :])
-    least = np.where(inside, val[None, :], np.inf).min(axis=1)
-    piece = np.clip(np.searchsorted(edges, phi, side="right") - 1, 0, len(mids) - 1)
-    # An angle on a piece's edge may lie on an interval's open end: count it as outside.
-    on_edge = np.isin(phi, edges)
-    return np.where(on_edge, np.inf, least[piece])
-
-
-def _tangents_from(circles: np.ndarray, i: int) -> _Tangents:
-    """Every common tangent from circle ``i`` to the others (not back to the start), with the
-    sense in which a path along it wraps each circle (+1 counter-clockwise, -1 clockwise, 0 for
-    a point)."""
+def _tangents_from(circles: np.ndarray, i: np.ndarray, j: np.ndarray) -> _Tangents:
+    """Every common tangent from circle ``i[k]`` to circle ``j[k]``, for each pair, with the sense
+    in which a path along it wraps each circle (+1 counter-clockwise, -1 clockwise, 0 for a
+    point)."""
     c = circles
-    j = np.arange(len(c))
-    j = j[(j != i) & (j != 0)]
+    i = np.asarray(i, dtype=np.intp)
+    j = np.asarray(j, dtype=np.intp)
     ri, rj = c[i, 2], c[j, 2]
     d_vec = c[j, :2] - c[i, :2]
     d = np.hypot(*d_vec.T)
@@ -652,15 +1094,16 @@ def _tangents_from(circles: np.ndarray, i: int) -> _Tangents:
             cos_a = np.divide(ri - rj, d, out=np.ones_like(d), where=d > 0)
         ang = base + sign * np.arccos(np.clip(cos_a, -1.0, 1.0))
         n = np.column_stack([np.cos(ang), np.sin(ang)])
-        p = c[i, :2] + ri * n
+        p = c[i, :2] + ri[:, None] * n
         q = c[j, :2] + (-1.0 if inner else 1.0) * rj[:, None] * n
         aj = ang + math.pi if inner else ang
-        parts.append((j[ok], np.full(int(ok.sum()), t), p[ok], q[ok], ang[ok], aj[ok]))
-    jj, tt, p, q, ai, aj = (np.concatenate(x) for x in zip(*parts, strict=True))
+        parts.append((i[ok], j[ok], np.full(int(ok.sum()), t), p[ok], q[ok], ang[ok], aj[ok]))
+    ii, jj, tt, p, q, ai, aj = (np.concatenate(x) for x in zip(*parts, strict=True))
     direction = q - p
-    sense_i = _sense(direction, c[i, :2] - p) if ri > 0 else np.zeros(len(jj), dtype=int)
+    sense_i = np.where(c[ii, 2] > 0, _sense(direction, c[ii, :2] - p), 0)
     sense_j = np.where(c[jj, 2] > 0, _sense(direction, c[jj, :2] - q), 0)
-    return _Tangents(jj, tt, p, q, np.mod(ai, _TWO_PI), np.mod(aj, _TWO_PI), sense_i, sense_j)
+    return _Tangents(ii, jj, tt, p, q, np.mod(ai, _TWO_PI), np.mod(aj, _TWO_PI), sense_i,
+                     sense_j)  # fmt: skip
 
 
 def _sense(direction: np.ndarray, to_center: np.ndarray) -> np.ndarray:
@@ -706,8 +1149,7 @@ def _arcs_free(world: World, center, rho, a0, sweep) -> np.ndarray:
 
 
 def _edges_of(world: World, arc: np.ndarray, ids: np.ndarray, kind: np.ndarray):
-    """(arc, edge) pairs for the boxes and polygon edges among the candidates (the world indexes
-    a polygon by its edges, and its interior, which :meth:`World.in_polygons` covers)."""
+    """(arc, edge) pairs for the boxes and polygons among the candidates."""
     arcs, edges = [], []
     x = kind == 1
     if x.any():

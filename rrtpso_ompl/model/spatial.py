@@ -174,7 +174,7 @@ class Grid:
         """(query, cell) pairs to unique (query, id) pairs through the CSR arrays."""
         if not len(cells):
             return np.empty(0, dtype=np.intp), np.empty(0, dtype=np.intp)
-        key = np.unique(query.astype(np.int64) * (self.nx * self.ny) + cells)
+        key = _unique_ints(query.astype(np.int64) * (self.nx * self.ny) + cells)
         query, cells = np.divmod(key, self.nx * self.ny)
         start, stop = self.offsets[cells], self.offsets[cells + 1]
         counts = stop - start
@@ -190,9 +190,22 @@ class Grid:
             mark[np.searchsorted(queries, q), ids] = True
             row, ids = np.nonzero(mark)
             return queries[row].astype(np.intp), ids.astype(np.intp)
-        key = np.unique(q * n + ids)
+        key = _unique_ints(q * n + ids)
         q, ids = np.divmod(key, n)
         return q.astype(np.intp), ids.astype(np.intp)
+
+
+def _unique_ints(key: np.ndarray) -> np.ndarray:
+    """``np.unique`` of an integer array, by sorting: numpy 2's hash-based ``np.unique`` is an
+    order of magnitude slower on the millions of keys a bulk query makes (4.8 s against 0.3 s for
+    2 million int64, numpy 2.4), and it was the exact optimum's hot spot."""
+    if len(key) < 2:
+        return key.copy()
+    key = np.sort(key)
+    keep = np.empty(len(key), dtype=bool)
+    keep[0] = True
+    np.not_equal(key[1:], key[:-1], out=keep[1:])
+    return key[keep]
 
 
 def _csr(i0, i1, j0, j1, counts, nx: int, n_cells: int) -> tuple[np.ndarray, np.ndarray]:

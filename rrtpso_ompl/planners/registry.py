@@ -46,7 +46,7 @@ __all__ = [
 log = logging.getLogger(__name__)
 
 ENTRY_POINT_GROUP = "rrtpso_ompl.planners"
-FIRST_PARTY_PLUGINS = ("rrtstar_pso", "pso", "ompl_geometric")
+FIRST_PARTY_PLUGINS = ("rrtstar_pso", "pso", "exact", "ompl_geometric")
 
 
 @dataclass(frozen=True)

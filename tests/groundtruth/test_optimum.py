@@ -313,21 +313,241 @@ def test_the_json_path_is_a_valid_path_of_nearly_the_exact_length(path):
 
 
 @pytest.mark.parametrize("seed", [0, 1])
-def test_occlusion_never_drops_a_free_tangent(seed):
-    """The angular filter only removes tangents the exact check would reject."""
-    from rrtpso_ompl.groundtruth.optimum import _node_circles, _tangents_from, _TangentSearch
+def test_the_cheap_filters_never_drop_a_free_tangent(seed):
+    """The raster's rejection and the near-obstacle pass only remove tangents the exact check
+    would reject, and between them they remove most of the blocked ones."""
+    from rrtpso_ompl.groundtruth.free_grid import FreeGrid
+    from rrtpso_ompl.groundtruth.optimum import _NodeCircles, _tangents_from, _TangentSearch
 
     problem = problem_from_dict(_cluttered(seed, 0.8, 40, (1.5, 4)))
     world = World.from_problem(problem)
     start, goal = np.array(problem.start[:2]), np.array(problem.goal[:2])
-    circles = _node_circles(problem, world, start, goal, world.robot_radius)
-    search = _TangentSearch(world, circles, 0.0, math.inf, "t")
-    dropped = 0
-    for i in range(len(search.circles)):
-        cand = _tangents_from(search.circles, i)
-        cand.seg = np.hypot(*(cand.q - cand.p).T)
-        blocked = search._occluded(i, cand)
-        if blocked.any():
-            assert not world.segments_free(cand.p[blocked], cand.q[blocked]).any()
-            dropped += int(blocked.sum())
-    assert dropped > 500  # the filter does real work
+    grid = FreeGrid.for_world(world, start, goal)
+    nodes = _NodeCircles.build(world, grid, start, goal, world.robot_radius)
+    search = _TangentSearch(world, grid, nodes, 0.0, math.inf, "t", None)
+    n = len(search.circles)
+    i, j = np.nonzero(~np.eye(n, dtype=bool))
+    pick = np.random.default_rng(seed).choice(len(i), 2000, replace=False)
+    cand = _tangents_from(search.circles, i[pick], j[pick])
+    free = world.segments_free(cand.p, cand.q)
+    raster = grid.blocked_segments(cand.p, cand.q)
+    near = search._blocked_near(cand)
+    assert not (free & (raster | near)).any()
+    assert (raster | near).sum() > 0.5 * (~free).sum()
+
+
+# ----------------------------------------------------------------------------------------------
+# Maps: brute force on small random grids, mazes, the lower bounds and the pruning
+# ----------------------------------------------------------------------------------------------
+def _write_map(folder, blocked: np.ndarray, res: float = 1.0, name: str = "m"):
+    """A map_server map (YAML + PGM) of ``blocked`` (image order, row 0 on top)."""
+    h, w = blocked.shape
+    img = np.where(blocked, 0, 254).astype(np.uint8)
+    (folder / f"{name}.pgm").write_bytes(f"P5\n{w} {h}\n255\n".encode() + img.tobytes())
+    (folder / f"{name}.yaml").write_text(
+        f"image: {name}.pgm\nresolution: {res}\norigin: [0.0, 0.0, 0.0]\n")
+    return folder / f"{name}.yaml"
+
+
+def _map_problem(folder, blocked, start, goal, radius, res=1.0):
+    yaml_path = _write_map(folder, blocked, res)
+    doc = {"name": "grid", "map": yaml_path.name, "start": list(start), "goal": list(goal),
+           "robot": {"radius": radius}}  # fmt: skip
+    return problem_from_dict(doc, source=str(folder / "grid.yaml"), base=folder)
+
+
+def _map_brute_force(blocked, res, radius, start, goal, quad_segs=8,
+                     bound=math.inf) -> float | None:  # fmt: skip
+    """Visibility graph of the blocked cells grown by the radius, drawn by shapely (vertices on
+    the true boundary: a lower bound that tends to the optimum). A point robot's cells are grown
+    by a hair with square corners, so that two cells touching at a corner stay closed, as in the
+    exact checker. Only vertices a path no longer than ``bound`` can pass are kept."""
+    h = blocked.shape[0]
+    rows, cols = np.nonzero(blocked)
+    cells = shapely.union_all(shapely.box(cols * res, (h - 1 - rows) * res, (cols + 1) * res,
+                                          (h - rows) * res))  # fmt: skip
+    if radius > 0:
+        union = cells.buffer(radius, quad_segs=quad_segs)
+    else:
+        union = cells.buffer(1e-7, join_style="mitre")
+    verts = [start, goal]
+    for poly in getattr(union, "geoms", [union]):
+        for ring in [poly.exterior, *poly.interiors]:
+            verts.extend(ring.coords[:-1])
+    v = np.array(verts, float)
+    x1, y1 = blocked.shape[1] * res, h * res
+    v = v[(v[:, 0] >= 0) & (v[:, 0] <= x1) & (v[:, 1] >= 0) & (v[:, 1] <= y1)]
+    v = v[np.hypot(*(v - v[0]).T) + np.hypot(*(v - v[1]).T) <= bound]
+    i, j = np.triu_indices(len(v), k=1)
+    lines = shapely.linestrings(np.stack([v[i], v[j]], axis=1))
+    ok = ~shapely.relate_pattern(union, lines, "T********")
+    w = np.hypot(*(v[i] - v[j]).T)[ok]
+    graph = csr_array((w, (i[ok], j[ok])), shape=(len(v), len(v)))
+    d = dijkstra(graph, directed=False, indices=0)[1]
+    return float(d) if np.isfinite(d) else None
+
+
+def _random_grid(rng, size=12, density=0.3, pinches=2):
+    """Random cells, with a few diagonal pinches (two cells touching only at a corner)."""
+    g = rng.random((size, size)) < density
+    for _ in range(pinches):
+        r, c = rng.integers(1, size - 2, 2)
+        g[r : r + 2, c : c + 2] = [[True, False], [False, True]]
+    g[-1, 0] = g[0, -1] = False  # start and goal cells
+    return g
+
+
+@pytest.mark.parametrize(("seed", "radius"), [(0, 0.0), (1, 0.0), (2, 0.0), (3, 0.25), (4, 0.4),
+                                              (5, 0.7)])  # fmt: skip
+def test_grid_maps_agree_with_brute_force(tmp_path, seed, radius):
+    rng = np.random.default_rng(seed)
+    blocked = _random_grid(rng)
+    start, goal = (0.5, 0.5), (11.5, 11.5)
+    if radius > 0:  # a disc robot needs room at the ends
+        blocked[-2:, :2] = blocked[:2, -2:] = False
+        start, goal = (1.0, 1.0), (11.0, 11.0)
+    problem = _map_problem(tmp_path, blocked, start, goal, radius)
+    result = shortest_path(problem)
+    bound = result.length * 1.001 if result.found else math.inf
+    brute = _map_brute_force(blocked, 1.0, radius, start, goal, bound=bound)
+    if brute is None:
+        assert not result.found
+        return
+    assert result.found
+    world = World.from_problem(problem)
+    assert world.path_valid(result.valid_polyline(world))
+    # The brute force's polygons lie inside the grown cells: a lower bound, close to it.
+    assert brute <= result.length * (1 + 1e-9) + 1e-6
+    assert result.length <= brute * (1 + 1e-3) + 1e-6
+    grid = grid_path(problem)
+    if grid is not None:
+        assert result.length <= path_length(grid) + 1e-9
+
+
+def _maze(rng, n=6, corridor=1, wall=1) -> np.ndarray:
+    """A perfect maze of n x n rooms (depth-first), corridors and walls in cells."""
+    step = corridor + wall
+    size = n * step + wall
+    g = np.ones((size, size), bool)
+    seen = np.zeros((n, n), bool)
+    stack = [(0, 0)]
+    seen[0, 0] = True
+    g[wall : wall + corridor, wall : wall + corridor] = False
+    while stack:
+        i, j = stack[-1]
+        nb = [(i + di, j + dj) for di, dj in ((0, 1), (1, 0), (0, -1), (-1, 0))
+              if 0 <= i + di < n and 0 <= j + dj < n and not seen[i + di, j + dj]]  # fmt: skip
+        if not nb:
+            stack.pop()
+            continue
+        a, b = nb[rng.integers(len(nb))]
+        seen[a, b] = True
+        r0, c0 = wall + a * step, wall + b * step
+        g[r0 : r0 + corridor, c0 : c0 + corridor] = False
+        r, c = wall + min(i, a) * step, wall + min(j, b) * step
+        if a != i:
+            g[r + corridor : r + step, c : c + corridor] = False
+        else:
+            g[r : r + corridor, c + corridor : c + step] = False
+        stack.append((a, b))
+    return g
+
+
+@pytest.mark.parametrize(("corridor", "radius"), [(1, 0.0), (2, 0.0), (3, 0.5)])
+def test_mazes_agree_with_brute_force(tmp_path, corridor, radius):
+    blocked = _maze(np.random.default_rng(corridor), 5, corridor)
+    size = blocked.shape[0]
+    start = (1 + corridor / 2, size - 1 - corridor / 2)  # the top-left room
+    goal = (size - 1 - corridor / 2, 1 + corridor / 2)  # the bottom-right room
+    problem = _map_problem(tmp_path, blocked, start, goal, radius)
+    result = shortest_path(problem)
+    brute = _map_brute_force(blocked, 1.0, radius, start, goal, bound=result.length * 1.001)
+    assert result.found and brute is not None
+    assert result.length > 1.15 * math.dist(start, goal)  # walls in the way
+    assert brute <= result.length * (1 + 1e-9) + 1e-6 <= brute * (1 + 1e-3) + 2e-6
+
+
+def test_the_pinch_between_two_cells_is_closed(tmp_path):
+    """Two cells touching only at a corner close the diagonal for a point robot: the path goes
+    round (the old formulation's semantics)."""
+    blocked = np.zeros((6, 6), bool)
+    blocked[1:3, 1:3] = True
+    blocked[3:5, 3:5] = True  # touches the first block at (3, 3) only
+    blocked[0, 5] = True
+    # The squares [1, 3] x [3, 5] and [3, 5] x [1, 3]: from below-left of the pinch to above
+    # right of it, the straight line runs through (3, 3).
+    problem = _map_problem(tmp_path, blocked, (2.0, 2.0), (4.0, 4.0), 0.0)
+    result = shortest_path(problem)
+    brute = _map_brute_force(blocked, 1.0, 0.0, (2.0, 2.0), (4.0, 4.0))
+    assert result.length > math.dist((2, 2), (4, 4)) + 0.1
+    assert result.length == pytest.approx(brute, rel=1e-5)
+
+
+@pytest.mark.parametrize("radius", [0.0, 0.6])
+def test_the_lower_bounds_are_admissible(tmp_path, radius):
+    """Against exact optima from random free points: the geodesic bound never exceeds the
+    shortest path, and free segments always pass the step-count test."""
+    from rrtpso_ompl.groundtruth.free_grid import FreeGrid
+
+    blocked = _maze(np.random.default_rng(7), 5, 2)
+    size = blocked.shape[0]
+    goal = (size - 2.0, 2.0)
+    problem = _map_problem(tmp_path, blocked, (2.0, size - 2.0), goal, radius)
+    world = World.from_problem(problem)
+    grid = FreeGrid.for_world(world, problem.start, goal)
+    rng = np.random.default_rng(0)
+    pts = rng.uniform(0, size, (400, 2))
+    pts = pts[world.point_clearance(pts) >= world.threshold][:12]
+    assert len(pts) >= 8
+    lb = grid.lower_bound(1, pts)
+    tight = 0
+    for p, bound in zip(pts, lb, strict=True):
+        doc = {"map": "m.yaml", "start": p.tolist(), "goal": list(goal),
+               "robot": {"radius": radius}}  # fmt: skip
+        query = problem_from_dict(doc, source=str(tmp_path / "q.yaml"), base=tmp_path)
+        exact = shortest_path(query).length
+        assert bound <= exact * (1 + 1e-12)
+        tight += bound > math.dist(p, goal) + 1.0  # the geodesic part does work
+    assert tight >= 3
+    a = rng.uniform(0, size, (3000, 2))
+    b = np.clip(a + rng.uniform(-5, 5, (3000, 2)), 0, size)  # short: some are free in a maze
+    free = world.segments_free(a, b) & (world.point_clearance(a) >= world.threshold)
+    assert free.sum() > 20
+    ranges = grid.step_ranges(np.column_stack([np.vstack([a, b]), np.zeros(6000)]))
+    d = np.abs(b - a)
+    ok = grid.visible_pairs(ranges[:3000], ranges[3000:], d[:, 0], d[:, 1])
+    assert ok[free].all() and not ok.all()  # never drops a free segment, and does prune
+
+
+def test_bounded_rounds_find_the_unbounded_optimum(tmp_path):
+    """Rounds of growing bounds, and a bound far too loose, give the same optimum."""
+    blocked = _maze(np.random.default_rng(3), 5, 2)
+    size = blocked.shape[0]
+    problem = _map_problem(tmp_path, blocked, (2.0, size - 2.0), (size - 2.0, 2.0), 0.3)
+    rounds = shortest_path(problem)
+    free = shortest_path(problem, upper_bound=math.inf)
+    assert rounds.length == pytest.approx(free.length, rel=1e-12)
+
+
+def test_stopped_searches_say_so():
+    problem = load_problem(PROBLEMS / "static" / "maze.yaml")
+    calls = []
+
+    def terminate() -> bool:
+        calls.append(1)
+        return len(calls) > 3
+
+    result = shortest_path(problem, terminate=terminate)
+    assert result.stopped and not result.found and result.length is None
+    assert not shortest_path(problem).stopped
+
+
+def test_six_library_maps_keep_their_written_optima():
+    """The optima written in the headers of problems/maps (computed by the old formulation)."""
+    import re
+
+    for path in sorted((PROBLEMS / "maps").glob("*.yaml")):
+        text = path.read_text()
+        written = float(re.search(r"Shortest collision-free path: ([0-9.]+)", text).group(1))
+        result = shortest_path(load_problem(path))
+        assert result.length == pytest.approx(written, abs=6e-5), path.stem
