@@ -28,6 +28,7 @@ the workspace (floating-point round-off).
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Sequence
@@ -37,6 +38,7 @@ import shapely
 
 from .geometry import point_segment_distance, point_segment_distance_xy, segments_cross
 from .problem import Circle, Polygon, Problem, clearance_threshold, touch_tolerance
+from .raster import Lattice, MapRaster
 from .spatial import Grid
 
 __all__ = ["World", "clearance_threshold"]  # the rule lives in problem (the loader shares it)
@@ -67,6 +69,11 @@ class World:
         Radius ``R`` of the robot disc (its safety zone), in the same unit.
     boxes : sequence of (xmin, ymin, xmax, ymax)
         Axis-aligned rectangles (a map's blocked cells, merged; rectangles of a problem file).
+    raster : MapRaster, optional
+        The occupancy grid the last ``raster_boxes`` boxes were merged from, for lattice queries
+        (:meth:`free_cells`).
+    raster_boxes : int
+        How many of the boxes (the last ones) come from ``raster``.
     """
 
     def __init__(
@@ -76,6 +83,8 @@ class World:
         polygons: Sequence[np.ndarray | Sequence[Sequence[float]]] = (),
         robot_radius: float = 0.0,
         boxes: Sequence[Sequence[float]] = (),
+        raster: MapRaster | None = None,
+        raster_boxes: int = 0,
     ) -> None:
         (xmin, ymin), (xmax, ymax) = bounds
         self.bounds = ((float(xmin), float(ymin)), (float(xmax), float(ymax)))
@@ -93,6 +102,8 @@ class World:
         self._prepare_polygons()
         self._prepare_scalar()
         self._prepare_index()
+        self.raster = raster
+        self._raster_boxes = int(raster_boxes) if raster is not None else 0
 
     # ------------------------------------------------------------------------------------------
     @classmethod
@@ -100,7 +111,13 @@ class World:
         """Build the static world of a :class:`~rrtpso_ompl.model.Problem` (moving obstacles
         are not part of it; a map's blocked cells are boxes)."""
         extra = getattr(problem, "map_boxes", None)
-        return cls.from_obstacles(problem.bounds, problem.obstacles, problem.robot.radius, extra)
+        occupancy = getattr(problem, "map", None)
+        raster = None
+        if occupancy is not None:
+            raster = MapRaster.from_image(occupancy.blocked, occupancy.origin,
+                                          occupancy.resolution, occupancy.unknown_blocks)  # fmt: skip
+        return cls.from_obstacles(problem.bounds, problem.obstacles, problem.robot.radius, extra,
+                                  raster)  # fmt: skip
 
     @classmethod
     def from_obstacles(
@@ -109,6 +126,7 @@ class World:
         obstacles: Sequence[Circle | Polygon],
         robot_radius: float,
         boxes: np.ndarray | None = None,
+        raster: MapRaster | None = None,
     ) -> World:
         """A world of the problem model's obstacles (:class:`~rrtpso_ompl.model.Circle`,
         :class:`~rrtpso_ompl.model.Polygon`; axis-aligned rectangles become boxes) and extra
@@ -119,11 +137,88 @@ class World:
         polygons = [np.asarray(o.points) for o in polys if not _is_box(o)]
         extra = np.asarray(boxes if boxes is not None else (), dtype=float).reshape(-1, 4)
         all_boxes = np.vstack([np.asarray(rects, dtype=float).reshape(-1, 4), extra])
-        return cls(bounds, circles, polygons, robot_radius, all_boxes)
+        return cls(bounds, circles, polygons, robot_radius, all_boxes, raster, len(extra))
 
     def with_robot_radius(self, robot_radius: float) -> World:
         """The same obstacles for another robot radius."""
-        return World(self.bounds, self.circles, self.polygons, robot_radius, self.boxes)
+        return World(self.bounds, self.circles, self.polygons, robot_radius, self.boxes,
+                     self.raster, self._raster_boxes)  # fmt: skip
+
+    # ------------------------------------------------------------------------------------------
+    # Lattice queries (the corridor search)
+    # ------------------------------------------------------------------------------------------
+    def lattice(self, max_cells: int) -> Lattice:
+        """A lattice of about ``max_cells`` square cells inside the bounds: aligned with the map's
+        cells when the world has one, else square cells centred in the bounds."""
+        if self.raster is not None:
+            return self.raster.lattice(self.bounds, max_cells)
+        (xmin, ymin), (xmax, ymax) = self.bounds
+        h = math.sqrt((xmax - xmin) * (ymax - ymin) / max(max_cells, 1))
+        lat = Lattice.over(self.bounds, h)
+        while lat.n_cells > max_cells:  # rounding may add a row or column
+            h *= 1.01
+            lat = Lattice.over(self.bounds, h)
+        return lat
+
+    def free_cells(self, lat: Lattice) -> np.ndarray:
+        """(nx, ny) booleans: the lattice cells every point of which is a free configuration
+        (for a point robot: cells no obstacle enters, which may touch one), conservatively.
+
+        A map answers exactly (:meth:`MapRaster.free_cells`); circles, polygons and a problem's
+        rectangles through the exact clearance at each cell's centre, which the whole square
+        keeps up to ``h / sqrt(2)``.
+        """
+        margin = self.threshold if self.robot_radius > 0.0 else 0.0
+        free = np.ones((lat.nx, lat.ny), dtype=bool)
+        if self.raster is not None:
+            free &= self.raster.free_cells(lat, margin, self.bounds)
+        shapes = self._non_raster
+        if shapes.n_obstacles and free.any():
+            free &= shapes._clear_cells(lat, margin + lat.h * math.sqrt(0.5))
+        return free
+
+    def _clear_cells(self, lat: Lattice, need: float) -> np.ndarray:
+        """(nx, ny) booleans: cells whose centre is at least ``need`` from every obstacle.
+
+        Each obstacle marks the cells near it (its bounding box grown by ``need``), with the
+        exact distance from their centres: the work grows with the area the obstacles cover,
+        not with the number of cells times the number of obstacles.
+        """
+        clear = np.ones((lat.nx, lat.ny), dtype=bool)
+        (ox, oy), h = lat.origin, lat.h
+        boxes = self._item_boxes() + np.array([-1.0, -1.0, 1.0, 1.0]) * need
+        i0 = np.clip(np.floor((boxes[:, 0] - ox) / h - 0.5), 0, lat.nx).astype(np.int64)
+        i1 = np.clip(np.ceil((boxes[:, 2] - ox) / h - 0.5) + 1, 0, lat.nx).astype(np.int64)
+        j0 = np.clip(np.floor((boxes[:, 1] - oy) / h - 0.5), 0, lat.ny).astype(np.int64)
+        j1 = np.clip(np.ceil((boxes[:, 3] - oy) / h - 0.5) + 1, 0, lat.ny).astype(np.int64)
+        ni, nj = np.maximum(i1 - i0, 0), np.maximum(j1 - j0, 0)
+        counts = ni * nj
+        # In chunks of obstacles whose cells add up to a bounded number of pairs.
+        ends = np.searchsorted(np.cumsum(counts), np.arange(0, counts.sum(), _PAIR_CHUNK))
+        cuts = np.unique(np.concatenate([ends, [len(counts)]]))
+        for a, b in itertools.pairwise(np.concatenate([[0], cuts])):
+            if a >= b:
+                continue
+            ids = np.arange(a, b)
+            c = counts[a:b]
+            obj = np.repeat(ids, c)
+            k = np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)
+            ci = i0[obj] + k // nj[obj]
+            cj = j0[obj] + k % nj[obj]
+            pts = np.column_stack([ox + h * (ci + 0.5), oy + h * (cj + 0.5)])
+            d = self._pair_distance(np.arange(len(obj)), obj, pts, pts)
+            close = d < need
+            clear[ci[close], cj[close]] = False
+        return clear
+
+    @functools.cached_property
+    def _non_raster(self) -> World:
+        """The obstacles that do not come from the map raster (all of them without one)."""
+        if self.raster is None:
+            return self
+        keep = self._n_boxes - self._raster_boxes
+        return World(self.bounds, self.circles, self.polygons, self.robot_radius,
+                     self.boxes[:keep])  # fmt: skip
 
     @property
     def n_obstacles(self) -> int:

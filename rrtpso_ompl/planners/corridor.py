@@ -1,0 +1,464 @@
+"""The corridor stage of RRTstarPSO: which way round the obstacles, decided before RRT* grows.
+
+A sampling planner commits to a corridor (a homotopy class) by chance: its first path goes through
+whichever door, aisle or gap its tree happened to cross first, and a local optimiser such as the
+swarm can shorten a path but never move it to another corridor. This stage looks at every
+corridor at once, at the resolution of a lattice:
+
+1. **Lattice.** Square cells over the workspace (about ``max_cells`` of them; aligned with an
+   occupancy map's own cells), each marked free when the robot's centre may be *anywhere* in it
+   (:meth:`~rrtpso_ompl.model.World.free_cells`: exact for maps, conservative for circles and
+   polygons; through the validity checker otherwise).
+2. **Route.** Dijkstra's algorithm over the free cells, 16-connected (the 8 neighbours and the
+   knight's moves, so a route deviates from a straight line by at most 2.7 % in length), from the
+   start's cell to the goal's. A diagonal or knight's move needs the cells it passes free, so
+   consecutive cells of a route always share an edge once the passed cells are inserted.
+3. **Funnel.** The route's cells form a channel, a strip of squares each sharing an edge (a
+   *portal*) with the next; the shortest path from start to goal inside the channel is found in
+   one pass by the funnel algorithm (Lee and Preparata 1984; Mononen's "simple stupid funnel").
+   It bends only at portal end points, the corners of the channel, exactly where a taut string
+   would: on a map with 1-cell corridors it is the exact shortest path within 1e-4.
+
+The path stays inside cells that are wholly free, so it is valid without further checks; it is
+checked once anyway (exactly, or through the user's checker, whose lattice answers are not
+conservative). Its cost is a few array operations and one sparse-graph search: milliseconds on a
+map of 65,000 cells.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy import ndimage
+from scipy.sparse.csgraph import dijkstra
+
+from ..model.geometry import path_length
+from ..model.raster import Lattice
+
+#: Alternative routes are tried when their lattice length is within this share of the best's
+#: (the lattice's error in length: up to 2.7 % for the moves, plus the cells' conservatism).
+ALTERNATIVE_SLACK = 0.06
+#: ... and when they pass this share of the lattice's diagonal away from the routes before.
+ALTERNATIVE_APART = 0.03
+
+__all__ = [
+    "ALTERNATIVE_APART",
+    "ALTERNATIVE_SLACK",
+    "CorridorResult",
+    "alternative_routes",
+    "channel",
+    "corridor_path",
+    "free_rectangles",
+    "funnel",
+    "lattice_route",
+]
+
+#: Moves of the 16-connected lattice (half of them; the graph is undirected): the cells next to
+#: the way that must be free too, and those the channel goes through (each sharing an edge with
+#: the one before).
+_MOVES = (
+    ((1, 0), (), ()),
+    ((0, 1), (), ()),
+    ((1, 1), ((1, 0), (0, 1)), ((1, 0),)),
+    ((1, -1), ((1, 0), (0, -1)), ((1, 0),)),
+    ((2, 1), ((1, 0), (1, 1)), ((1, 0), (1, 1))),
+    ((1, 2), ((0, 1), (1, 1)), ((0, 1), (1, 1))),
+    ((2, -1), ((1, 0), (1, -1)), ((1, 0), (1, -1))),
+    ((1, -2), ((0, -1), (1, -1)), ((0, -1), (1, -1))),
+)
+
+
+@dataclass(frozen=True)
+class CorridorResult:
+    """Outcome of :func:`corridor_path`.
+
+    Attributes
+    ----------
+    path : (n, 2) ndarray or None
+        The funnel path from start to goal, valid; None when the lattice has no route.
+    length : float
+        Its length (``inf`` without one).
+    lattice : Lattice or None
+        The lattice searched.
+    cells : int
+        Free cells of the lattice.
+    route_cells : int
+        Cells of the route.
+    time : float
+        Seconds.
+    reason : str
+        Why there is no path (empty when there is one).
+    stages : dict
+        Seconds per step (``cells``, ``route``, ``funnel``).
+    routes, chosen : int
+        Routes tried and the one whose funnel path won (0: the shortest route).
+    """
+
+    path: np.ndarray | None
+    length: float = math.inf
+    lattice: Lattice | None = None
+    cells: int = 0
+    route_cells: int = 0
+    time: float = 0.0
+    reason: str = ""
+    stages: dict[str, float] = field(default_factory=dict)
+    routes: int = 0
+    chosen: int = 0
+
+
+def lattice_graph(free: np.ndarray):
+    """The 16-connected graph of the free cells (CSR, undirected; cell ``(i, j)`` is node
+    ``i * ny + j``; move lengths in cells)."""
+    nx, ny = free.shape
+    index = np.arange(nx * ny).reshape(nx, ny)
+    rows, cols, weights = [], [], []
+    for (di, dj), passed, _ in _MOVES:
+        # Cells (i, j) whose move to (i + di, j + dj) stays on the lattice.
+        i0, i1 = max(0, -di), nx - max(0, di)
+        j0, j1 = max(0, -dj), ny - max(0, dj)
+        if i0 >= i1 or j0 >= j1:
+            continue
+        ok = free[i0:i1, j0:j1] & free[i0 + di : i1 + di, j0 + dj : j1 + dj]
+        for pi, pj in passed:
+            ok &= free[i0 + pi : i1 + pi, j0 + pj : j1 + pj]
+        a = index[i0:i1, j0:j1][ok]
+        rows.append(a)
+        cols.append(a + di * ny + dj)
+        weights.append(np.full(len(a), math.hypot(di, dj)))
+    n = nx * ny
+    return coo_matrix(
+        (np.concatenate(weights), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)
+    ).tocsr()
+
+
+def _walk(pred: np.ndarray, node: int) -> list[int]:
+    """Nodes from the root of a predecessor tree to ``node`` (at most as many steps as nodes)."""
+    out = [node]
+    while pred[out[-1]] >= 0:
+        out.append(int(pred[out[-1]]))
+    return out[::-1]
+
+
+def lattice_route(free: np.ndarray, source: tuple[int, int], target: tuple[int, int]):
+    """The shortest 16-connected route of free cells from ``source`` to ``target`` (cell lists),
+    or None."""
+    ny = free.shape[1]
+    s = source[0] * ny + source[1]
+    t = target[0] * ny + target[1]
+    dist, pred = dijkstra(lattice_graph(free), directed=False, indices=s,
+                          return_predecessors=True)  # fmt: skip
+    if not np.isfinite(dist[t]):
+        return None
+    return [(v // ny, v % ny) for v in _walk(pred, t)]
+
+
+def alternative_routes(
+    free: np.ndarray, source, target, count: int, slack: float, apart: float
+) -> list[list[tuple[int, int]]]:
+    """The shortest route and up to ``count`` others through different corridors.
+
+    With Dijkstra distances from both ends, the best route through a cell ``v`` has length
+    ``d_s(v) + d_t(v)``. An alternative goes through the cell of least such length that lies
+    more than ``apart`` cells from every route taken so far, if that length is within ``slack``
+    (relative) of the best: a different door, aisle or side of an obstacle (the *via-node* method
+    of alternative route planning on road networks).
+    """
+    nx, ny = free.shape
+    s = source[0] * ny + source[1]
+    t = target[0] * ny + target[1]
+    dist, pred = dijkstra(lattice_graph(free), directed=False, indices=[s, t],
+                          return_predecessors=True)  # fmt: skip
+    best = dist[0, t]
+    if not np.isfinite(best):
+        return []
+    through = dist[0] + dist[1]
+    routes = [_walk(pred[0], t)]
+    near = np.zeros(nx * ny, dtype=bool)
+    for _ in range(count):
+        mask = np.ones((nx, ny), dtype=bool)
+        for r in routes[-1:]:
+            near[np.asarray(r)] = True
+        mask = ~near.reshape(nx, ny)
+        far = ndimage.distance_transform_edt(mask) > apart
+        ok = far.ravel() & (through <= best * (1.0 + slack))
+        if not ok.any():
+            break
+        v = int(np.flatnonzero(ok)[np.argmin(through[ok])])
+        routes.append(_walk(pred[0], v) + _walk(pred[1], v)[::-1][1:])
+    return [[(v // ny, v % ny) for v in r] for r in routes]
+
+
+def channel(route: list[tuple[int, int]]) -> list[tuple[int, int]]:
+    """The route with the cells its diagonal and knight's moves pass inserted: consecutive cells
+    share an edge."""
+    out = [route[0]]
+    for (i0, j0), (i1, j1) in zip(route[:-1], route[1:], strict=True):
+        di, dj = i1 - i0, j1 - j0
+        for (mi, mj), _, via in _MOVES:
+            for sign in (1, -1):
+                if (di, dj) == (sign * mi, sign * mj):
+                    out.extend((i0 + sign * pi, j0 + sign * pj) for pi, pj in via)
+        out.append((i1, j1))
+    return out
+
+
+def free_rectangles(free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Free cells merged into rectangles: ``(rects, label)``.
+
+    ``rects[k] = (i0, i1, j0, j1)`` covers cells ``i0 <= i < i1``, ``j0 <= j < j1``; ``label``
+    (nx, ny) holds each free cell's rectangle (-1 for blocked cells). Runs of free cells along x
+    in each row, and equal runs in consecutive rows, become one rectangle (as a map's blocked
+    cells are merged into boxes), in O(cells) array operations.
+    """
+    nx, ny = free.shape
+    label = np.full((nx, ny), -1, dtype=np.int64)
+    if not free.any():
+        return np.empty((0, 4), dtype=np.int64), label
+    pad = np.zeros((ny, nx + 2), dtype=np.int8)
+    pad[:, 1:-1] = free.T
+    step = np.diff(pad, axis=1)
+    rows, c0 = np.nonzero(step == 1)
+    _, c1 = np.nonzero(step == -1)
+    order = np.lexsort((rows, c1, c0))
+    rows, c0, c1 = rows[order], c0[order], c1[order]
+    new = np.ones(len(rows), dtype=bool)
+    new[1:] = (c0[1:] != c0[:-1]) | (c1[1:] != c1[:-1]) | (rows[1:] != rows[:-1] + 1)
+    group = np.cumsum(new) - 1
+    j1 = np.zeros(group[-1] + 1, dtype=np.int64)
+    np.maximum.at(j1, group, rows + 1)
+    rects = np.column_stack([c0[new], c1[new], rows[new], j1])
+    # Label every cell of every run with its rectangle.
+    length = c1 - c0
+    cell_i = np.repeat(c0, length) + (
+        np.arange(length.sum()) - np.repeat(np.cumsum(length) - length, length)
+    )
+    label[cell_i, np.repeat(rows, length)] = np.repeat(group, length)
+    return rects, label
+
+
+def _rectangle_channel(cells, label: np.ndarray) -> list[int]:
+    """The rectangles an edge-connected cell sequence passes through, in order, without
+    repeats (a rectangle entered twice cuts out the loop in between: it is convex)."""
+    seq: list[int] = []
+    where: dict[int, int] = {}
+    for cell in cells:
+        r = int(label[cell])
+        if seq and seq[-1] == r:
+            continue
+        if r in where:  # back into a rectangle already passed: drop the detour
+            for dropped in seq[where[r] + 1 :]:
+                where.pop(dropped, None)
+            del seq[where[r] + 1 :]
+            continue
+        where[r] = len(seq)
+        seq.append(r)
+    return seq
+
+
+def _portals(seq: list[int], rects: np.ndarray, lat: Lattice, shrink: float):
+    """(left, right) end points of the edge each rectangle shares with the next, seen in the
+    direction of travel, each moved ``shrink`` towards the other."""
+    (ox, oy), h = lat.origin, lat.h
+    out = []
+    for a, b in zip(seq[:-1], seq[1:], strict=True):
+        ai0, ai1, aj0, aj1 = rects[a]
+        bi0, bi1, bj0, bj1 = rects[b]
+        if ai1 == bi0 or bi1 == ai0:  # across a vertical edge
+            x = ox + h * (ai1 if ai1 == bi0 else ai0)
+            lo = oy + h * max(aj0, bj0) + shrink
+            hi = oy + h * min(aj1, bj1) - shrink
+            out.append(((x, hi), (x, lo)) if ai1 == bi0 else ((x, lo), (x, hi)))
+        else:  # across a horizontal edge
+            y = oy + h * (aj1 if aj1 == bj0 else aj0)
+            lo = ox + h * max(ai0, bi0) + shrink
+            hi = ox + h * min(ai1, bi1) - shrink
+            out.append(((lo, y), (hi, y)) if aj1 == bj0 else ((hi, y), (lo, y)))
+    return out
+
+
+def _lift(path: np.ndarray, lat: Lattice, free: np.ndarray, step: float) -> np.ndarray:
+    """Move each interior vertex ``step`` away from the blocked cells at its lattice corner.
+
+    For a point robot the funnel's corners lie on the corners of blocked cells, and a segment
+    between two corners of one wall runs along it: zero clearance, which counts as entering.
+    Pushed diagonally off the corner, the path keeps a clearance of about ``step``.
+    """
+    out = path.copy()
+    (ox, oy), h = lat.origin, lat.h
+    for k in range(1, len(path) - 1):
+        ci = round((path[k, 0] - ox) / h)
+        cj = round((path[k, 1] - oy) / h)
+        away = np.zeros(2)
+        for di in (-1, 0):
+            for dj in (-1, 0):
+                i, j = ci + di, cj + dj
+                if not (0 <= i < lat.nx and 0 <= j < lat.ny) or not free[i, j]:
+                    away -= (di + 0.5, dj + 0.5)
+        norm = math.hypot(*away)
+        if norm > 0.0:
+            out[k] += step * away / norm
+    return out
+
+
+def _area2(a, b, c) -> float:
+    """Twice the signed area of triangle a, b, c (> 0 when c lies left of a -> b)."""
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+
+def funnel(start, goal, portals) -> np.ndarray:
+    """The shortest path from ``start`` to ``goal`` through ``portals`` ((left, right) pairs in
+    order), by the funnel algorithm.
+
+    The funnel is the wedge from the last path vertex (the apex) through the left and right ends
+    of the portals seen so far; each new portal narrows it, and when one side would cross the
+    other, that side's end becomes a path vertex and the new apex. A restart goes back to the
+    portal after the new apex, so the total work is bounded by the number of portals squared
+    (linear in practice).
+    """
+    pts = [(tuple(start), tuple(start)), *portals, (tuple(goal), tuple(goal))]
+    path = [tuple(start)]
+    apex = left = right = tuple(start)
+    apex_i = left_i = right_i = 0
+    i = 1
+    n = len(pts)
+    budget = n * n + 16  # the restarts cannot loop: each makes the apex index grow
+    while i < n and budget > 0:
+        budget -= 1
+        new_left, new_right = pts[i]
+        if _area2(apex, right, new_right) >= 0.0:  # the right side narrows the funnel
+            if apex == right or _area2(apex, left, new_right) < 0.0:
+                right, right_i = new_right, i
+            else:  # it crosses the left side: the left end is a corner of the path
+                path.append(left)
+                apex, apex_i = left, left_i
+                left = right = apex
+                left_i = right_i = apex_i
+                i = apex_i + 1
+                continue
+        if _area2(apex, left, new_left) <= 0.0:  # the left side narrows the funnel
+            if apex == left or _area2(apex, right, new_left) > 0.0:
+                left, left_i = new_left, i
+            else:
+                path.append(right)
+                apex, apex_i = right, right_i
+                left = right = apex
+                left_i = right_i = apex_i
+                i = apex_i + 1
+                continue
+        i += 1
+    if path[-1] != tuple(goal):
+        path.append(tuple(goal))
+    return np.asarray(path, dtype=float)
+
+
+def _entry(model: Any, lat: Lattice, free: np.ndarray, point, reach: int):
+    """The free cell to enter the lattice from ``point``: its own cell when free, else the
+    nearest free cell within ``reach`` cells whose centre it sees (exact segment test)."""
+    cell = lat.cell_of(point)
+    if free[cell]:
+        return cell, False
+    ci, cj = cell
+    cand = [(i, j) for i in range(ci - reach, ci + reach + 1)
+            for j in range(cj - reach, cj + reach + 1)
+            if 0 <= i < lat.nx and 0 <= j < lat.ny and free[i, j]]  # fmt: skip
+    if not cand:
+        return None, False
+    centres = np.array([lat.centre(c) for c in cand])
+    order = np.argsort(np.hypot(*(centres - np.asarray(point, dtype=float)).T))
+    for chunk in np.array_split(order, max(1, math.ceil(len(order) / 16))):
+        sees = model.segments_free(np.broadcast_to(np.asarray(point, float), (len(chunk), 2)),
+                                   centres[chunk])  # fmt: skip
+        if sees.any():
+            return cand[int(chunk[np.flatnonzero(sees)[0]])], True
+    return None, False
+
+
+def corridor_path(
+    model: Any,
+    start,
+    goal,
+    max_cells: int = 65_536,
+    terminate=None,
+    alternatives: int = 3,
+) -> CorridorResult:
+    """The shortest path through the best corridor of a lattice of about ``max_cells`` cells.
+
+    Parameters
+    ----------
+    model : World or SpaceInformationCollisionModel
+        Answers ``lattice``, ``free_cells``, ``segments_free`` and ``path_valid``.
+    start, goal : (2,) array_like
+        End points.
+    max_cells : int
+        Most lattice cells (memory and time grow linearly with it).
+    terminate : callable, optional
+        Polled between the steps; the search gives up (no path) when it returns True.
+    alternatives : int
+        Routes through other corridors to try besides the shortest (:func:`alternative_routes`);
+        the shortest path after the funnel wins.
+
+    Returns
+    -------
+    CorridorResult
+    """
+    t0 = time.perf_counter()
+    stages: dict[str, float] = {}
+
+    def done(reason: str, **kw) -> CorridorResult:
+        return CorridorResult(None, time=time.perf_counter() - t0, reason=reason, stages=stages,
+                              **kw)  # fmt: skip
+
+    start = np.asarray(start, dtype=float)
+    goal = np.asarray(goal, dtype=float)
+    lat = model.lattice(max_cells)
+    if lat.nx < 2 or lat.ny < 2:
+        return done("the lattice is too small")
+    free = model.free_cells(lat)
+    stages["cells"] = time.perf_counter() - t0
+    if terminate is not None and terminate():
+        return done("out of time", lattice=lat)
+    n_free = int(free.sum())
+    s_cell, s_hop = _entry(model, lat, free, start, 2)
+    g_cell, g_hop = _entry(model, lat, free, goal, 2)
+    if s_cell is None or g_cell is None:
+        return done("start or goal is not next to a free lattice cell", lattice=lat,
+                    cells=n_free)  # fmt: skip
+    t1 = time.perf_counter()
+    routes = alternative_routes(free, s_cell, g_cell, alternatives, ALTERNATIVE_SLACK,
+                                max(3.0, ALTERNATIVE_APART * math.hypot(lat.nx, lat.ny)))  # fmt: skip
+    stages["route"] = time.perf_counter() - t1
+    if not routes:
+        return done("no route through the lattice", lattice=lat, cells=n_free)
+    t2 = time.perf_counter()
+    rects, label = free_rectangles(free)
+    # Through a cell the end point lies in, the funnel starts at the point itself; entered from
+    # outside, at the cell's centre (the segment there was checked).
+    a = lat.centre(s_cell) if s_hop else start
+    b = lat.centre(g_cell) if g_hop else goal
+    best = None
+    for k, route in enumerate(routes):
+        if k and terminate is not None and terminate():
+            break
+        seq = _rectangle_channel(channel(route), label)
+        for shrink in (max(1e-6 * lat.h, 16.0 * model.tol), 1e-3 * lat.h):
+            inner = funnel(a, b, _portals(seq, rects, lat, shrink))
+            if model.robot_radius <= 0.0:
+                inner = _lift(inner, lat, free, 2.0 * shrink)
+            candidate = np.vstack([start[None]] * s_hop + [inner] + [goal[None]] * g_hop)
+            if model.path_valid(candidate):
+                length = path_length(candidate)
+                if best is None or length < best[1]:
+                    best = (candidate, length, len(route), k)
+                break
+    stages["funnel"] = time.perf_counter() - t2
+    if best is None:
+        return done("the corridor's path did not pass the check", lattice=lat, cells=n_free,
+                    route_cells=len(routes[0]))  # fmt: skip
+    path, length, n_route, which = best
+    return CorridorResult(path, length, lat, n_free, n_route, time.perf_counter() - t0, "",
+                          stages, len(routes), which)  # fmt: skip
