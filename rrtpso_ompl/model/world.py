@@ -527,11 +527,23 @@ class World:
         return bool(self.segments_free(p[:-1], p[1:]).all())
 
     def path_clearance(self, path: np.ndarray) -> float:
-        """Smallest distance from the polyline to any obstacle (``inf`` without obstacles)."""
+        """Smallest distance from the polyline to any obstacle (``inf`` without obstacles).
+
+        Asked through the index with a reach that doubles until some obstacle is within it (a
+        path's clearance is usually small), so a long path among thousands of boxes costs its
+        neighbourhood, not every (segment, obstacle) pair.
+        """
         p = np.asarray(path, dtype=float).reshape(-1, 2)
-        if len(p) == 1:
-            return float(self.point_clearance(p)[0])
-        return float(self.segment_distance(p[:-1], p[1:]).min())
+        a, b = (p, p) if len(p) == 1 else (p[:-1], p[1:])
+        (xmin, ymin), (xmax, ymax) = self.bounds
+        extent = max(xmax - xmin, ymax - ymin)
+        reach = max(self.threshold, 1e-3 * extent)
+        while self._indexed and reach < extent:
+            d = float(self.segment_distance(a, b, cap=reach).min())
+            if d <= reach - self.threshold:
+                return d
+            reach *= 4.0
+        return float(self.segment_distance(a, b).min())
 
     def local_model(self, seg_lo: np.ndarray, seg_hi: np.ndarray) -> LocalViolation:
         """A violation model for paths whose segment ``s`` lies in the box ``seg_lo[s]..seg_hi[s]``.

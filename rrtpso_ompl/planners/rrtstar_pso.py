@@ -186,7 +186,10 @@ SIMPLIFIER_PASS_LENGTHS = 20
 
 #: Lattice cells the corridor stage can build, search and funnel per second on this project's
 #: reference machine (2 cores, x86_64), on the safe side: it sizes the lattice to the time share.
-_CORRIDOR_CELLS_PER_SECOND = 400_000
+_CORRIDOR_CELLS_PER_SECOND = 600_000
+#: With no route through the lattice yet, a finer lattice may be tried until this share of the
+#: budget (there is nothing for the other stages to refine meanwhile).
+_CORRIDOR_NO_ROUTE_SHARE = 0.5
 
 #: RRT*'s automatic range is at most this many times the median clearance of free points.
 RANGE_PER_CLEARANCE = 10.0
@@ -322,11 +325,26 @@ class RRTstarPSO(PythonPlanner):
                 return None
 
         def terminate() -> bool:
-            return ptc() or (end is not None and time.perf_counter() >= end)
+            limit = None if end is None else max(end, t0 + _CORRIDOR_NO_ROUTE_SHARE * budget)
+            return ptc() or (limit is not None and time.perf_counter() >= limit)
 
-        result = corridor_path(self._model, start, goal, cells, terminate,
-                               v["corridor_alternatives"])  # fmt: skip
-        stats.corridor_time = result.time
+        t_first = t1 = time.perf_counter()
+        while True:
+            result = corridor_path(self._model, start, goal, cells, terminate,
+                                   v["corridor_alternatives"])  # fmt: skip
+            # No route at this resolution: a passage may be narrower than a few cells. Four
+            # times the cells, while the last try's time, four times over, still fits.
+            finer = min(4 * cells, v["corridor_cells"])
+            if result.path is not None or finer <= cells or terminate():
+                break
+            # Without any route the swarm has nothing to work on: the finer try may use up to
+            # half the budget.
+            if end is not None and time.perf_counter() + 4.5 * result.time > max(
+                end, t0 + _CORRIDOR_NO_ROUTE_SHARE * budget
+            ):
+                break
+            cells, t1 = finer, time.perf_counter()
+        stats.corridor_time = time.perf_counter() - t_first
         stats.corridor_cells = result.lattice.n_cells if result.lattice else 0
         stats.corridor_routes = result.routes
         stats.corridor_reason = result.reason
@@ -351,8 +369,9 @@ class RRTstarPSO(PythonPlanner):
                 short = self._simplify(raw, xy, stats, ptc, t0) if self._values["simplify"] else xy
                 out.append((stats.first_solution, xy, short))
         if corridor is not None:
+            # Taut within its corridor already: a short look-ahead suffices.
             out.append(("corridor", corridor, shortcut(corridor, self._model.segments_free,
-                                                       self._stop(ptc, t0))))  # fmt: skip
+                                                       self._stop(ptc, t0), window=8)))  # fmt: skip
         return out
 
     def _stop(self, ptc, t0: float):
