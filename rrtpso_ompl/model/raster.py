@@ -88,8 +88,8 @@ class Lattice:
         # Smallest lattice line at or above the lower bound (with round-off slack).
         ox = ax + h * math.ceil((xmin - ax) / h - 1e-9)
         oy = ay + h * math.ceil((ymin - ay) / h - 1e-9)
-        nx = max(int(math.floor((xmax - ox) / h + 1e-9)), 0)
-        ny = max(int(math.floor((ymax - oy) / h + 1e-9)), 0)
+        nx = max(math.floor((xmax - ox) / h + 1e-9), 0)
+        ny = max(math.floor((ymax - oy) / h + 1e-9), 0)
         return cls((ox, oy), h, nx, ny)
 
 
@@ -142,21 +142,21 @@ class MapRaster:
         res = self.resolution
         ratio = lat.h / res
         # Map-cell index of the lattice's lower-left corner.
-        i0 = int(round((lat.origin[0] - self.origin[0]) / res))
-        j0 = int(round((lat.origin[1] - self.origin[1]) / res))
+        i0 = round((lat.origin[0] - self.origin[0]) / res)
+        j0 = round((lat.origin[1] - self.origin[1]) / res)
         w, hgt = self.blocked.shape
         if ratio >= 1.0 - 1e-9:
-            k = int(round(ratio))
+            k = round(ratio)
             span_x, span_y = lat.nx * k, lat.ny * k
             window = self._window(i0, j0, span_x, span_y)
             return window.reshape(lat.nx, k, lat.ny, k).any(axis=(1, 3))
-        sub = int(round(1.0 / ratio))
+        sub = round(1.0 / ratio)
         # Lattice cells are sub-cells of map cells: map cell of lattice cell (i, j) is
         # (i0' + i // sub) with the lattice origin on a sub-cell line.
         fx = (lat.origin[0] - self.origin[0]) / lat.h
         fy = (lat.origin[1] - self.origin[1]) / lat.h
-        ix = (int(round(fx)) + np.arange(lat.nx)) // sub
-        iy = (int(round(fy)) + np.arange(lat.ny)) // sub
+        ix = (round(fx) + np.arange(lat.nx)) // sub
+        iy = (round(fy) + np.arange(lat.ny)) // sub
         inside_x = (ix >= 0) & (ix < w)
         inside_y = (iy >= 0) & (iy < hgt)
         out = np.full((lat.nx, lat.ny), self.outside_blocked)
@@ -188,7 +188,7 @@ class MapRaster:
         """
         if clearance <= 0.0:
             return ~self.blocked_on(lat)
-        ext = int(math.ceil(clearance / lat.h)) + 2
+        ext = math.ceil(clearance / lat.h) + 2
         ox, oy = lat.origin
         wide = Lattice((ox - ext * lat.h, oy - ext * lat.h), lat.h, lat.nx + 2 * ext,
                        lat.ny + 2 * ext)  # fmt: skip

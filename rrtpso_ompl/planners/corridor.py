@@ -27,14 +27,15 @@ map of 65,000 cells.
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.sparse import coo_matrix
 from scipy import ndimage
+from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from ..model.geometry import path_length
@@ -197,7 +198,7 @@ def channel(route: list[tuple[int, int]]) -> list[tuple[int, int]]:
     """The route with the cells its diagonal and knight's moves pass inserted: consecutive cells
     share an edge."""
     out = [route[0]]
-    for (i0, j0), (i1, j1) in zip(route[:-1], route[1:], strict=True):
+    for (i0, j0), (i1, j1) in itertools.pairwise(route):
         di, dj = i1 - i0, j1 - j0
         for (mi, mj), _, via in _MOVES:
             for sign in (1, -1):
@@ -265,7 +266,7 @@ def _portals(seq: list[int], rects: np.ndarray, lat: Lattice, shrink: float):
     direction of travel, each moved ``shrink`` towards the other."""
     (ox, oy), h = lat.origin, lat.h
     out = []
-    for a, b in zip(seq[:-1], seq[1:], strict=True):
+    for a, b in itertools.pairwise(seq):
         ai0, ai1, aj0, aj1 = rects[a]
         bi0, bi1, bj0, bj1 = rects[b]
         if ai1 == bi0 or bi1 == ai0:  # across a vertical edge

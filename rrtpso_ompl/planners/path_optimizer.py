@@ -243,6 +243,7 @@ def _pso_round(
     options: PathOptimizerOptions,
     rng: np.random.Generator,
     terminate: Callable[[], bool] | None,
+    deadline: float | None = None,
 ) -> tuple[np.ndarray, pso.PSOResult]:
     """One swarm run over every interior waypoint, seeded around ``seed_path``; returns the best
     path and the PSO result."""
@@ -279,6 +280,7 @@ def _pso_round(
         init=init,
         v_max=options.v_max_fraction * float(seg_len.mean()),
         terminate=terminate,
+        deadline=deadline,
     )
     best = np.vstack([seed_path[:1], res.position.reshape(k, 2), seed_path[-1:]])
     return best, res
@@ -310,6 +312,7 @@ def _window_round(
     rng: np.random.Generator,
     terminate: Callable[[], bool] | None,
     offset: int,
+    deadline: float | None = None,
 ) -> tuple[np.ndarray, pso.PSOResult]:
     """One round of a small swarm per window of ``options.window`` waypoints, all windows in one
     array operation (:func:`~rrtpso_ompl.planners.swarm.minimize` with ``blocks``).
@@ -386,6 +389,7 @@ def _window_round(
         v_max=options.v_max_fraction * float(seg_len.mean()),
         terminate=terminate,
         blocks=n_win,
+        deadline=deadline,
     )
     best = seed_path.copy()
     pos = res.position.reshape(n_win, width, 2)
@@ -399,6 +403,7 @@ def optimize_path(
     options: PathOptimizerOptions | None = None,
     rng: np.random.Generator | None = None,
     terminate: Callable[[], bool] | None = None,
+    deadline: float | None = None,
 ) -> PathOptimizationResult:
     """Shorten (and optionally smooth) a valid path with the particle swarm, end points fixed.
 
@@ -415,6 +420,9 @@ def optimize_path(
     terminate : callable, optional
         Polled once per PSO iteration; stops the optimisation early when it returns True. With
         it, rounds go on (up to ``polish_rounds`` more) while they still pay.
+    deadline : float, optional
+        ``time.perf_counter()`` seconds by which the swarm must be done: no PSO iteration starts
+        that would end after it (their cost is measured as they run).
 
     Returns
     -------
@@ -426,7 +434,7 @@ def optimize_path(
     options = options or PathOptimizerOptions()
     rng = rng if rng is not None else np.random.default_rng()
     original = np.array(path, dtype=float).reshape(-1, 2)
-    run = _Rounds(original, world, options, rng, terminate)
+    run = _Rounds(original, world, options, rng, terminate, deadline)
     if len(original) >= 2 and world.path_valid(original) and not run.stopped():
         run.optimise()
     return run.result(t0)
@@ -435,7 +443,8 @@ def optimize_path(
 class _Rounds:
     """The rounds of one :func:`optimize_path` call and their bookkeeping."""
 
-    def __init__(self, original, world, options, rng, terminate) -> None:
+    def __init__(self, original, world, options, rng, terminate, deadline=None) -> None:
+        self.deadline = deadline
         self.original = original
         self.world = world
         self.options = options
@@ -481,9 +490,10 @@ class _Rounds:
         opts = self.options
         if opts.window and len(seed) - 2 > opts.window:
             candidate, res = _window_round(seed, self.cost_model, opts, self.rng, self.terminate,
-                                           offset=r * (opts.window // 2 + 1))  # fmt: skip
+                                           r * (opts.window // 2 + 1), self.deadline)  # fmt: skip
         else:
-            candidate, res = _pso_round(seed, self.cost_model, opts, self.rng, self.terminate)
+            candidate, res = _pso_round(seed, self.cost_model, opts, self.rng, self.terminate,
+                                        self.deadline)  # fmt: skip
         self.history.append(res.history)
         self.iterations += res.n_iterations
         self.evaluations += res.n_evaluations

@@ -216,7 +216,7 @@ class PSOPathOptimizer:
                 return self.last_result
             model.stop = lambda: time.perf_counter() >= deadline - reserve
         try:
-            self.last_result = optimize_path(xy, model, options, self.rng, terminate)
+            self.last_result = optimize_path(xy, model, options, self.rng, terminate, deadline)
         finally:
             if isinstance(model, SpaceInformationCollisionModel):
                 model.stop = None

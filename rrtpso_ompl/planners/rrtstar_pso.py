@@ -191,6 +191,10 @@ _CORRIDOR_CELLS_PER_SECOND = 600_000
 #: budget (there is nothing for the other stages to refine meanwhile).
 _CORRIDOR_NO_ROUTE_SHARE = 0.5
 
+#: Share of the budget kept back for handing the path over (the last checks, OMPL's path): the
+#: stages aim to be done by the rest.
+FINISH_RESERVE = 0.03
+
 #: RRT*'s automatic range is at most this many times the median clearance of free points.
 RANGE_PER_CLEARANCE = 10.0
 
@@ -328,7 +332,7 @@ class RRTstarPSO(PythonPlanner):
             limit = None if end is None else max(end, t0 + _CORRIDOR_NO_ROUTE_SHARE * budget)
             return ptc() or (limit is not None and time.perf_counter() >= limit)
 
-        t_first = t1 = time.perf_counter()
+        t_first = time.perf_counter()
         while True:
             result = corridor_path(self._model, start, goal, cells, terminate,
                                    v["corridor_alternatives"])  # fmt: skip
@@ -343,7 +347,7 @@ class RRTstarPSO(PythonPlanner):
                 end, t0 + _CORRIDOR_NO_ROUTE_SHARE * budget
             ):
                 break
-            cells, t1 = finer, time.perf_counter()
+            cells, _t1 = finer, time.perf_counter()
         stats.corridor_time = time.perf_counter() - t_first
         stats.corridor_cells = result.lattice.n_cells if result.lattice else 0
         stats.corridor_routes = result.routes
@@ -374,12 +378,17 @@ class RRTstarPSO(PythonPlanner):
                                                        self._stop(ptc, t0), window=8)))  # fmt: skip
         return out
 
-    def _stop(self, ptc, t0: float):
-        """The outer condition or the end of the budget."""
+    def _finish_by(self, t0: float) -> float | None:
+        """When the stages must be done (``time.perf_counter()`` s): the end of the budget, less
+        :data:`FINISH_RESERVE` of it for handing the path over; None without a budget."""
         budget = self._values["budget"]
-        if budget <= 0:
+        return t0 + (1.0 - FINISH_RESERVE) * budget if budget > 0 else None
+
+    def _stop(self, ptc, t0: float):
+        """The outer condition or :meth:`_finish_by`."""
+        deadline = self._finish_by(t0)
+        if deadline is None:
             return lambda: bool(ptc())
-        deadline = t0 + budget
         return lambda: bool(ptc()) or time.perf_counter() >= deadline
 
     def _anytime(self, best: np.ndarray, stats: RRTstarPSOStats, t0: float, ptc) -> np.ndarray:
@@ -466,12 +475,12 @@ class RRTstarPSO(PythonPlanner):
         self, xy: np.ndarray, stats: RRTstarPSOStats, t0: float, ptc: ob.PlannerTerminationCondition
     ):
         """The path optimiser over the candidate nodes, until the budget's end."""
-        budget = self._values["budget"]
+        self._values["budget"]
         # With a known budget the PSO stops at its end (and at the outer condition); without one
         # the outer condition has already fired, so the swarm is bounded by its iterations only.
-        terminate = deadline = None
-        if budget > 0:
-            deadline = t0 + budget
+        terminate = None
+        deadline = self._finish_by(t0)
+        if deadline is not None:
 
             def terminate() -> bool:
                 return ptc() or time.perf_counter() >= deadline

@@ -113,6 +113,7 @@ def minimize(
     v_max: float | None = None,
     terminate: Callable[[], bool] | None = None,
     blocks: int = 1,
+    deadline: float | None = None,
 ) -> PSOResult:
     """Minimise ``cost`` over the box ``[lower, upper]`` with a global-best PSO.
 
@@ -141,6 +142,9 @@ def minimize(
     blocks : int
         Independent blocks of ``dims / blocks`` coordinates (see the module docstring); the cost
         then returns ``(n_particles, blocks)``.
+    deadline : float, optional
+        ``time.perf_counter()`` seconds: no iteration starts that would not end before it (by
+        the longest iteration so far), so a swarm whose iterations are slow stops in time.
 
     Returns
     -------
@@ -169,7 +173,9 @@ def minimize(
     def block_view(a: np.ndarray) -> np.ndarray:
         return a.reshape(a.shape[0], k_blocks, width)
 
+    t_eval = time.perf_counter()
     f = evaluate(x)
+    slowest = time.perf_counter() - t_eval  # an iteration costs about one evaluation
     pbest_x, pbest_f = x.copy(), f.copy()
     g = np.argmin(pbest_f, axis=0)
     gbest_x = block_view(pbest_x)[g, cols].reshape(dims)  # a copy (fancy indexing)
@@ -180,6 +186,10 @@ def minimize(
     stopped_by = "iterations"
     for k in range(1, options.iterations + 1):
         if terminate is not None and terminate():
+            stopped_by = "terminate"
+            break
+        t_iter = time.perf_counter()
+        if deadline is not None and t_iter + slowest > deadline:
             stopped_by = "terminate"
             break
         r1 = rng.random((n, dims))
@@ -204,6 +214,7 @@ def minimize(
             gb[improved] = block_view(pbest_x)[g[improved], cols[improved]]
             gbest_f[improved] = pbest_f[g[improved], cols[improved]]
         history.append(float(gbest_f.sum()))
+        slowest = max(slowest, time.perf_counter() - t_iter)
         w *= options.w_damping
         if options.tolerance > 0 and k >= options.patience:
             old = history[-1 - options.patience]
