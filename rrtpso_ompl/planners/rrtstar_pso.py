@@ -475,7 +475,6 @@ class RRTstarPSO(PythonPlanner):
         self, xy: np.ndarray, stats: RRTstarPSOStats, t0: float, ptc: ob.PlannerTerminationCondition
     ):
         """The path optimiser over the candidate nodes, until the budget's end."""
-        self._values["budget"]
         # With a known budget the PSO stops at its end (and at the outer condition); without one
         # the outer condition has already fired, so the swarm is bounded by its iterations only.
         terminate = None
