@@ -51,7 +51,7 @@ from .corridor import corridor_path
 from .ompl_planners import RRTSTAR_PARAMS
 from .params import ParamSpec, ParamTable
 from .path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
-from .post import PSOPathOptimizer
+from .post import PSOPathOptimizer, simplify_until
 from .result import BenchmarkRun
 from .swarm import SWARM_PARAMS
 
@@ -418,22 +418,20 @@ class RRTstarPSO(PythonPlanner):
     def _simplify(self, raw: og.PathGeometric, xy: np.ndarray, stats: RRTstarPSOStats, ptc, t0):
         """OMPL's simplifier on a copy of RRT*'s path; the shorter of the two waypoints.
 
-        ``simplifyMax`` (about a millisecond on a typical path) without a budget; with one, at
-        most half of what is left, so a path of hundreds of waypoints through a maze cannot eat
-        the swarm's share.
+        ``simplifyMax`` (about a millisecond on a typical path) without a budget; with one, its
+        steps in small batches for at most half of what is left (:func:`simplify_until`), so a
+        path of hundreds of waypoints through a maze cannot eat the swarm's share or the budget.
         """
         t1 = time.perf_counter()
         budget = self._values["budget"]
         if budget > 0 and not self._simplifier_fits(xy, 0.5 * (t0 + budget - t1)):
             return xy
         simplified = og.PathGeometric(raw)  # a copy: RRT*'s own path stays as it was
-        simplifier = og.PathSimplifier(self.getSpaceInformation())
         if budget > 0:
-            left = max(0.5 * (t0 + budget - t1), 1e-4)
-            simplifier.simplify(simplified, ob.plannerOrTerminationCondition(
-                ptc, ob.timedPlannerTerminationCondition(left)))  # fmt: skip
+            simplify_until(self.getSpaceInformation(), simplified,
+                           t1 + max(0.5 * (t0 + budget - t1), 1e-4))  # fmt: skip
         else:
-            simplifier.simplifyMax(simplified)
+            og.PathSimplifier(self.getSpaceInformation()).simplifyMax(simplified)
         candidate = path_to_array(simplified)
         better = path_length(candidate) < path_length(xy) and self._fine_valid(candidate, t0)
         stats.simplify_time = time.perf_counter() - t1
