@@ -120,12 +120,12 @@ class MapRaster:
         grid = np.ascontiguousarray(np.asarray(blocked_image, dtype=bool)[::-1].T)
         return cls(grid, (float(origin[0]), float(origin[1])), float(resolution), outside_blocked)
 
-    def lattice(self, bounds, max_cells: int) -> Lattice:
+    def lattice(self, bounds, max_cells: int, split: int = 4) -> Lattice:
         """The finest lattice aligned with the map's cells (the map's own cells, split in two or
-        four when the map is small, merged 2 x 2, 3 x 3, ... when it is large) of at most
-        ``max_cells`` cells inside ``bounds``."""
+        four, at most ``split``, when the map is small, merged 2 x 2, 3 x 3, ... when it is
+        large) of at most ``max_cells`` cells inside ``bounds``."""
         res = self.resolution
-        for sub in (4, 2, 1):
+        for sub in (s for s in (4, 2, 1) if s <= split):
             lat = Lattice.over(bounds, res / sub, self.origin)
             if lat.n_cells <= max_cells:
                 return lat

@@ -147,11 +147,12 @@ class World:
     # ------------------------------------------------------------------------------------------
     # Lattice queries (the corridor search)
     # ------------------------------------------------------------------------------------------
-    def lattice(self, max_cells: int) -> Lattice:
+    def lattice(self, max_cells: int, split: int = 4) -> Lattice:
         """A lattice of about ``max_cells`` square cells inside the bounds: aligned with the map's
-        cells when the world has one, else square cells centred in the bounds."""
+        cells when the world has one (a map cell split in at most ``split`` per side), else
+        square cells centred in the bounds."""
         if self.raster is not None:
-            return self.raster.lattice(self.bounds, max_cells)
+            return self.raster.lattice(self.bounds, max_cells, split)
         (xmin, ymin), (xmax, ymax) = self.bounds
         h = math.sqrt((xmax - xmin) * (ymax - ymin) / max(max_cells, 1))
         lat = Lattice.over(self.bounds, h)
@@ -176,6 +177,11 @@ class World:
         if shapes.n_obstacles and free.any():
             free &= shapes._clear_cells(lat, margin + lat.h * math.sqrt(0.5))
         return free
+
+    def centres_free(self, lat: Lattice) -> np.ndarray:
+        """(nx, ny) booleans: the lattice cells whose centre is a free configuration (exact;
+        says nothing about the rest of the cell)."""
+        return self._clear_cells(lat, self.threshold)
 
     def _clear_cells(self, lat: Lattice, need: float) -> np.ndarray:
         """(nx, ny) booleans: cells whose centre is at least ``need`` from every obstacle.

@@ -215,7 +215,7 @@ class SpaceInformationCollisionModel:
             return len(p) == 1 and bool(self.segments_free(p, p)[0])
         return bool(self.segments_free(p[:-1], p[1:]).all())
 
-    def lattice(self, max_cells: int) -> Lattice:
+    def lattice(self, max_cells: int, split: int = 4) -> Lattice:
         """Square cells centred in the space's bounds, about ``max_cells`` of them."""
         (xmin, ymin), (xmax, ymax) = self.bounds
         h = math.sqrt((xmax - xmin) * (ymax - ymin) / max(max_cells, 1))
@@ -224,6 +224,10 @@ class SpaceInformationCollisionModel:
     def free_cells(self, lat: Lattice) -> np.ndarray:
         """Cells whose centre the checker accepts. Not conservative (a point checker says
         nothing about the rest of the cell): paths through them are checked before use."""
+        return self.centres_free(lat)
+
+    def centres_free(self, lat: Lattice) -> np.ndarray:
+        """Cells whose centre the checker accepts."""
         st, valid = self._state, self.si.isValid
         free = np.zeros(lat.n_cells, dtype=bool)
         for k, (x, y) in enumerate(lat.centres().tolist()):

@@ -27,6 +27,7 @@ map of 65,000 cells.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 import time
@@ -41,6 +42,20 @@ from scipy.sparse.csgraph import dijkstra
 from ..model.geometry import path_length
 from ..model.raster import Lattice
 
+#: Lattice cells the corridor stage builds, searches and funnels per second, on the safe side
+#: (measured on the reference machine: 2-3 million on maps, fewer among many shapes).
+CELLS_PER_SECOND = 1_000_000
+#: The refinement searches the cells within this many coarse cells of the coarse path.
+BAND_CELLS = 3.0
+#: Lattice cells per second the refinement marks free or not (array work over the whole
+#: lattice; the search itself stays in the band), on the safe side.
+MARK_CELLS_PER_SECOND = 8_000_000
+
+#: Most re-routings of :func:`centre_route` around segments that failed the check.
+CENTRE_ROUTE_ROUNDS = 32
+#: The weight of a move found blocked: no route uses it while another exists.
+_CUT = 1e12
+
 #: Alternative routes are tried when their lattice length is within this share of the best's
 #: (the lattice's error in length: up to 2.7 % for the moves, plus the cells' conservatism).
 ALTERNATIVE_SLACK = 0.06
@@ -50,6 +65,9 @@ ALTERNATIVE_APART = 0.03
 __all__ = [
     "ALTERNATIVE_APART",
     "ALTERNATIVE_SLACK",
+    "BAND_CELLS",
+    "CELLS_PER_SECOND",
+    "CENTRE_ROUTE_ROUNDS",
     "CorridorResult",
     "alternative_routes",
     "channel",
@@ -57,6 +75,7 @@ __all__ = [
     "free_rectangles",
     "funnel",
     "lattice_route",
+    "search",
 ]
 
 #: Moves of the 16-connected lattice (half of them; the graph is undirected): the cells next to
@@ -386,6 +405,7 @@ def corridor_path(
     max_cells: int = 65_536,
     terminate=None,
     alternatives: int = 3,
+    near=None,
 ) -> CorridorResult:
     """The shortest path through the best corridor of a lattice of about ``max_cells`` cells.
 
@@ -402,6 +422,9 @@ def corridor_path(
     alternatives : int
         Routes through other corridors to try besides the shortest (:func:`alternative_routes`);
         the shortest path after the funnel wins.
+    near : ((n, 2) ndarray, float), optional
+        A path and a distance: only cells within that distance of the path are searched (the
+        corridor of a coarser search, refined on a finer lattice: :func:`refine`).
 
     Returns
     -------
@@ -420,9 +443,22 @@ def corridor_path(
     if lat.nx < 2 or lat.ny < 2:
         return done("the lattice is too small")
     free = model.free_cells(lat)
+    if near is not None:
+        free &= band(lat, *near)
     stages["cells"] = time.perf_counter() - t0
     if terminate is not None and terminate():
         return done("out of time", lattice=lat)
+    return _route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0, stages)
+
+
+def _route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0, stages,
+                      routes=None) -> CorridorResult:  # fmt: skip
+    """Route over ``free`` (or take ``routes``), funnel each route, keep the shortest valid."""
+
+    def done(reason: str, **kw) -> CorridorResult:
+        return CorridorResult(None, time=time.perf_counter() - t0, reason=reason, stages=stages,
+                              **kw)  # fmt: skip
+
     n_free = int(free.sum())
     s_cell, s_hop = _entry(model, lat, free, start, 2)
     g_cell, g_hop = _entry(model, lat, free, goal, 2)
@@ -430,9 +466,10 @@ def corridor_path(
         return done("start or goal is not next to a free lattice cell", lattice=lat,
                     cells=n_free)  # fmt: skip
     t1 = time.perf_counter()
-    routes = alternative_routes(free, s_cell, g_cell, alternatives, ALTERNATIVE_SLACK,
-                                max(3.0, ALTERNATIVE_APART * math.hypot(lat.nx, lat.ny)))  # fmt: skip
-    stages["route"] = time.perf_counter() - t1
+    if routes is None:
+        apart = max(3.0, ALTERNATIVE_APART * math.hypot(lat.nx, lat.ny))
+        routes = alternative_routes(free, s_cell, g_cell, alternatives, ALTERNATIVE_SLACK, apart)
+    stages["route"] = stages.get("route", 0.0) + time.perf_counter() - t1
     if not routes:
         return done("no route through the lattice", lattice=lat, cells=n_free)
     t2 = time.perf_counter()
@@ -456,10 +493,249 @@ def corridor_path(
                 if best is None or length < best[1]:
                     best = (candidate, length, len(route), k)
                 break
-    stages["funnel"] = time.perf_counter() - t2
+    stages["funnel"] = stages.get("funnel", 0.0) + time.perf_counter() - t2
     if best is None:
         return done("the corridor's path did not pass the check", lattice=lat, cells=n_free,
                     route_cells=len(routes[0]))  # fmt: skip
     path, length, n_route, which = best
     return CorridorResult(path, length, lat, n_free, n_route, time.perf_counter() - t0, "",
                           stages, len(routes), which)  # fmt: skip
+
+
+def centre_route(model: Any, start, goal, max_cells: int = 65_536, terminate=None):
+    """A path through the centres of lattice cells whose centre is free, every segment checked:
+    for a free space too thin for any wholly free cell (a disc robot in a corridor barely wider
+    than it), where :func:`corridor_path` finds no route.
+
+    Dijkstra's algorithm over the cells with a free centre (16-connected, as
+    :func:`corridor_path`), then every segment of the route through the model's exact check; a
+    segment that fails is taken out of the graph and the route searched again, at most
+    :data:`CENTRE_ROUTE_ROUNDS` times. The path is valid, not taut: it runs through cell centres.
+    """
+    t0 = time.perf_counter()
+    start = np.asarray(start, dtype=float)
+    goal = np.asarray(goal, dtype=float)
+    lat = model.lattice(max_cells, split=1)  # a map's own cells: their centres are its middles
+    if lat.nx < 2 or lat.ny < 2:
+        return CorridorResult(None, reason="the lattice is too small")
+    free = model.centres_free(lat)
+    s_cell, s_hop = _entry(model, lat, free, start, 2)
+    g_cell, g_hop = _entry(model, lat, free, goal, 2)
+    if s_cell is None or g_cell is None:
+        return CorridorResult(None, lattice=lat, time=time.perf_counter() - t0,
+                              reason="start or goal is not next to a free cell centre")  # fmt: skip
+    ny = lat.ny
+    graph = lattice_graph(free)
+    graph.sort_indices()
+    s, t = s_cell[0] * ny + s_cell[1], g_cell[0] * ny + g_cell[1]
+    centres = lat.centres()
+    for _ in range(CENTRE_ROUTE_ROUNDS):
+        if terminate is not None and terminate():
+            break
+        dist, pred = dijkstra(graph, directed=False, indices=s, return_predecessors=True)
+        if not dist[t] < _CUT:
+            break
+        nodes = np.array(_walk(pred, t))
+        ok = model.segments_free(centres[nodes[:-1]], centres[nodes[1:]])
+        if ok.all():
+            inner = centres[nodes]
+            path = np.vstack([start[None]] * s_hop + [inner] + [goal[None]] * g_hop)
+            if not s_hop:
+                path[0] = start
+            if not g_hop:
+                path[-1] = goal
+            if not model.path_valid(path):
+                break
+            route = [(v // ny, v % ny) for v in nodes.tolist()]
+            taut = _thin_funnel(model, lat, free, route, path, s_hop, g_hop)
+            if taut is not None and path_length(taut) < path_length(path):
+                path = taut
+            return CorridorResult(path, path_length(path), lat, int(free.sum()), len(nodes),
+                                  time.perf_counter() - t0, "", {}, 1, 0)  # fmt: skip
+        for a, b in zip(nodes[:-1][~ok], nodes[1:][~ok], strict=True):
+            for u, v in ((a, b), (b, a)):  # the edge is stored once, in either direction
+                lo, hi = graph.indptr[u], graph.indptr[u + 1]
+                at = lo + np.searchsorted(graph.indices[lo:hi], v)
+                if at < hi and graph.indices[at] == v:
+                    graph.data[at] = _CUT  # as good as gone
+    return CorridorResult(None, lattice=lat, cells=int(free.sum()), time=time.perf_counter() - t0,
+                          reason="no checked route through free cell centres")  # fmt: skip
+
+
+def _thin_funnel(model, lat: Lattice, free: np.ndarray, route, path, s_hop: bool, g_hop: bool):
+    """The funnel through a route of cells whose centres are free but whose sides are not, each
+    corner it bends round wrapped at the robot's radius (:func:`_wrap`). Checked; None when the
+    check fails."""
+    rects = np.array([(i, i + 1, j, j + 1) for i, j in channel(route)])
+    seq = list(range(len(rects)))
+    start, goal = path[0], path[-1]
+    a = path[1] if s_hop else start
+    b = path[-2] if g_hop else goal
+    inner = funnel(a, b, _portals(seq, rects, lat, 16.0 * model.tol))
+    inner = _wrap(inner, lat, free, float(model.robot_radius) + 16.0 * model.tol)
+    candidate = np.vstack([start[None]] * s_hop + [inner] + [goal[None]] * g_hop)
+    return candidate if model.path_valid(candidate) else None
+
+
+def _wrap(path: np.ndarray, lat: Lattice, free: np.ndarray, r: float) -> np.ndarray:
+    """Replace each interior vertex that lies on a lattice corner with the polygon
+    circumscribed about the arc of radius ``r`` round that corner, from the normal of the
+    segment coming in to that of the segment going out (vertices at ``r / cos(delta / 2)``,
+    ``delta`` at most 45 degrees): each of its segments is tangent to the circle, so none comes
+    closer than ``r`` to the corner."""
+    (ox, oy), h = lat.origin, lat.h
+    out = [path[0]]
+    for k in range(1, len(path) - 1):
+        v, u, w = path[k], path[k - 1], path[k + 1]
+        corner = np.array([ox + h * round((v[0] - ox) / h), oy + h * round((v[1] - oy) / h)])
+        d_in, d_out = v - u, w - v
+        n_in, n_out = np.hypot(*d_in), np.hypot(*d_out)
+        if n_in == 0.0 or n_out == 0.0 or np.hypot(*(v - corner)) > 0.25 * h:
+            out.append(v)
+            continue
+        turn = math.atan2(d_in[0] * d_out[1] - d_in[1] * d_out[0], float(d_in @ d_out))
+        side = -math.copysign(1.0, turn)  # the path turns round the corner on this side
+        # Normals pointing away from the corner, on the outside of the turn.
+        a_in = math.atan2(d_in[1], d_in[0]) + side * 0.5 * math.pi
+        pieces = max(1, math.ceil(abs(turn) / (0.25 * math.pi)))
+        delta = turn / pieces
+        rho = r / math.cos(0.5 * delta)
+        for i in range(pieces):
+            ang = a_in + (i + 0.5) * delta
+            out.append(corner + rho * np.array([math.cos(ang), math.sin(ang)]))
+    out.append(path[-1])
+    return np.asarray(out)
+
+
+def band(lat: Lattice, path: np.ndarray, width: float) -> np.ndarray:
+    """(nx, ny) booleans: the cells whose centre lies within ``width`` of the polyline ``path``
+    (up to half a cell: the cells the path passes, grown by a distance transform)."""
+    path = np.asarray(path, dtype=float)
+    seg = np.diff(path, axis=0)
+    n = np.maximum(np.ceil(np.hypot(*seg.T) / (0.5 * lat.h)).astype(np.int64), 1)
+    k = np.repeat(np.arange(len(seg)), n)
+    t = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) / n[k]
+    pts = np.vstack([path[:-1][k] + t[:, None] * seg[k], path[-1:]])
+    i = np.clip(np.floor((pts[:, 0] - lat.origin[0]) / lat.h).astype(np.int64), 0, lat.nx - 1)
+    j = np.clip(np.floor((pts[:, 1] - lat.origin[1]) / lat.h).astype(np.int64), 0, lat.ny - 1)
+    on = np.ones((lat.nx, lat.ny), dtype=bool)
+    on[i, j] = False
+    return ndimage.distance_transform_edt(on) * lat.h <= width
+
+
+def search(
+    model: Any,
+    start,
+    goal,
+    seconds: float | None,
+    max_cells: int = 4_194_304,
+    terminate=None,
+    alternatives: int = 3,
+) -> CorridorResult:
+    """The corridor stage within ``seconds``: corridors chosen on a coarse lattice, the chosen
+    one searched again on a fine one.
+
+    1. **Fine cells.** The finest lattice whose cells can be marked in 40 % of the time (at
+       :data:`MARK_CELLS_PER_SECOND`, at most ``max_cells``), every cell wholly free or not
+       (:meth:`~rrtpso_ompl.model.World.free_cells`).
+    2. **Coarse routes.** The fine cells pooled ``k x k`` into a lattice small enough to route
+       on in a quarter of the time (at :data:`CELLS_PER_SECOND`): a coarse cell is open when any
+       fine cell in it is free, so no passage the fine cells keep is closed at the coarse level.
+       The shortest route and ``alternatives`` through other corridors
+       (:func:`alternative_routes`).
+    3. **Fine route in each corridor.** For each coarse route, best first, the route over the
+       fine free cells within :data:`BAND_CELLS` coarse cells of it (a coarse passage whose fine
+       cells do not connect has none), and its funnel path. The shortest valid path wins.
+
+    Free space too thin for any wholly free fine cell: :func:`centre_route`. ``seconds`` None:
+    no limit but ``max_cells``.
+    """
+    t0 = time.perf_counter()
+    end = None if seconds is None else t0 + seconds
+    start = np.asarray(start, dtype=float)
+    goal = np.asarray(goal, dtype=float)
+
+    def out_of_time() -> bool:
+        return (terminate is not None and terminate()) or (
+            end is not None and time.perf_counter() >= end
+        )
+
+    def left() -> float:
+        return math.inf if end is None else max(end - time.perf_counter(), 0.0)
+
+    fine_cells = int(min(max_cells, max(0.4 * MARK_CELLS_PER_SECOND * left(), 4096)))
+    fine = model.lattice(fine_cells)
+    stages: dict[str, float] = {}
+    if fine.nx < 2 or fine.ny < 2:
+        return CorridorResult(None, reason="the lattice is too small")
+    free = model.free_cells(fine)
+    stages["cells"] = time.perf_counter() - t0
+    route_cells = min(max_cells, max(CELLS_PER_SECOND * 0.4 * left(), 1024))
+    k = max(1, math.ceil(math.sqrt(fine.n_cells / route_cells)))
+    result = None
+    if k == 1:
+        result = _route_and_funnel(model, fine, free, start, goal, alternatives, out_of_time, t0,
+                                   stages)  # fmt: skip
+    elif not out_of_time():
+        result = _through_coarse(model, fine, free, k, start, goal, alternatives, out_of_time,
+                                 t0, stages)  # fmt: skip
+    if (result is None or result.path is None) and not out_of_time():
+        thin = centre_route(model, start, goal, max(min(fine_cells, 1 << 18), 4096), out_of_time)
+        if thin.path is not None:
+            result = thin
+    if result is None:
+        return CorridorResult(None, lattice=fine, time=time.perf_counter() - t0,
+                              reason="out of time", stages=stages)  # fmt: skip
+    return dataclasses.replace(result, time=time.perf_counter() - t0)
+
+
+def _through_coarse(model, fine: Lattice, free, k: int, start, goal, alternatives, terminate, t0,
+                    stages) -> CorridorResult:  # fmt: skip
+    """Steps 2 and 3 of :func:`search`."""
+    nx, ny = fine.nx // k, fine.ny // k
+    if nx < 2 or ny < 2:
+        return _route_and_funnel(model, fine, free, start, goal, alternatives, terminate, t0,
+                                 stages)  # fmt: skip
+    pooled = free[: nx * k, : ny * k].reshape(nx, k, ny, k).any(axis=(1, 3))
+    coarse = Lattice(fine.origin, fine.h * k, nx, ny)
+    ends = []
+    for point in (start, goal):
+        cell = coarse.cell_of(point)
+        if not pooled[cell]:  # its cell has no free fine cell: the nearest one that has
+            near = np.argwhere(pooled[max(cell[0] - 2, 0) : cell[0] + 3,
+                                      max(cell[1] - 2, 0) : cell[1] + 3])  # fmt: skip
+            if not len(near):
+                return CorridorResult(None, lattice=fine, reason="start or goal is not next to "
+                                      "a free lattice cell", stages=stages)  # fmt: skip
+            off = np.array([max(cell[0] - 2, 0), max(cell[1] - 2, 0)])
+            cell = tuple(int(c) for c in (near + off)[np.argmin(np.abs(near + off - cell).sum(1))])
+        ends.append(cell)
+    t1 = time.perf_counter()
+    apart = max(3.0, ALTERNATIVE_APART * math.hypot(nx, ny))
+    routes = alternative_routes(pooled, ends[0], ends[1], alternatives, ALTERNATIVE_SLACK, apart)
+    stages["coarse_route"] = time.perf_counter() - t1
+    best = None
+    for route in routes:
+        if best is not None and terminate():
+            break
+        mask = np.zeros((nx, ny), dtype=bool)
+        mask[tuple(np.array(route).T)] = True
+        grow = int(math.ceil(BAND_CELLS))
+        mask = ndimage.binary_dilation(mask, iterations=grow)
+        # The band's bounding box of fine cells, as a lattice of its own (routing cost follows
+        # the box, not the whole map).
+        rows, cols = np.nonzero(mask)
+        i0, i1 = rows.min() * k, (rows.max() + 1) * k
+        j0, j1 = cols.min() * k, (cols.max() + 1) * k
+        box = Lattice((fine.origin[0] + i0 * fine.h, fine.origin[1] + j0 * fine.h), fine.h,
+                      i1 - i0, j1 - j0)  # fmt: skip
+        near = np.repeat(np.repeat(mask[rows.min() : rows.max() + 1, cols.min() : cols.max() + 1],
+                                   k, axis=0), k, axis=1)  # fmt: skip
+        result = _route_and_funnel(model, box, free[i0:i1, j0:j1] & near, start, goal, 0,
+                                   terminate, t0, stages)  # fmt: skip
+        if result.path is not None and (best is None or result.length < best.length):
+            best = result
+    if best is None:
+        return CorridorResult(None, lattice=fine, reason="no route through the lattice",
+                              stages=stages)  # fmt: skip
+    return dataclasses.replace(best, routes=len(routes))

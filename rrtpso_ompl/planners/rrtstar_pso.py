@@ -47,7 +47,7 @@ from .base import (
     SpaceInformationCollisionModel,
     collision_model_for,
 )
-from .corridor import corridor_path
+from .corridor import search
 from .ompl_planners import RRTSTAR_PARAMS
 from .params import ParamSpec, ParamTable
 from .path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
@@ -73,10 +73,10 @@ RRTSTAR_PSO_PARAMS = (
     ParamTable(*(RRTSTAR_PARAMS[n] for n in _INNER))
     + ParamTable(
         BUDGET,
-        ParamSpec("corridor_cells", int, 65_536,
-                  "Most cells of the corridor stage's lattice (0 = no corridor stage): finer "
-                  "finds narrower gaps, coarser is faster (time grows linearly).",
-                  low=0, high=4_194_304),
+        ParamSpec("corridor_cells", int, 4_194_304,
+                  "Most cells of the corridor stage's fine lattice (0 = no corridor stage); "
+                  "within this, the lattice is as fine as its time share allows.",
+                  low=0, high=16_777_216),
         ParamSpec("corridor_fraction", float, 0.25,
                   "Most share of the budget the corridor stage may take (it usually needs far "
                   "less; a smaller lattice is used when the time would not do).",
@@ -184,9 +184,6 @@ class RRTstarPSOStats(PlannerStats):
 #: shortcuts, collapsing), for sizing it to a user's slow checker: an estimate on the safe side.
 SIMPLIFIER_PASS_LENGTHS = 20
 
-#: Lattice cells the corridor stage can build, search and funnel per second on this project's
-#: reference machine (2 cores, x86_64), on the safe side: it sizes the lattice to the time share.
-_CORRIDOR_CELLS_PER_SECOND = 600_000
 #: With no route through the lattice yet, a finer lattice may be tried until this share of the
 #: budget (there is nothing for the other stages to refine meanwhile).
 _CORRIDOR_NO_ROUTE_SHARE = 0.5
@@ -301,10 +298,9 @@ class RRTstarPSO(PythonPlanner):
         return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
 
     def _corridor(self, ptc, t0: float, stats: RRTstarPSOStats) -> np.ndarray | None:
-        """Stage 0: the corridor stage's path (:func:`corridor_path`), or None.
-
-        Its lattice shrinks when the time share would not hold it (measured rate: cells per
-        second of the last solve on this model, else a conservative guess)."""
+        """Stage 0: the corridor stage's path (:func:`~rrtpso_ompl.planners.corridor.search`
+        within ``corridor_fraction`` of the budget; with no route at all, up to
+        :data:`_CORRIDOR_NO_ROUTE_SHARE` of it), or None."""
         v = self._values
         if v["corridor_cells"] <= 0:
             stats.corridor_reason = "off"
@@ -315,40 +311,26 @@ class RRTstarPSO(PythonPlanner):
             return None
         budget = v["budget"]
         cells = v["corridor_cells"]
-        end = None
-        if budget > 0:
-            end = t0 + v["corridor_fraction"] * budget
-            cells = min(cells, max(int(_CORRIDOR_CELLS_PER_SECOND * (end - t0)), 1024))
+        seconds = v["corridor_fraction"] * budget if budget > 0 else None
         if isinstance(self._model, SpaceInformationCollisionModel):
             # The user's checker answers the lattice one state at a time: size it to its cost.
             per_check = self._model.probe(np.asarray(start)) * self._model.step
-            if end is not None:
-                cells = min(cells, int(0.5 * (end - time.perf_counter()) / max(per_check, 1e-9)))
+            if seconds is not None:
+                cells = min(cells, int(0.4 * seconds / max(per_check, 1e-9)))
             if cells < 1024:
                 stats.corridor_reason = "the validity checker is too slow for a lattice"
                 return None
-
-        def terminate() -> bool:
-            limit = None if end is None else max(end, t0 + _CORRIDOR_NO_ROUTE_SHARE * budget)
-            return ptc() or (limit is not None and time.perf_counter() >= limit)
-
-        t_first = time.perf_counter()
-        while True:
-            result = corridor_path(self._model, start, goal, cells, terminate,
-                                   v["corridor_alternatives"])  # fmt: skip
-            # No route at this resolution: a passage may be narrower than a few cells. Four
-            # times the cells, while the last try's time, four times over, still fits.
-            finer = min(4 * cells, v["corridor_cells"])
-            if result.path is not None or finer <= cells or terminate():
-                break
-            # Without any route the swarm has nothing to work on: the finer try may use up to
-            # half the budget.
-            if end is not None and time.perf_counter() + 4.5 * result.time > max(
-                end, t0 + _CORRIDOR_NO_ROUTE_SHARE * budget
-            ):
-                break
-            cells, _t1 = finer, time.perf_counter()
-        stats.corridor_time = time.perf_counter() - t_first
+        t1 = time.perf_counter()
+        result = search(self._model, start, goal, seconds, cells, ptc,
+                        v["corridor_alternatives"])  # fmt: skip
+        if result.path is None and seconds is not None and not ptc():
+            # No route at all: there is nothing for the later stages to refine, so a finer try
+            # may take more of the budget.
+            more = t0 + _CORRIDOR_NO_ROUTE_SHARE * budget - time.perf_counter()
+            if more > 2.0 * result.time:
+                result = search(self._model, start, goal, more, cells, ptc,
+                                v["corridor_alternatives"])  # fmt: skip
+        stats.corridor_time = time.perf_counter() - t1
         stats.corridor_cells = result.lattice.n_cells if result.lattice else 0
         stats.corridor_routes = result.routes
         stats.corridor_reason = result.reason
