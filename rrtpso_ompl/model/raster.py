@@ -48,6 +48,13 @@ class Lattice:
     nx: int
     ny: int
 
+    def __post_init__(self) -> None:
+        # Plain Python numbers (index arithmetic with numpy integers overflows or casts).
+        object.__setattr__(self, "origin", (float(self.origin[0]), float(self.origin[1])))
+        object.__setattr__(self, "h", float(self.h))
+        object.__setattr__(self, "nx", int(self.nx))
+        object.__setattr__(self, "ny", int(self.ny))
+
     @property
     def n_cells(self) -> int:
         return self.nx * self.ny

@@ -161,21 +161,22 @@ class World:
             lat = Lattice.over(self.bounds, h)
         return lat
 
-    def free_cells(self, lat: Lattice) -> np.ndarray:
+    def free_cells(self, lat: Lattice, within: np.ndarray | None = None) -> np.ndarray:
         """(nx, ny) booleans: the lattice cells every point of which is a free configuration
         (for a point robot: cells no obstacle enters, which may touch one), conservatively.
 
         A map answers exactly (:meth:`MapRaster.free_cells`); circles, polygons and a problem's
         rectangles through the exact clearance at each cell's centre, which the whole square
-        keeps up to ``h / sqrt(2)``.
+        keeps up to ``h / sqrt(2)``. With ``within`` ((nx, ny) booleans) only those cells are
+        asked about (the others come back False), and only obstacles near them are measured.
         """
         margin = self.threshold if self.robot_radius > 0.0 else 0.0
-        free = np.ones((lat.nx, lat.ny), dtype=bool)
+        free = np.ones((lat.nx, lat.ny), dtype=bool) if within is None else within.copy()
         if self.raster is not None:
             free &= self.raster.free_cells(lat, margin, self.bounds)
         shapes = self._non_raster
         if shapes.n_obstacles and free.any():
-            free &= shapes._clear_cells(lat, margin + lat.h * math.sqrt(0.5))
+            free &= shapes._clear_cells(lat, margin + lat.h * math.sqrt(0.5), free)
         return free
 
     def centres_free(self, lat: Lattice) -> np.ndarray:
@@ -183,12 +184,13 @@ class World:
         says nothing about the rest of the cell)."""
         return self._clear_cells(lat, self.threshold)
 
-    def _clear_cells(self, lat: Lattice, need: float) -> np.ndarray:
+    def _clear_cells(self, lat: Lattice, need: float, asked=None) -> np.ndarray:
         """(nx, ny) booleans: cells whose centre is at least ``need`` from every obstacle.
 
         Each obstacle marks the cells near it (its bounding box grown by ``need``), with the
         exact distance from their centres: the work grows with the area the obstacles cover,
-        not with the number of cells times the number of obstacles.
+        not with the number of cells times the number of obstacles. With ``asked`` ((nx, ny)
+        booleans) obstacles none of whose cells is asked about are skipped.
         """
         clear = np.ones((lat.nx, lat.ny), dtype=bool)
         (ox, oy), h = lat.origin, lat.h
@@ -198,24 +200,88 @@ class World:
         j0 = np.clip(np.floor((boxes[:, 1] - oy) / h - 0.5), 0, lat.ny).astype(np.int64)
         j1 = np.clip(np.ceil((boxes[:, 3] - oy) / h - 0.5) + 1, 0, lat.ny).astype(np.int64)
         ni, nj = np.maximum(i1 - i0, 0), np.maximum(j1 - j0, 0)
+        if asked is not None:
+            # Asked cells in each obstacle's box, from a summed-area table.
+            sat = np.zeros((lat.nx + 1, lat.ny + 1), dtype=np.int64)
+            sat[1:, 1:] = asked.cumsum(axis=0).cumsum(axis=1)
+            inside = sat[i1, j1] - sat[i0, j1] - sat[i1, j0] + sat[i0, j0]
+            ni = np.where(inside > 0, ni, 0)
+        # A box's cross (its own rows grown by `need` up and down, its own columns grown left
+        # and right) is close wholesale: marked by slicing, no distances; only the corners of
+        # its grown box need them.
+        box_ids = np.arange(self._n_circles, self._n_circles + self._n_boxes)
+        corners_of = self._mark_box_crosses(clear, lat, need, box_ids[ni[box_ids] > 0])
         counts = ni * nj
-        # In chunks of obstacles whose cells add up to a bounded number of pairs.
+        counts[box_ids] = 0
+        self._mark_pairs(clear, lat, need, i0, j0, nj, counts, asked)
+        if corners_of:
+            c_ids, c_i0, c_j0, c_nj, c_n = corners_of
+            self._mark_pairs(clear, lat, need, c_i0, c_j0, c_nj, c_n, asked, c_ids)
+        return clear
+
+    def _mark_box_crosses(self, clear, lat: Lattice, need: float, ids: np.ndarray):
+        """Mark the cells whose centre lies in a box grown by ``need`` along one axis (close to
+        it, exactly); return the corner windows still to measure, as (ids, i0, j0, nj, counts).
+        The index ranges lean inwards, so a cell on a boundary goes to the measured corners."""
+        if not len(ids):
+            return None
+        (ox, oy), h = lat.origin, lat.h
+        b = self.boxes[ids - self._n_circles]
+        eps = 1e-9 * h
+
+        def lo(v, origin, n):  # first cell whose centre is >= v
+            return np.clip(np.ceil((v - origin) / h - 0.5 - eps), 0, n).astype(np.int64)
+
+        def hi(v, origin, n):  # past the last cell whose centre is <= v
+            return np.clip(np.floor((v - origin) / h - 0.5 + eps) + 1, 0, n).astype(np.int64)
+
+        xi0, xi1 = lo(b[:, 0], ox, lat.nx), hi(b[:, 2], ox, lat.nx)
+        yj0, yj1 = lo(b[:, 1], oy, lat.ny), hi(b[:, 3], oy, lat.ny)
+        gi0, gi1 = lo(b[:, 0] - need, ox, lat.nx), hi(b[:, 2] + need, ox, lat.nx)
+        gj0, gj1 = lo(b[:, 1] - need, oy, lat.ny), hi(b[:, 3] + need, oy, lat.ny)
+        for k in range(len(ids)):
+            clear[xi0[k] : xi1[k], gj0[k] : gj1[k]] = False
+            clear[gi0[k] : gi1[k], yj0[k] : yj1[k]] = False
+        # Corner windows (a cell or so of slack round each corner square), measured exactly.
+        out_ids, out_i0, out_j0, out_nj, out_n = [], [], [], [], []
+        for ci0, ci1 in ((gi0 - 1, xi0 + 1), (xi1 - 1, gi1 + 1)):
+            for cj0, cj1 in ((gj0 - 1, yj0 + 1), (yj1 - 1, gj1 + 1)):
+                a0 = np.clip(ci0, 0, lat.nx)
+                a1 = np.clip(ci1, 0, lat.nx)
+                c0 = np.clip(cj0, 0, lat.ny)
+                c1 = np.clip(cj1, 0, lat.ny)
+                out_ids.append(ids)
+                out_i0.append(a0)
+                out_j0.append(c0)
+                out_nj.append(np.maximum(c1 - c0, 0))
+                out_n.append(np.maximum(a1 - a0, 0) * np.maximum(c1 - c0, 0))
+        cat = np.concatenate
+        return cat(out_ids), cat(out_i0), cat(out_j0), cat(out_nj), cat(out_n)
+
+    def _mark_pairs(self, clear, lat: Lattice, need: float, i0, j0, nj, counts, asked=None,
+                    ids=None) -> None:  # fmt: skip
+        """Measure (cell, obstacle) pairs: obstacle ``ids[m]`` (default ``m``) against the
+        ``counts[m]`` cells of its window from ``(i0[m], j0[m])``, ``nj[m]`` cells a column;
+        mark the close ones."""
+        (ox, oy), h = lat.origin, lat.h
+        if ids is None:
+            ids = np.arange(len(counts))
         ends = np.searchsorted(np.cumsum(counts), np.arange(0, counts.sum(), _PAIR_CHUNK))
         cuts = np.unique(np.concatenate([ends, [len(counts)]]))
         for a, b in itertools.pairwise(np.concatenate([[0], cuts])):
             if a >= b:
                 continue
-            ids = np.arange(a, b)
             c = counts[a:b]
-            obj = np.repeat(ids, c)
+            which = np.repeat(np.arange(a, b), c)
             k = np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)
-            ci = i0[obj] + k // nj[obj]
-            cj = j0[obj] + k % nj[obj]
+            ci = i0[which] + k // nj[which]
+            cj = j0[which] + k % nj[which]
+            keep = clear[ci, cj] if asked is None else clear[ci, cj] & asked[ci, cj]
+            ci, cj, obj = ci[keep], cj[keep], ids[which[keep]]
             pts = np.column_stack([ox + h * (ci + 0.5), oy + h * (cj + 0.5)])
             d = self._pair_distance(np.arange(len(obj)), obj, pts, pts)
             close = d < need
             clear[ci[close], cj[close]] = False
-        return clear
 
     @functools.cached_property
     def _non_raster(self) -> World:

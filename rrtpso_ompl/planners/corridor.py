@@ -47,9 +47,11 @@ from ..model.raster import Lattice
 CELLS_PER_SECOND = 1_000_000
 #: The refinement searches the cells within this many coarse cells of the coarse path.
 BAND_CELLS = 3.0
-#: Lattice cells per second the refinement marks free or not (array work over the whole
+#: Lattice cells per second a map's cells are marked free or not (array work over the whole
 #: lattice; the search itself stays in the band), on the safe side.
 MARK_CELLS_PER_SECOND = 8_000_000
+#: Among shapes, fine cells per coarse cell side in the bands.
+SHAPE_SPLIT = 4
 
 #: Most re-routings of :func:`centre_route` around segments that failed the check.
 CENTRE_ROUTE_ROUNDS = 32
@@ -68,6 +70,7 @@ __all__ = [
     "BAND_CELLS",
     "CELLS_PER_SECOND",
     "CENTRE_ROUTE_ROUNDS",
+    "SHAPE_SPLIT",
     "CorridorResult",
     "alternative_routes",
     "channel",
@@ -502,7 +505,8 @@ def _route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0
                           stages, len(routes), which)  # fmt: skip
 
 
-def centre_route(model: Any, start, goal, max_cells: int = 65_536, terminate=None):
+def centre_route(model: Any, start, goal, max_cells: int = 65_536, terminate=None,
+                 lattice: Lattice | None = None, within=None):  # fmt: skip
     """A path through the centres of lattice cells whose centre is free, every segment checked:
     for a free space too thin for any wholly free cell (a disc robot in a corridor barely wider
     than it), where :func:`corridor_path` finds no route.
@@ -511,14 +515,17 @@ def centre_route(model: Any, start, goal, max_cells: int = 65_536, terminate=Non
     :func:`corridor_path`), then every segment of the route through the model's exact check; a
     segment that fails is taken out of the graph and the route searched again, at most
     :data:`CENTRE_ROUTE_ROUNDS` times. The path is valid, not taut: it runs through cell centres.
+    With ``lattice`` (and ``within``, booleans of its cells) only those cells are searched.
     """
     t0 = time.perf_counter()
     start = np.asarray(start, dtype=float)
     goal = np.asarray(goal, dtype=float)
-    lat = model.lattice(max_cells, split=1)  # a map's own cells: their centres are its middles
+    lat = lattice or model.lattice(max_cells, split=1)  # a map's own cells: their middles
     if lat.nx < 2 or lat.ny < 2:
         return CorridorResult(None, reason="the lattice is too small")
     free = model.centres_free(lat)
+    if within is not None:
+        free &= within
     s_cell, s_hop = _entry(model, lat, free, start, 2)
     g_cell, g_hop = _entry(model, lat, free, goal, 2)
     if s_cell is None or g_cell is None:
@@ -632,20 +639,20 @@ def search(
     terminate=None,
     alternatives: int = 3,
 ) -> CorridorResult:
-    """The corridor stage within ``seconds``: corridors chosen on a coarse lattice, the chosen
-    one searched again on a fine one.
+    """The corridor stage within ``seconds``: corridors chosen on a coarse lattice, each searched
+    again on a fine lattice within a band round it.
 
-    1. **Fine cells.** The finest lattice whose cells can be marked in 40 % of the time (at
-       :data:`MARK_CELLS_PER_SECOND`, at most ``max_cells``), every cell wholly free or not
-       (:meth:`~rrtpso_ompl.model.World.free_cells`).
-    2. **Coarse routes.** The fine cells pooled ``k x k`` into a lattice small enough to route
-       on in a quarter of the time (at :data:`CELLS_PER_SECOND`): a coarse cell is open when any
-       fine cell in it is free, so no passage the fine cells keep is closed at the coarse level.
-       The shortest route and ``alternatives`` through other corridors
-       (:func:`alternative_routes`).
-    3. **Fine route in each corridor.** For each coarse route, best first, the route over the
-       fine free cells within :data:`BAND_CELLS` coarse cells of it (a coarse passage whose fine
-       cells do not connect has none), and its funnel path. The shortest valid path wins.
+    1. **Coarse routes.** A lattice small enough to route on in a third of the time (at
+       :data:`CELLS_PER_SECOND`) whose cells are open generously: for a map, a coarse cell is
+       open when any of the fine cells it pools is wholly free (marking a map's cells is cheap:
+       :data:`MARK_CELLS_PER_SECOND`); among shapes, when its centre is free. No passage the
+       fine cells keep is closed at the coarse level. The shortest route and ``alternatives``
+       through other corridors (:func:`alternative_routes`).
+    2. **Fine route in each corridor.** For each coarse route, best first, the fine cells within
+       :data:`BAND_CELLS` coarse cells of it, marked wholly free or not (a box of the lattice
+       round the band, so the work follows the band, not the whole map), the route over them
+       (a coarse passage whose fine cells do not connect has none) and its funnel path. The
+       shortest valid path wins.
 
     Free space too thin for any wholly free fine cell: :func:`centre_route`. ``seconds`` None:
     no limit but ``max_cells``.
@@ -654,88 +661,150 @@ def search(
     end = None if seconds is None else t0 + seconds
     start = np.asarray(start, dtype=float)
     goal = np.asarray(goal, dtype=float)
+    stages: dict[str, float] = {}
 
-    def out_of_time() -> bool:
-        return (terminate is not None and terminate()) or (
-            end is not None and time.perf_counter() >= end
-        )
+    out_of_time = _Deadline(end, terminate)
 
     def left() -> float:
         return math.inf if end is None else max(end - time.perf_counter(), 0.0)
 
-    fine_cells = int(min(max_cells, max(0.4 * MARK_CELLS_PER_SECOND * left(), 4096)))
+    route_cells = int(min(max_cells, max(CELLS_PER_SECOND * left() / 3.0, 1024)))
+    while True:
+        t1 = time.perf_counter()
+        if getattr(model, "raster", None) is not None:
+            fine_cells = int(min(max_cells, max(0.4 * MARK_CELLS_PER_SECOND * left(), 4096)))
+            result = _map_corridors(model, fine_cells, route_cells, start, goal, alternatives,
+                                    out_of_time, t0, stages)  # fmt: skip
+        else:
+            result = _shape_corridors(model, route_cells, max_cells, start, goal, alternatives,
+                                      out_of_time, t0, stages)  # fmt: skip
+        # No corridor held a route at the fine level: the coarse lattice joined cells that do
+        # not join. Twice the coarse cells, while a try as long again fits twice over.
+        took = time.perf_counter() - t1
+        if result.path is not None or route_cells >= max_cells or left() < 4.0 * took:
+            break
+        route_cells = min(2 * route_cells, max_cells)
+    if result.path is None and not out_of_time():
+        thin = centre_route(model, start, goal, max(min(route_cells, 1 << 18), 4096), out_of_time)
+        if thin.path is not None:
+            result = thin
+    return dataclasses.replace(result, time=time.perf_counter() - t0, stages=stages)
+
+
+def _map_corridors(model, fine_cells, route_cells, start, goal, alternatives, terminate, t0,
+                   stages) -> CorridorResult:  # fmt: skip
+    """:func:`search` on a map: the fine cells marked once, pooled into the coarse lattice."""
     fine = model.lattice(fine_cells)
-    stages: dict[str, float] = {}
     if fine.nx < 2 or fine.ny < 2:
         return CorridorResult(None, reason="the lattice is too small")
     free = model.free_cells(fine)
     stages["cells"] = time.perf_counter() - t0
-    route_cells = min(max_cells, max(CELLS_PER_SECOND * 0.4 * left(), 1024))
     k = max(1, math.ceil(math.sqrt(fine.n_cells / route_cells)))
-    result = None
-    if k == 1:
-        result = _route_and_funnel(model, fine, free, start, goal, alternatives, out_of_time, t0,
-                                   stages)  # fmt: skip
-    elif not out_of_time():
-        result = _through_coarse(model, fine, free, k, start, goal, alternatives, out_of_time,
-                                 t0, stages)  # fmt: skip
-    if (result is None or result.path is None) and not out_of_time():
-        thin = centre_route(model, start, goal, max(min(fine_cells, 1 << 18), 4096), out_of_time)
-        if thin.path is not None:
-            result = thin
-    if result is None:
-        return CorridorResult(None, lattice=fine, time=time.perf_counter() - t0,
-                              reason="out of time", stages=stages)  # fmt: skip
-    return dataclasses.replace(result, time=time.perf_counter() - t0)
-
-
-def _through_coarse(model, fine: Lattice, free, k: int, start, goal, alternatives, terminate, t0,
-                    stages) -> CorridorResult:  # fmt: skip
-    """Steps 2 and 3 of :func:`search`."""
     nx, ny = fine.nx // k, fine.ny // k
-    if nx < 2 or ny < 2:
+    if k == 1 or nx < 2 or ny < 2:
         return _route_and_funnel(model, fine, free, start, goal, alternatives, terminate, t0,
                                  stages)  # fmt: skip
     pooled = free[: nx * k, : ny * k].reshape(nx, k, ny, k).any(axis=(1, 3))
     coarse = Lattice(fine.origin, fine.h * k, nx, ny)
+
+    def fine_band(r0, r1, c0, c1, mask):
+        i0, i1, j0, j1 = r0 * k, r1 * k, c0 * k, c1 * k
+        box = Lattice((fine.origin[0] + i0 * fine.h, fine.origin[1] + j0 * fine.h), fine.h,
+                      i1 - i0, j1 - j0)  # fmt: skip
+        return box, free[i0:i1, j0:j1], k
+
+    return _corridors(model, coarse, pooled, fine_band, start, goal, alternatives, terminate,
+                      t0, stages)  # fmt: skip
+
+
+def _shape_corridors(model, route_cells, max_cells, start, goal, alternatives, terminate, t0,
+                     stages) -> CorridorResult:  # fmt: skip
+    """:func:`search` among shapes: coarse cells open when their centre is free, fine cells
+    (:data:`SHAPE_SPLIT` per coarse side) marked in each band's box only."""
+    coarse = model.lattice(route_cells)
+    if coarse.nx < 2 or coarse.ny < 2:
+        return CorridorResult(None, reason="the lattice is too small")
+    opened = model.centres_free(coarse)
+    stages["cells"] = time.perf_counter() - t0
+
+    def fine_band(r0, r1, c0, c1, mask):
+        cells = int(mask.sum())
+        # As fine as the time left affords: the band's cells are routed and funnelled too.
+        afford = max_cells
+        if terminate.end is not None:
+            afford = min(afford, CELLS_PER_SECOND * max(terminate.end - time.perf_counter(), 0.0))
+        k = SHAPE_SPLIT
+        while k > 1 and cells * k * k > afford:
+            k -= 1
+        box = Lattice((coarse.origin[0] + r0 * coarse.h, coarse.origin[1] + c0 * coarse.h),
+                      coarse.h / k, (r1 - r0) * k, (c1 - c0) * k)  # fmt: skip
+        near = np.repeat(np.repeat(mask, k, axis=0), k, axis=1)
+        return box, model.free_cells(box, near), k
+
+    return _corridors(model, coarse, opened, fine_band, start, goal, alternatives, terminate,
+                      t0, stages)  # fmt: skip
+
+
+def _corridors(model, coarse: Lattice, opened, fine_band, start, goal, alternatives, terminate,
+               t0, stages) -> CorridorResult:  # fmt: skip
+    """Coarse routes over ``opened``, then the funnel path of the fine route in each one's band
+    (``fine_band(r0, r1, c0, c1)`` gives, for a box of coarse cells, its fine lattice, which of
+    its cells are wholly free and the fine cells per coarse side); the shortest valid one."""
+    nx, ny = coarse.nx, coarse.ny
     ends = []
     for point in (start, goal):
-        cell = coarse.cell_of(point)
-        if not pooled[cell]:  # its cell has no free fine cell: the nearest one that has
-            near = np.argwhere(pooled[max(cell[0] - 2, 0) : cell[0] + 3,
-                                      max(cell[1] - 2, 0) : cell[1] + 3])  # fmt: skip
-            if not len(near):
-                return CorridorResult(None, lattice=fine, reason="start or goal is not next to "
-                                      "a free lattice cell", stages=stages)  # fmt: skip
-            off = np.array([max(cell[0] - 2, 0), max(cell[1] - 2, 0)])
-            cell = tuple(int(c) for c in (near + off)[np.argmin(np.abs(near + off - cell).sum(1))])
+        cell = _nearest_open(opened, coarse.cell_of(point))
+        if cell is None:
+            return CorridorResult(None, lattice=coarse, reason="start or goal is not next to "
+                                  "a free lattice cell")  # fmt: skip
         ends.append(cell)
     t1 = time.perf_counter()
     apart = max(3.0, ALTERNATIVE_APART * math.hypot(nx, ny))
-    routes = alternative_routes(pooled, ends[0], ends[1], alternatives, ALTERNATIVE_SLACK, apart)
+    routes = alternative_routes(opened, ends[0], ends[1], alternatives, ALTERNATIVE_SLACK, apart)
     stages["coarse_route"] = time.perf_counter() - t1
     best = None
+    grow = int(math.ceil(BAND_CELLS))
     for route in routes:
         if best is not None and terminate():
             break
         mask = np.zeros((nx, ny), dtype=bool)
         mask[tuple(np.array(route).T)] = True
-        grow = int(math.ceil(BAND_CELLS))
         mask = ndimage.binary_dilation(mask, iterations=grow)
-        # The band's bounding box of fine cells, as a lattice of its own (routing cost follows
-        # the box, not the whole map).
         rows, cols = np.nonzero(mask)
-        i0, i1 = rows.min() * k, (rows.max() + 1) * k
-        j0, j1 = cols.min() * k, (cols.max() + 1) * k
-        box = Lattice((fine.origin[0] + i0 * fine.h, fine.origin[1] + j0 * fine.h), fine.h,
-                      i1 - i0, j1 - j0)  # fmt: skip
-        near = np.repeat(np.repeat(mask[rows.min() : rows.max() + 1, cols.min() : cols.max() + 1],
-                                   k, axis=0), k, axis=1)  # fmt: skip
-        result = _route_and_funnel(model, box, free[i0:i1, j0:j1] & near, start, goal, 0,
-                                   terminate, t0, stages)  # fmt: skip
+        r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+        box, free, k = fine_band(r0, r1, c0, c1, mask[r0:r1, c0:c1])
+        near = np.repeat(np.repeat(mask[r0:r1, c0:c1], k, axis=0), k, axis=1)
+        result = _route_and_funnel(model, box, free & near, start, goal, 0, terminate, t0, stages)
+        if result.path is None and not terminate():
+            # The corridor's gaps are narrower than wholly free fine cells: through the centres
+            # of the fine cells that are free, every segment checked.
+            result = centre_route(model, start, goal, 0, terminate, box, near)
         if result.path is not None and (best is None or result.length < best.length):
             best = result
     if best is None:
-        return CorridorResult(None, lattice=fine, reason="no route through the lattice",
-                              stages=stages)  # fmt: skip
+        return CorridorResult(None, lattice=coarse, reason="no route through the lattice")
     return dataclasses.replace(best, routes=len(routes))
+
+
+class _Deadline:
+    """A termination test: ``terminate()``, or the clock past ``end``."""
+
+    def __init__(self, end: float | None, terminate=None) -> None:
+        self.end, self.terminate = end, terminate
+
+    def __call__(self) -> bool:
+        return bool(self.terminate is not None and self.terminate()) or (
+            self.end is not None and time.perf_counter() >= self.end
+        )
+
+
+def _nearest_open(opened: np.ndarray, cell, reach: int = 2):
+    """``cell`` when open, else the nearest open cell within ``reach`` (Manhattan), or None."""
+    if opened[cell]:
+        return cell
+    i0, j0 = max(cell[0] - reach, 0), max(cell[1] - reach, 0)
+    near = np.argwhere(opened[i0 : cell[0] + reach + 1, j0 : cell[1] + reach + 1])
+    if not len(near):
+        return None
+    near += (i0, j0)
+    return tuple(int(c) for c in near[np.argmin(np.abs(near - cell).sum(axis=1))])
