@@ -123,6 +123,7 @@ def shortcut(
     path: np.ndarray,
     segments_free: Callable[[np.ndarray, np.ndarray], np.ndarray],
     terminate: Callable[[], bool] | None = None,
+    window: int = 64,
 ) -> np.ndarray:
     """Greedy shortcutting: from each kept vertex jump to the farthest vertex in free sight.
 
@@ -136,6 +137,9 @@ def shortcut(
     terminate : callable, optional
         Polled before each kept vertex; when it returns True the rest of the path is kept as it
         is (still a valid path, just less shortened).
+    window : int
+        Vertices looked ahead at first (the window doubles while its far end is in sight): small
+        for a path that is already nearly taut, where little lies in sight.
 
     Returns
     -------
@@ -145,7 +149,7 @@ def shortcut(
 
     Notes
     -----
-    The look-ahead window starts at 64 vertices and doubles while its far end is in sight, so a
+    The look-ahead window starts at ``window`` vertices and doubles while its far end is in sight, so a
     long winding route (a grid path of thousands of vertices) is not tested against every later
     vertex; the visibility calls are chunked to bound their memory.
     """
@@ -159,9 +163,9 @@ def shortcut(
         if terminate is not None and terminate():
             keep.extend(range(i + 1, last + 1))
             break
-        window = 64
+        ahead = window
         while True:
-            j = np.arange(i + 1, min(last, i + window) + 1)
+            j = np.arange(i + 1, min(last, i + ahead) + 1)
             sight = np.concatenate(
                 [
                     segments_free(np.broadcast_to(p[i], (len(chunk), 2)), p[chunk])
@@ -171,9 +175,9 @@ def shortcut(
             # The next vertex is in sight on a valid input; on an invalid one, step to it anyway.
             seen = np.flatnonzero(sight)
             best = int(j[seen[-1]]) if len(seen) else i + 1
-            if best < i + window or best == last:
+            if best < i + ahead or best == last:
                 break
-            window *= 2
+            ahead *= 2
         i = best
         keep.append(i)
     return p[keep]

@@ -32,6 +32,7 @@ the workspace (floating-point round-off; :func:`~rrtpso_ompl.model.problem.touch
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import time
@@ -43,6 +44,7 @@ import shapely
 
 from .geometry import point_segment_distance, point_segment_distance_xy, segments_cross
 from .problem import Circle, Polygon, Problem, clearance_threshold, touch_tolerance
+from .raster import Lattice, MapRaster
 from .spatial import Grid
 
 __all__ = ["World", "clearance_threshold"]  # the rule lives in problem (the loader shares it)
@@ -81,6 +83,11 @@ class World:
         Radius ``R`` of the robot disc (its safety zone), in the same unit.
     boxes : sequence of (xmin, ymin, xmax, ymax)
         Axis-aligned rectangles (a map's blocked cells, merged; rectangles of a problem file).
+    raster : MapRaster, optional
+        The occupancy grid the last ``raster_boxes`` boxes were merged from, for lattice queries
+        (:meth:`free_cells`).
+    raster_boxes : int
+        How many of the boxes (the last ones) come from ``raster``.
     """
 
     def __init__(
@@ -90,6 +97,8 @@ class World:
         polygons: Sequence[np.ndarray | Sequence[Sequence[float]]] = (),
         robot_radius: float = 0.0,
         boxes: Sequence[Sequence[float]] = (),
+        raster: MapRaster | None = None,
+        raster_boxes: int = 0,
     ) -> None:
         (xmin, ymin), (xmax, ymax) = bounds
         self.bounds = ((float(xmin), float(ymin)), (float(xmax), float(ymax)))
@@ -114,6 +123,8 @@ class World:
         self._n_items = self._first_interior + len(self.polygons)
         self._prepare_scalar()
         self._prepare_index()
+        self.raster = raster
+        self._raster_boxes = int(raster_boxes) if raster is not None else 0
 
     # ------------------------------------------------------------------------------------------
     @classmethod
@@ -121,7 +132,13 @@ class World:
         """Build the static world of a :class:`~rrtpso_ompl.model.Problem` (moving obstacles
         are not part of it; a map's blocked cells are boxes)."""
         extra = getattr(problem, "map_boxes", None)
-        return cls.from_obstacles(problem.bounds, problem.obstacles, problem.robot.radius, extra)
+        occupancy = getattr(problem, "map", None)
+        raster = None
+        if occupancy is not None:
+            raster = MapRaster.from_image(occupancy.blocked, occupancy.origin,
+                                          occupancy.resolution, occupancy.unknown_blocks)  # fmt: skip
+        return cls.from_obstacles(problem.bounds, problem.obstacles, problem.robot.radius, extra,
+                                  raster)  # fmt: skip
 
     @classmethod
     def from_obstacles(
@@ -130,6 +147,7 @@ class World:
         obstacles: Sequence[Circle | Polygon],
         robot_radius: float,
         boxes: np.ndarray | None = None,
+        raster: MapRaster | None = None,
     ) -> World:
         """A world of the problem model's obstacles (:class:`~rrtpso_ompl.model.Circle`,
         :class:`~rrtpso_ompl.model.Polygon`; axis-aligned rectangles become boxes) and extra
@@ -140,7 +158,7 @@ class World:
         polygons = [np.asarray(o.points) for o in polys if not _is_box(o)]
         extra = np.asarray(boxes if boxes is not None else (), dtype=float).reshape(-1, 4)
         all_boxes = np.vstack([np.asarray(rects, dtype=float).reshape(-1, 4), extra])
-        return cls(bounds, circles, polygons, robot_radius, all_boxes)
+        return cls(bounds, circles, polygons, robot_radius, all_boxes, raster, len(extra))
 
     @contextmanager
     def refusing_motions_after(self, deadline: float | None) -> Iterator[None]:
@@ -162,7 +180,156 @@ class World:
 
     def with_robot_radius(self, robot_radius: float) -> World:
         """The same obstacles for another robot radius."""
-        return World(self.bounds, self.circles, self.polygons, robot_radius, self.boxes)
+        return World(self.bounds, self.circles, self.polygons, robot_radius, self.boxes,
+                     self.raster, self._raster_boxes)  # fmt: skip
+
+    # ------------------------------------------------------------------------------------------
+    # Lattice queries (the corridor search)
+    # ------------------------------------------------------------------------------------------
+    def lattice(self, max_cells: int, split: int = 4) -> Lattice:
+        """A lattice of about ``max_cells`` square cells inside the bounds: aligned with the map's
+        cells when the world has one (a map cell split in at most ``split`` per side), else
+        square cells centred in the bounds."""
+        if self.raster is not None:
+            return self.raster.lattice(self.bounds, max_cells, split)
+        (xmin, ymin), (xmax, ymax) = self.bounds
+        h = math.sqrt((xmax - xmin) * (ymax - ymin) / max(max_cells, 1))
+        lat = Lattice.over(self.bounds, h)
+        while lat.n_cells > max_cells:  # rounding may add a row or column
+            h *= 1.01
+            lat = Lattice.over(self.bounds, h)
+        return lat
+
+    def free_cells(self, lat: Lattice, within: np.ndarray | None = None) -> np.ndarray:
+        """(nx, ny) booleans: the lattice cells every point of which is a free configuration
+        (for a point robot: cells no obstacle enters, which may touch one), conservatively.
+
+        A map answers exactly (:meth:`MapRaster.free_cells`); circles, polygons and a problem's
+        rectangles through the exact clearance at each cell's centre, which the whole square
+        keeps up to ``h / sqrt(2)``. With ``within`` ((nx, ny) booleans) only those cells are
+        asked about (the others come back False), and only obstacles near them are measured.
+        """
+        margin = self.threshold if self.robot_radius > 0.0 else 0.0
+        free = np.ones((lat.nx, lat.ny), dtype=bool) if within is None else within.copy()
+        if self.raster is not None:
+            free &= self.raster.free_cells(lat, margin, self.bounds)
+        shapes = self._non_raster
+        if shapes.n_obstacles and free.any():
+            free &= shapes._clear_cells(lat, margin + lat.h * math.sqrt(0.5), free)
+        return free
+
+    def centres_free(self, lat: Lattice) -> np.ndarray:
+        """(nx, ny) booleans: the lattice cells whose centre is a free configuration (exact;
+        says nothing about the rest of the cell)."""
+        return self._clear_cells(lat, self.threshold)
+
+    def _clear_cells(self, lat: Lattice, need: float, asked=None) -> np.ndarray:
+        """(nx, ny) booleans: cells whose centre is at least ``need`` from every obstacle.
+
+        Each obstacle marks the cells near it (its bounding box grown by ``need``), with the
+        exact distance from their centres: the work grows with the area the obstacles cover,
+        not with the number of cells times the number of obstacles. With ``asked`` ((nx, ny)
+        booleans) obstacles none of whose cells is asked about are skipped.
+        """
+        clear = np.ones((lat.nx, lat.ny), dtype=bool)
+        (ox, oy), h = lat.origin, lat.h
+        boxes = self._item_boxes() + np.array([-1.0, -1.0, 1.0, 1.0]) * need
+        i0 = np.clip(np.floor((boxes[:, 0] - ox) / h - 0.5), 0, lat.nx).astype(np.int64)
+        i1 = np.clip(np.ceil((boxes[:, 2] - ox) / h - 0.5) + 1, 0, lat.nx).astype(np.int64)
+        j0 = np.clip(np.floor((boxes[:, 1] - oy) / h - 0.5), 0, lat.ny).astype(np.int64)
+        j1 = np.clip(np.ceil((boxes[:, 3] - oy) / h - 0.5) + 1, 0, lat.ny).astype(np.int64)
+        ni, nj = np.maximum(i1 - i0, 0), np.maximum(j1 - j0, 0)
+        if asked is not None:
+            # Asked cells in each obstacle's box, from a summed-area table.
+            sat = np.zeros((lat.nx + 1, lat.ny + 1), dtype=np.int64)
+            sat[1:, 1:] = asked.cumsum(axis=0).cumsum(axis=1)
+            inside = sat[i1, j1] - sat[i0, j1] - sat[i1, j0] + sat[i0, j0]
+            ni = np.where(inside > 0, ni, 0)
+        # A box's cross (its own rows grown by `need` up and down, its own columns grown left
+        # and right) is close wholesale: marked by slicing, no distances; only the corners of
+        # its grown box need them.
+        box_ids = np.arange(self._n_circles, self._n_circles + self._n_boxes)
+        corners_of = self._mark_box_crosses(clear, lat, need, box_ids[ni[box_ids] > 0])
+        counts = ni * nj
+        counts[box_ids] = 0
+        self._mark_pairs(clear, lat, need, i0, j0, nj, counts, asked)
+        if corners_of:
+            c_ids, c_i0, c_j0, c_nj, c_n = corners_of
+            self._mark_pairs(clear, lat, need, c_i0, c_j0, c_nj, c_n, asked, c_ids)
+        return clear
+
+    def _mark_box_crosses(self, clear, lat: Lattice, need: float, ids: np.ndarray):
+        """Mark the cells whose centre lies in a box grown by ``need`` along one axis (close to
+        it, exactly); return the corner windows still to measure, as (ids, i0, j0, nj, counts).
+        The index ranges lean inwards, so a cell on a boundary goes to the measured corners."""
+        if not len(ids):
+            return None
+        (ox, oy), h = lat.origin, lat.h
+        b = self.boxes[ids - self._n_circles]
+        eps = 1e-9 * h
+
+        def lo(v, origin, n):  # first cell whose centre is >= v
+            return np.clip(np.ceil((v - origin) / h - 0.5 - eps), 0, n).astype(np.int64)
+
+        def hi(v, origin, n):  # past the last cell whose centre is <= v
+            return np.clip(np.floor((v - origin) / h - 0.5 + eps) + 1, 0, n).astype(np.int64)
+
+        xi0, xi1 = lo(b[:, 0], ox, lat.nx), hi(b[:, 2], ox, lat.nx)
+        yj0, yj1 = lo(b[:, 1], oy, lat.ny), hi(b[:, 3], oy, lat.ny)
+        gi0, gi1 = lo(b[:, 0] - need, ox, lat.nx), hi(b[:, 2] + need, ox, lat.nx)
+        gj0, gj1 = lo(b[:, 1] - need, oy, lat.ny), hi(b[:, 3] + need, oy, lat.ny)
+        for k in range(len(ids)):
+            clear[xi0[k] : xi1[k], gj0[k] : gj1[k]] = False
+            clear[gi0[k] : gi1[k], yj0[k] : yj1[k]] = False
+        # Corner windows (a cell or so of slack round each corner square), measured exactly.
+        out_ids, out_i0, out_j0, out_nj, out_n = [], [], [], [], []
+        for ci0, ci1 in ((gi0 - 1, xi0 + 1), (xi1 - 1, gi1 + 1)):
+            for cj0, cj1 in ((gj0 - 1, yj0 + 1), (yj1 - 1, gj1 + 1)):
+                a0 = np.clip(ci0, 0, lat.nx)
+                a1 = np.clip(ci1, 0, lat.nx)
+                c0 = np.clip(cj0, 0, lat.ny)
+                c1 = np.clip(cj1, 0, lat.ny)
+                out_ids.append(ids)
+                out_i0.append(a0)
+                out_j0.append(c0)
+                out_nj.append(np.maximum(c1 - c0, 0))
+                out_n.append(np.maximum(a1 - a0, 0) * np.maximum(c1 - c0, 0))
+        cat = np.concatenate
+        return cat(out_ids), cat(out_i0), cat(out_j0), cat(out_nj), cat(out_n)
+
+    def _mark_pairs(self, clear, lat: Lattice, need: float, i0, j0, nj, counts, asked=None,
+                    ids=None) -> None:  # fmt: skip
+        """Measure (cell, obstacle) pairs: obstacle ``ids[m]`` (default ``m``) against the
+        ``counts[m]`` cells of its window from ``(i0[m], j0[m])``, ``nj[m]`` cells a column;
+        mark the close ones."""
+        (ox, oy), h = lat.origin, lat.h
+        if ids is None:
+            ids = np.arange(len(counts))
+        ends = np.searchsorted(np.cumsum(counts), np.arange(0, counts.sum(), _PAIR_CHUNK))
+        cuts = np.unique(np.concatenate([ends, [len(counts)]]))
+        for a, b in itertools.pairwise(np.concatenate([[0], cuts])):
+            if a >= b:
+                continue
+            c = counts[a:b]
+            which = np.repeat(np.arange(a, b), c)
+            k = np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)
+            ci = i0[which] + k // nj[which]
+            cj = j0[which] + k % nj[which]
+            keep = clear[ci, cj] if asked is None else clear[ci, cj] & asked[ci, cj]
+            ci, cj, obj = ci[keep], cj[keep], ids[which[keep]]
+            pts = np.column_stack([ox + h * (ci + 0.5), oy + h * (cj + 0.5)])
+            d = self._pair_distance(np.arange(len(obj)), obj, pts, pts)
+            close = d < need
+            clear[ci[close], cj[close]] = False
+
+    @functools.cached_property
+    def _non_raster(self) -> World:
+        """The obstacles that do not come from the map raster (all of them without one)."""
+        if self.raster is None:
+            return self
+        keep = self._n_boxes - self._raster_boxes
+        return World(self.bounds, self.circles, self.polygons, self.robot_radius,
+                     self.boxes[:keep])  # fmt: skip
 
     @property
     def n_obstacles(self) -> int:
@@ -541,11 +708,23 @@ class World:
         return bool(self.segments_free(p[:-1], p[1:]).all())
 
     def path_clearance(self, path: np.ndarray) -> float:
-        """Smallest distance from the polyline to any obstacle (``inf`` without obstacles)."""
+        """Smallest distance from the polyline to any obstacle (``inf`` without obstacles).
+
+        Asked through the index with a reach that doubles until some obstacle is within it (a
+        path's clearance is usually small), so a long path among thousands of boxes costs its
+        neighbourhood, not every (segment, obstacle) pair.
+        """
         p = np.asarray(path, dtype=float).reshape(-1, 2)
-        if len(p) == 1:
-            return float(self.point_clearance(p)[0])
-        return float(self.segment_distance(p[:-1], p[1:]).min())
+        a, b = (p, p) if len(p) == 1 else (p[:-1], p[1:])
+        (xmin, ymin), (xmax, ymax) = self.bounds
+        extent = max(xmax - xmin, ymax - ymin)
+        reach = max(self.threshold, 1e-3 * extent)
+        while self._indexed and reach < extent:
+            d = float(self.segment_distance(a, b, cap=reach).min())
+            if d <= reach - self.threshold:
+                return d
+            reach *= 4.0
+        return float(self.segment_distance(a, b).min())
 
     def local_model(self, seg_lo: np.ndarray, seg_hi: np.ndarray) -> LocalViolation:
         """A violation model for paths whose segment ``s`` lies in the box ``seg_lo[s]..seg_hi[s]``.

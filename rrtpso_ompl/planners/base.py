@@ -29,6 +29,7 @@ from ompl import base as ob
 from ompl import util as ou
 
 from ..model.problem import touch_tolerance
+from ..model.raster import Lattice
 from ..validation import MAX_SECONDS, SEED_MAX
 from .params import ParamSpec, ParamTable
 from .result import BenchmarkRun
@@ -216,6 +217,28 @@ class SpaceInformationCollisionModel:
         if len(p) < 2:
             return len(p) == 1 and bool(self.segments_free(p, p)[0])
         return bool(self.segments_free(p[:-1], p[1:]).all())
+
+    def lattice(self, max_cells: int, split: int = 4) -> Lattice:
+        """Square cells centred in the space's bounds, about ``max_cells`` of them."""
+        (xmin, ymin), (xmax, ymax) = self.bounds
+        h = math.sqrt((xmax - xmin) * (ymax - ymin) / max(max_cells, 1))
+        return Lattice.over(self.bounds, h)
+
+    def free_cells(self, lat: Lattice, within: np.ndarray | None = None) -> np.ndarray:
+        """Cells whose centre the checker accepts. Not conservative (a point checker says
+        nothing about the rest of the cell): paths through them are checked before use."""
+        return self.centres_free(lat, within)
+
+    def centres_free(self, lat: Lattice, within: np.ndarray | None = None) -> np.ndarray:
+        """Cells whose centre the checker accepts (only those in ``within``, when given)."""
+        st, valid = self._state, self.si.isValid
+        asked = np.ones(lat.n_cells, dtype=bool) if within is None else within.ravel()
+        free = np.zeros(lat.n_cells, dtype=bool)
+        centres = lat.centres()
+        for k in np.flatnonzero(asked).tolist():
+            st[0], st[1] = float(centres[k, 0]), float(centres[k, 1])
+            free[k] = valid(st)
+        return free.reshape(lat.nx, lat.ny)
 
 
 def collision_model_for(si: ob.SpaceInformation) -> Any:

@@ -25,7 +25,11 @@ Stages, each optional:
 
 1. *prune*: greedy exact shortcutting (keep a waypoint only when the next ones are not directly
    visible), so the swarm searches the few dimensions that matter;
-2. *PSO* over the interior waypoints, seeded around the current path;
+2. *PSO* over the interior waypoints, seeded around the current path: one swarm over all of
+   them (the paper's), or, on longer paths, one small swarm per window of ``window``
+   consecutive waypoints (a fixed waypoint between two windows makes their costs independent,
+   so every window keeps a best of its own, :func:`~rrtpso_ompl.planners.swarm.minimize` with
+   ``blocks``); the windows shift from round to round so that every waypoint moves;
 3. *refine*: where a segment runs along an obstacle (a polyline can only approximate an arc by its
    chords' tangents), insert mid-points and run the swarm again, up to ``max_waypoints``;
 4. *polish* (only with a deadline): more rounds re-centred on the best path while each still
@@ -111,6 +115,15 @@ class PathOptimizerOptions(PSOOptions):
         high=10.0,
     )
     max_waypoints: int = param(48, "Most waypoints refinement may create.", low=2, high=10_000)
+    window: int = param(
+        4,
+        "Waypoints each sub-swarm moves: the path's waypoints are cut into windows of this many, "
+        "a fixed waypoint between two windows, and every window gets a swarm of its own (all in "
+        "one array operation; the windows shift every round). 0 = one swarm over all the "
+        "waypoints, as in the paper.",
+        low=0,
+        high=10_000,
+    )
     polish_rounds: int = param(
         20,
         "With a deadline, further rounds re-centred on the best path while each still shortens "
@@ -231,6 +244,29 @@ def _refine(path: np.ndarray, world: World, margin: float, max_waypoints: int) -
     return np.insert(path, tight + 1, mids, axis=0)
 
 
+def _search_boxes(path: np.ndarray, world: World, fraction: float):
+    """Per interior waypoint, the box it may move in this round: ``fraction`` of its longer
+    segment around it, clipped to the bounds; and the lengths of the path's segments."""
+    seg_len = np.linalg.norm(np.diff(path, axis=0), axis=1)
+    (xmin, ymin), (xmax, ymax) = world.bounds
+    half = fraction * np.maximum(seg_len[:-1], seg_len[1:])
+    interior = path[1:-1]
+    lo = np.maximum(interior - half[:, None], [xmin, ymin])
+    hi = np.minimum(interior + half[:, None], [xmax, ymax])
+    return lo, hi, seg_len
+
+
+def _violation_within(world: World, pt_lo: np.ndarray, pt_hi: np.ndarray):
+    """The world's violation for segments whose end points stay in the boxes ``pt_lo[k]``..
+    ``pt_hi[k]`` (consecutive points, ``(S + 1, 2)``): culled to the obstacles near each
+    segment's box when the world can (exact for such segments), else the full check."""
+    if not hasattr(world, "local_model"):
+        return None
+    seg_lo = np.minimum(pt_lo[:-1], pt_lo[1:])
+    seg_hi = np.maximum(pt_hi[:-1], pt_hi[1:])
+    return world.local_model(seg_lo, seg_hi).violation
+
+
 def _pso_round(
     seed_path: np.ndarray,
     cost_model: PathCost,
@@ -239,31 +275,19 @@ def _pso_round(
     terminate: Callable[[], bool] | None,
     deadline: float | None = None,
 ) -> tuple[np.ndarray, pso.PSOResult]:
-    """One swarm run seeded around ``seed_path``; returns the best path and the PSO result
-    (the seed path itself, with no iterations, when even one evaluation would end after
-    ``deadline``)."""
+    """One swarm run over every interior waypoint, seeded around ``seed_path``; returns the best
+    path and the PSO result (the seed path itself, with no iterations, when even one evaluation
+    would end after ``deadline``)."""
     world = cost_model.world
     interior = seed_path[1:-1]
     k = len(interior)
-    seg_len = np.linalg.norm(np.diff(seed_path, axis=0), axis=1)
+    lo, hi, seg_len = _search_boxes(seed_path, world, options.box_fraction)
     # Spread each waypoint's initial cloud by the shorter of its two segments: a waypoint between
     # close neighbours must not be thrown across them.
     local = np.minimum(seg_len[:-1], seg_len[1:])
     sigma = np.repeat(options.init_spread * np.maximum(local, world.tol), 2)
-
-    # Search boxes per waypoint (end points: zero-size boxes), clipped to the workspace.
-    (xmin, ymin), (xmax, ymax) = world.bounds
-    half = options.box_fraction * np.maximum(seg_len[:-1], seg_len[1:])
-    lo = np.maximum(interior - half[:, None], [xmin, ymin])
-    hi = np.minimum(interior + half[:, None], [xmax, ymax])
-    violation = None
-    if hasattr(world, "local_model"):
-        pt_lo = np.vstack([seed_path[:1], lo, seed_path[-1:]])
-        pt_hi = np.vstack([seed_path[:1], hi, seed_path[-1:]])
-        seg_lo = np.minimum(pt_lo[:-1], pt_lo[1:])
-        seg_hi = np.maximum(pt_hi[:-1], pt_hi[1:])
-        local_model = world.local_model(seg_lo, seg_hi)
-        violation = local_model.violation
+    violation = _violation_within(world, np.vstack([seed_path[:1], lo, seed_path[-1:]]),
+                                  np.vstack([seed_path[:1], hi, seed_path[-1:]]))  # fmt: skip
     round_cost = PathCost(
         cost_model.start, cost_model.goal, world, cost_model.smoothness_weight, violation
     )
@@ -300,6 +324,117 @@ def _pso_round(
     return best, res
 
 
+def _windows(n_interior: int, width: int, offset: int) -> np.ndarray:
+    """(K, width) indices into the path of the waypoints each window moves, -1 for the empty
+    slots of a short window. Interior waypoints are 1..n_interior; every ``width + 1``-th one
+    (shifted by ``offset``) stays fixed, so no two windows share a segment."""
+    idx = np.arange(1, n_interior + 1)
+    fixed = (idx - 1 + offset) % (width + 1) == width
+    moving = idx[~fixed]
+    if not len(moving):
+        return np.empty((0, width), dtype=np.int64)
+    # A new window starts after a fixed waypoint (a gap in the moving indices) or when full.
+    gap = np.ones(len(moving), dtype=bool)
+    gap[1:] = np.diff(moving) > 1
+    group = np.cumsum(gap) - 1
+    slot = np.arange(len(moving)) - np.flatnonzero(gap)[group]
+    out = np.full((group[-1] + 1, width), -1, dtype=np.int64)
+    out[group, slot] = moving
+    return out
+
+
+def _window_round(
+    seed_path: np.ndarray,
+    cost_model: PathCost,
+    options: PathOptimizerOptions,
+    rng: np.random.Generator,
+    terminate: Callable[[], bool] | None,
+    offset: int,
+    deadline: float | None = None,
+) -> tuple[np.ndarray, pso.PSOResult]:
+    """One round of a small swarm per window of ``options.window`` waypoints, all windows in one
+    array operation (:func:`~rrtpso_ompl.planners.swarm.minimize` with ``blocks``).
+
+    Window ``k`` is the chain ``fixed, q_1 .. q_W, fixed``; a short window's empty slots are
+    pinned to its closing fixed waypoint (zero-length segments, no cost). Its cost is the
+    chain's length (and smoothness), and, when a segment intrudes, the seed chain's cost plus
+    the penalty: no window's best is ever worse or colliding. Returns the path with every
+    window's best in place, and the swarm's result.
+    """
+    world = cost_model.world
+    width = options.window
+    win = _windows(len(seed_path) - 2, width, offset)
+    n_win = len(win)
+    real = win >= 0
+    # Each window's closing fixed waypoint: after its last real slot.
+    last = np.where(real, win, -1).max(axis=1)
+    first = win[:, 0]
+    slot_idx = np.where(real, win, last[:, None] + 1)  # empty slots sit on the closing point
+    lo_all, hi_all, seg_len = _search_boxes(seed_path, world, options.box_fraction)
+    lo_pts = np.vstack([seed_path[:1], lo_all, seed_path[-1:]])
+    hi_pts = np.vstack([seed_path[:1], hi_all, seed_path[-1:]])
+    lo = np.where(real[..., None], lo_pts[slot_idx], seed_path[slot_idx])  # (K, W, 2)
+    hi = np.where(real[..., None], hi_pts[slot_idx], seed_path[slot_idx])
+    before, after = seed_path[first - 1], seed_path[last + 1]  # (K, 2)
+    chain_lo = np.concatenate([before[:, None], lo, after[:, None]], axis=1)  # (K, W + 2, 2)
+    chain_hi = np.concatenate([before[:, None], hi, after[:, None]], axis=1)
+    # Segment boxes of every chain, for the culled exact check.
+    seg_lo = np.minimum(chain_lo[:, :-1], chain_lo[:, 1:]).reshape(-1, 2)
+    seg_hi = np.maximum(chain_hi[:, :-1], chain_hi[:, 1:]).reshape(-1, 2)
+    violation = (world.local_model(seg_lo, seg_hi).violation if hasattr(world, "local_model")
+                 else world.segment_violation)  # fmt: skip
+
+    def chains(x: np.ndarray) -> np.ndarray:
+        n = x.shape[0]
+        mid = x.reshape(n, n_win, width, 2)
+        a = np.broadcast_to(before[None, :, None], (n, n_win, 1, 2))
+        b = np.broadcast_to(after[None, :, None], (n, n_win, 1, 2))
+        return np.concatenate([a, mid, b], axis=2)
+
+    def terms(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        ch = chains(x)
+        seg = np.diff(ch, axis=2)
+        length = np.sqrt(np.einsum("pksi,pksi->pks", seg, seg)).sum(axis=2)
+        if cost_model.smoothness_weight > 0:
+            # Turning at the moving waypoints; the turn at a fixed waypoint depends on two
+            # windows and is left out, so that the windows' costs stay independent.
+            length = length + cost_model.smoothness_weight * (
+                turning_angles(ch) ** 2).sum(axis=2)  # fmt: skip
+        n = ch.shape[0]
+        v = violation(ch[:, :, :-1].reshape(n, -1, 2), ch[:, :, 1:].reshape(n, -1, 2))
+        return length, v.reshape(n, n_win, width + 1).sum(axis=2)
+
+    x0 = seed_path[slot_idx].reshape(-1)
+    local = np.minimum(seg_len[:-1], seg_len[1:])
+    spread = np.where(real, options.init_spread * np.maximum(local[np.maximum(win - 1, 0)],
+                                                             world.tol), 0.0)  # fmt: skip
+    n = options.swarm_size
+    init = x0 + rng.standard_normal((n, n_win * width * 2)) * np.repeat(spread.reshape(-1), 2)
+    init[0] = x0
+    offset_cost = terms(x0[None])[0][0]  # (K,)
+
+    def cost(x: np.ndarray) -> np.ndarray:
+        c, v = terms(x)
+        return np.where(v > 0.0, c + offset_cost + options.violation_weight * v, c)
+
+    res = pso.minimize(
+        cost,
+        lo.reshape(-1),
+        hi.reshape(-1),
+        PSOOptions.from_values(asdict(options)),
+        rng,
+        init=init,
+        v_max=options.v_max_fraction * float(seg_len.mean()),
+        terminate=terminate,
+        blocks=n_win,
+        deadline=deadline,
+    )
+    best = seed_path.copy()
+    pos = res.position.reshape(n_win, width, 2)
+    best[win[real]] = pos[real]
+    return best, res
+
+
 def optimize_path(
     path: np.ndarray,
     world: World,
@@ -321,10 +456,11 @@ def optimize_path(
     rng : numpy.random.Generator, optional
         Source of all randomness; ``numpy.random.default_rng()`` (unseeded) when omitted.
     terminate : callable, optional
-        Polled once per PSO iteration; stops the optimisation early when it returns True.
+        Polled once per PSO iteration; stops the optimisation early when it returns True. With
+        it, rounds go on (up to ``polish_rounds`` more) while they still pay.
     deadline : float, optional
-        ``time.perf_counter()`` seconds; no swarm evaluation is started that would, judging by
-        the last one, end after it (:func:`~rrtpso_ompl.planners.swarm.minimize`).
+        ``time.perf_counter()`` seconds by which the swarm must be done: no PSO iteration starts
+        that would end after it (their cost is measured as they run).
 
     Returns
     -------
@@ -336,74 +472,97 @@ def optimize_path(
     options = options or PathOptimizerOptions()
     rng = rng if rng is not None else np.random.default_rng()
     original = np.array(path, dtype=float).reshape(-1, 2)
-    input_length = path_length(original)
+    run = _Rounds(original, world, options, rng, terminate, deadline)
+    if len(original) >= 2 and world.path_valid(original) and not run.stopped():
+        run.optimise()
+    return run.result(t0)
 
-    def result(p: np.ndarray, hist: list[np.ndarray], iters: int, evals: int, rounds: int):
-        improved = p is not original
+
+class _Rounds:
+    """The rounds of one :func:`optimize_path` call and their bookkeeping."""
+
+    def __init__(self, original, world, options, rng, terminate, deadline=None) -> None:
+        self.deadline = deadline
+        self.original = original
+        self.world = world
+        self.options = options
+        self.rng = rng
+        self.terminate = terminate
+        self.cost_model = PathCost(original[0], original[-1], world, options.smoothness_weight)
+        self.current = original
+        self.history: list[np.ndarray] = []
+        self.iterations = self.evaluations = self.rounds = 0
+
+    def stopped(self) -> bool:
+        return self.terminate is not None and self.terminate()
+
+    def optimise(self) -> None:
+        """Prune, then rounds (refining where segments run along obstacles) while they pay."""
+        opts, world = self.options, self.world
+        if opts.prune:
+            self.current = shortcut(self.original, world.segments_free, self.terminate)
+        # Without a deadline the work is bounded by the refinement rounds (reproducible); with
+        # one, polish rounds follow while a round still shortens the path.
+        limit = 1 + opts.refine_rounds + (opts.polish_rounds if self.terminate else 0)
+        still = 0
+        for r in range(limit):
+            if self.stopped() or len(self.current) <= 2:
+                break
+            seed = self.current
+            if r > 0:
+                seed = _refine(seed, world, opts.refine_margin, opts.max_waypoints)
+            refined = len(seed) > len(self.current)
+            before = _cost_of(self.cost_model, seed)
+            after = self._round(seed, r)
+            # Rounds that neither refine nor pay (both window offsets, with windows): converged.
+            still = 0 if refined or before - after > opts.polish_tolerance * before else still + 1
+            if still >= (2 if opts.window and len(seed) - 2 > opts.window else 1):
+                break
+        if self.rounds:
+            # Drop waypoints that ended up collinear or redundant.
+            self.current = shortcut(self.current, world.segments_free, self.terminate)
+
+    def _round(self, seed: np.ndarray, r: int) -> float:
+        """One swarm round from ``seed``; keeps its path when valid and no worse. Returns the
+        cost after the round."""
+        opts = self.options
+        if opts.window and len(seed) - 2 > opts.window:
+            candidate, res = _window_round(seed, self.cost_model, opts, self.rng, self.terminate,
+                                           r * (opts.window // 2 + 1), self.deadline)  # fmt: skip
+        else:
+            candidate, res = _pso_round(seed, self.cost_model, opts, self.rng, self.terminate,
+                                        self.deadline)  # fmt: skip
+        self.history.append(res.history)
+        self.iterations += res.n_iterations
+        self.evaluations += res.n_evaluations
+        self.rounds += 1
+        before = _cost_of(self.cost_model, seed)
+        if self.world.path_valid(candidate):
+            cost = _cost_of(self.cost_model, candidate)
+            if cost <= before:
+                self.current = candidate
+                return cost
+        self.current = seed
+        return before
+
+    def result(self, t0: float) -> PathOptimizationResult:
+        """Keep the contract: valid and never longer than the input, else the input itself."""
+        p = self.current
+        input_length = path_length(self.original)
+        ok = p is not self.original and self.world.path_valid(p)
+        if not (ok and path_length(p) < input_length):
+            p = self.original
         return PathOptimizationResult(
             path=p,
             length=path_length(p),
             input_length=input_length,
-            improved=improved,
-            history=np.concatenate(hist) if hist else np.empty(0),
-            n_iterations=iters,
-            n_evaluations=evals,
-            rounds=rounds,
+            improved=p is not self.original,
+            history=np.concatenate(self.history) if self.history else np.empty(0),
+            n_iterations=self.iterations,
+            n_evaluations=self.evaluations,
+            rounds=self.rounds,
             time=time.perf_counter() - t0,
         )
-
-    if len(original) < 2 or not world.path_valid(original):
-        return result(original, [], 0, 0, 0)
-
-    if terminate is not None and terminate():
-        return result(original, [], 0, 0, 0)  # no time left: the input, as promised
-    cost_model = PathCost(original[0], original[-1], world, options.smoothness_weight)
-    current = shortcut(original, world.segments_free, terminate) if options.prune else original
-    history: list[np.ndarray] = []
-    iters = evals = rounds = 0
-    for r in range(1 + options.refine_rounds):
-        if terminate is not None and terminate():
-            break
-        if r > 0:
-            refined = _refine(current, world, options.refine_margin, options.max_waypoints)
-            if len(refined) == len(current):
-                break
-            current = refined
-        if len(current) <= 2:
-            break  # a straight segment: nothing left to optimise
-        candidate, res = _pso_round(current, cost_model, options, rng, terminate, deadline)
-        history.append(res.history)
-        iters += res.n_iterations
-        evals += res.n_evaluations
-        rounds += 1
-        if world.path_valid(candidate) and res.cost <= _cost_of(cost_model, current):
-            current = candidate
-
-    # Anytime: with a deadline, keep polishing (boxes re-centred on the best path) while rounds
-    # still pay; the budget is the caller's, so none of it is left unused while the cost falls.
-    polish = options.polish_rounds if terminate is not None else 0
-    for _ in range(polish):
-        if terminate() or len(current) <= 2:
-            break
-        before = _cost_of(cost_model, current)
-        candidate, res = _pso_round(current, cost_model, options, rng, terminate, deadline)
-        history.append(res.history)
-        iters += res.n_iterations
-        evals += res.n_evaluations
-        rounds += 1
-        if not (world.path_valid(candidate) and res.cost <= before):
-            break
-        current = candidate
-        if before - res.cost <= options.polish_tolerance * before:
-            break
-
-    # Drop waypoints that ended up collinear or redundant, then keep the contract: valid and never
-    # longer than the input, else the input itself.
-    if rounds:
-        current = shortcut(current, world.segments_free, terminate)
-    if world.path_valid(current) and path_length(current) < input_length:
-        return result(current, history, iters, evals, rounds)
-    return result(original, history, iters, evals, rounds)
 
 
 def _cost_of(cost_model: PathCost, path: np.ndarray) -> float:

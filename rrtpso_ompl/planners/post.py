@@ -43,6 +43,7 @@ __all__ = [
     "PostStep",
     "parse_steps",
     "run_post",
+    "simplify_until",
     "split_spec",
 ]
 
@@ -216,6 +217,38 @@ class PSOPathOptimizer:
         return dataclasses.replace(self.options, swarm_size=size), 1.5 * validate
 
 
+#: Attempts each call of one of OMPL's simplifier steps makes, at least (a quarter of the path's
+#: states when that is more): few enough that the deadline is checked often.
+SIMPLIFY_ATTEMPTS = 16
+#: Sweeps in a row that change nothing before the simplifier counts as converged.
+SIMPLIFY_PATIENCE = 3
+
+
+def simplify_until(si: ob.SpaceInformation, path: og.PathGeometric, deadline: float) -> None:
+    """OMPL's path simplifier on ``path``, in place, a few attempts at a time until ``deadline``
+    (``time.perf_counter()`` seconds) or until it stops changing the path.
+
+    OMPL's own ``simplify(path, ptc)`` polls its termination condition only between whole
+    passes, and a pass over a path of hundreds of waypoints checks motions along it so often
+    that it took seconds (21 s past a 5 s budget on a 128 x 128 maze map). Its steps (vertex
+    reduction, partial shortcuts, collapsing close vertices) take a number of attempts, so they
+    run here in small batches with the deadline checked in between. B-spline smoothing, the last
+    step of ``simplifyMax``, is left out: it adds states and cannot stop early.
+    """
+    simplifier = og.PathSimplifier(si)
+    steps = (simplifier.reduceVertices, simplifier.partialShortcutPath,
+             simplifier.collapseCloseVertices)  # fmt: skip
+    still = 0
+    while still < SIMPLIFY_PATIENCE:
+        changed = False
+        for step in steps:
+            if time.perf_counter() >= deadline:
+                return
+            attempts = max(SIMPLIFY_ATTEMPTS, path.getStateCount() // 4)
+            changed = step(path, attempts, attempts) or changed
+        still = 0 if changed else still + 1
+
+
 def run_post(
     si: ob.SpaceInformation,
     path: og.PathGeometric,
@@ -245,9 +278,9 @@ def run_post(
             share = post["simplify_share"] if "pso" in steps[i + 1 :] else 1.0
             if left > 0:
                 seconds = max(share * left, 1e-4)
-                # It polls its time only between passes: our world cuts a long pass short.
+                # Our world also cuts a long batch short (it refuses motions after the time).
                 with refusing_motions_after(world or collision_model_for(si), t0 + seconds):
-                    og.PathSimplifier(si).simplify(path, seconds)
+                    simplify_until(si, path, t0 + seconds)
         else:
             options = PathOptimizerOptions.from_values(values)
             optimizer = PSOPathOptimizer(si, options=options, world=world, rng=rng)

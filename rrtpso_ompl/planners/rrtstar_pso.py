@@ -1,12 +1,19 @@
 """RRTstarPSO: OMPL's RRT* followed by the particle swarm over its waypoints (the paper's RRT*PSO).
 
+0. The corridor stage (:mod:`rrtpso_ompl.planners.corridor`) looks at every way round the
+   obstacles at once, on a lattice of the free space, and pulls the best route taut: a first
+   path in milliseconds, in the right corridor, also through mazes that RRT*'s tree would not
+   cross in time.
 1. OMPL's C++ ``og.RRTstar`` shares this planner's ProblemDefinition and grows its tree for
-   ``rrt_time_fraction`` of the time budget (always also stopped by the outer termination
+   ``rrt_time_fraction`` of the time left (always also stopped by the outer termination
    condition). Its best path's waypoints are the paper's "candidate nodes".
-2. :class:`rrtpso_ompl.planners.PSOPathOptimizer` (the post-pass any planner gets with
-   ``+pso``) shortens (and optionally smooths) them with the PSO of eqs. 4-5, checking every
-   candidate segment exactly.
-3. The result replaces RRT*'s path in the ProblemDefinition (``clearSolutionPaths`` then
+2. The candidates, RRT*'s path and the corridor's, each shortened (OMPL's simplifier), are
+   ranked by length: a jagged path in the best corridor must not lose to a smooth one in a
+   worse corridor.
+3. :class:`rrtpso_ompl.planners.PSOPathOptimizer` (the post-pass any planner gets with
+   ``+pso``) shortens (and optionally smooths) the winner with the PSO of eqs. 4-5, checking
+   every candidate segment exactly.
+4. The result replaces RRT*'s path in the ProblemDefinition (``clearSolutionPaths`` then
    ``addSolutionPath``), so ``ss.getSolutionPath()`` returns it like any planner's path.
 
 Use it like any OMPL planner::
@@ -29,7 +36,7 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from ..model.geometry import path_length
+from ..model.geometry import path_length, shortcut
 from ..model.world import World
 from ..ompl_setup import array_to_path, path_to_array
 from .base import (
@@ -41,10 +48,11 @@ from .base import (
     collision_model_for,
     refusing_motions_after,
 )
+from .corridor import search
 from .ompl_planners import RRTSTAR_PARAMS
 from .params import ParamSpec, ParamTable
 from .path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
-from .post import PSOPathOptimizer
+from .post import PSOPathOptimizer, simplify_until
 from .result import BenchmarkRun
 from .swarm import SWARM_PARAMS
 
@@ -66,15 +74,28 @@ RRTSTAR_PSO_PARAMS = (
     ParamTable(*(RRTSTAR_PARAMS[n] for n in _INNER))
     + ParamTable(
         BUDGET,
+        ParamSpec("corridor_cells", int, 4_194_304,
+                  "Most cells of the corridor stage's fine lattice (0 = no corridor stage); "
+                  "within this, the lattice is as fine as its time share allows.",
+                  low=0, high=16_777_216),
+        ParamSpec("corridor_fraction", float, 0.25,
+                  "Most share of the budget the corridor stage may take (it usually needs far "
+                  "less; a smaller lattice is used when the time would not do).",
+                  low=0.0, high=1.0),
+        ParamSpec("corridor_alternatives", int, 3,
+                  "Routes through other corridors the corridor stage tries besides the "
+                  "shortest one on its lattice.", low=0, high=32),
         ParamSpec("rrt_time_fraction", float, 0.9,
-                  "Share of the budget given to RRT*; the PSO gets the rest.", low=1e-3, high=1.0),
+                  "Share of the budget (after the corridor stage) given to RRT*; the PSO gets "
+                  "the rest.", low=1e-3, high=1.0),
         ParamSpec("stall_fraction", float, 0.25,
                   "Hand over to the swarm before RRT*'s share is used up once RRT*'s best cost "
                   "has fallen by less than 0.1 % over this share of the budget (0 = never).",
                   low=0.0, high=1.0),
         ParamSpec("connect_after", float, 0.2,
-                  "With no RRT* path after this share of RRT*'s time, OMPL's BIT* looks for a "
-                  "first path (narrow passages) whose waypoints become the candidate nodes "
+                  "With no RRT* path after this share of RRT*'s time, RRT* stops: the swarm "
+                  "takes over the corridor stage's path, or, without one, OMPL's BIT* looks for "
+                  "a first path (narrow passages) whose waypoints become the candidate nodes "
                   "(1 = never).", low=0.0, high=1.0),
         ParamSpec("rrt_max_iterations", int, 0,
                   "Stop RRT* after this many iterations (0 = no limit); with a bounded PSO this "
@@ -94,14 +115,24 @@ RRTSTAR_PSO_PARAMS = (
 class RRTstarPSOStats(PlannerStats):
     """Per-stage figures of one RRTstarPSO solve (the ``stages`` of a solve result).
 
-    Lengths are in problem units, times in seconds. In OMPL's benchmark terms the RRT* stage and
-    OMPL's simplifier are the planning, the swarm is the simplification. ``rrt_path`` is RRT*'s
-    first path, ``seed_path`` the RRT* path the returned one was made from (a later one when the
-    anytime loop found a shorter). ``range_used`` is the inner RRT*'s range, the one chosen for
-    the world when the ``range`` parameter is 0 (the parameter itself stays as the user set it).
+    Lengths are in problem units, times in seconds. In OMPL's benchmark terms the corridor stage,
+    the RRT* stage and OMPL's simplifier are the planning, the swarm is the simplification.
+    ``rrt_path`` is RRT*'s first path, ``seed_path`` the path the returned one was made from
+    (``seed_source`` says whose: ``"corridor"``, ``"RRTstar"`` or ``"BITstar"``; a later RRT*
+    path when the anytime loop found a shorter). ``corridor_*`` describe the corridor stage
+    (``corridor_cells``: its lattice's cells; ``corridor_reason``: why it has no path).
+    ``range_used`` is the inner RRT*'s range, the one chosen for the world when the ``range``
+    parameter is 0 (the parameter itself stays as the user set it).
     """
 
     range_used: float = 0.0
+    corridor_length: float | None = None
+    corridor_time: float = 0.0
+    corridor_cells: int = 0
+    corridor_routes: int = 0
+    corridor_reason: str = ""
+    seed_source: str = ""
+    seed_length: float | None = None
     rrt_length: float | None = None
     first_solution: str = "RRTstar"
     rrt_time: float = 0.0
@@ -138,10 +169,12 @@ class RRTstarPSOStats(PlannerStats):
         swarm_ran = self.pso_length is not None
         return BenchmarkRun(
             time=elapsed - self.pso_time,
-            solution_length=self.rrt_length,
+            solution_length=self.seed_length if self.seed_length is not None else self.rrt_length,
             simplification_time=self.pso_time if swarm_ran else None,
             simplified_length=length if swarm_ran else None,
             properties={
+                "corridor time": ("REAL", self.corridor_time),
+                "corridor length": ("REAL", self.corridor_length),
                 "rrt iterations": ("INTEGER", self.rrt_iterations),
                 "pso iterations": ("INTEGER", self.pso_iterations),
                 "pso evaluations": ("INTEGER", self.pso_evaluations),
@@ -154,6 +187,14 @@ class RRTstarPSOStats(PlannerStats):
 #: How many times over OMPL's simplifier checks the path's length in one pass (vertex reduction,
 #: shortcuts, collapsing), for sizing it to a user's slow checker: an estimate on the safe side.
 SIMPLIFIER_PASS_LENGTHS = 20
+
+#: With no route through the lattice yet, a finer lattice may be tried until this share of the
+#: budget (there is nothing for the other stages to refine meanwhile).
+_CORRIDOR_NO_ROUTE_SHARE = 0.5
+
+#: Share of the budget kept back for handing the path over (the last checks, OMPL's path): the
+#: stages aim to be done by the rest.
+FINISH_RESERVE = 0.03
 
 #: RRT*'s automatic range is at most this many times the median clearance of free points.
 RANGE_PER_CLEARANCE = 10.0
@@ -235,47 +276,21 @@ class RRTstarPSO(PythonPlanner):
         if not self._inner_ready:
             self.setup()
         pdef = self.getProblemDefinition()
-        values = self._values
         stats = RRTstarPSOStats(range_used=self.inner.getRange())  # the one chosen when 0
         self.last_stats = stats
 
-        # --- stage 1: RRT* ------------------------------------------------------------------
-        self._run_rrtstar(ptc, t0, stats)
-        if not pdef.hasSolution():
+        corridor = self._corridor(ptc, t0, stats)  # stage 0
+        self._run_rrtstar(ptc, t0, stats, fallback=corridor is None)  # stage 1
+        candidates = self._candidates(corridor, ptc, t0, stats)  # stage 2
+        if not candidates:
+            if pdef.hasSolution():  # RRT*'s tree never reached the goal
+                return ob.PlannerStatus(ob.PlannerStatus.APPROXIMATE_SOLUTION)
             return ob.PlannerStatus(ob.PlannerStatus.TIMEOUT)
-        raw = pdef.getSolutionPath()  # shared ownership: stays valid after clearSolutionPaths
-        xy = path_to_array(raw)
-        stats.rrt_length = path_length(xy)
-        stats.rrt_waypoints = len(xy)
-        stats.rrt_path = xy.tolist()
-        if pdef.hasApproximateSolution():
-            # The tree never reached the goal: nothing to optimise between fixed end points.
-            return ob.PlannerStatus(ob.PlannerStatus.APPROXIMATE_SOLUTION)
-
-        stats.seed_path = stats.rrt_path
-        # --- stage 2: OMPL's simplifier, so the swarm starts from a locally shortened path ------
-        if values["simplify"] and not ptc():
-            xy = self._simplify(raw, xy, stats, ptc, t0)
-        stats.simplified_length = path_length(xy)
-
-        # --- stage 3: PSO over the candidate nodes --------------------------------------------
-        best = self._swarm(xy, stats, t0, ptc).path
-
-        # --- anytime: RRT* stalled and the swarm converged with time left: grow the same tree
-        # on, and run the swarm again whenever RRT* finds a shorter path.
-        while self._resumable(t0, ptc):
-            seed_cost = self.inner.bestCost().value()
-            self._run_rrtstar(ptc, t0, stats, resume=True)
-            if not self.inner.bestCost().value() < seed_cost * (1.0 - 1e-9):
-                break
-            raw = pdef.getSolutionPath()
-            xy = path_to_array(raw)
-            seed = xy.tolist()
-            if values["simplify"] and not ptc():
-                xy = self._simplify(raw, xy, stats, ptc, t0)
-            again = self._swarm(xy, stats, t0, ptc)
-            if again.length < path_length(best):
-                best, stats.seed_path = again.path, seed
+        source, seed, xy = min(candidates, key=lambda c: path_length(c[2]))
+        stats.seed_source, stats.seed_path = source, seed.tolist()
+        stats.seed_length = stats.simplified_length = path_length(xy)
+        best = self._swarm(xy, stats, t0, ptc).path  # stage 3
+        best = self._anytime(best, stats, t0, ptc)
         stats.pso_length = path_length(best)
         stats.pso_waypoints = len(best)
 
@@ -285,26 +300,124 @@ class RRTstarPSO(PythonPlanner):
         pdef.addSolutionPath(path, False, 0.0, self.getName())
         return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
 
+    def _corridor(self, ptc, t0: float, stats: RRTstarPSOStats) -> np.ndarray | None:
+        """Stage 0: the corridor stage's path (:func:`~rrtpso_ompl.planners.corridor.search`
+        within ``corridor_fraction`` of the budget; with no route at all, up to
+        :data:`_CORRIDOR_NO_ROUTE_SHARE` of it), or None."""
+        v = self._values
+        if v["corridor_cells"] <= 0:
+            stats.corridor_reason = "off"
+            return None
+        start, goal = self._start_and_goal(ptc)
+        if start is None or goal is None:
+            stats.corridor_reason = "no start or goal state"
+            return None
+        budget = v["budget"]
+        cells = v["corridor_cells"]
+        seconds = v["corridor_fraction"] * budget if budget > 0 else None
+        if isinstance(self._model, SpaceInformationCollisionModel):
+            # The user's checker answers the lattice one state at a time: size it to its cost.
+            per_check = self._model.probe(np.asarray(start)) * self._model.step
+            if seconds is not None:
+                cells = min(cells, int(0.4 * seconds / max(per_check, 1e-9)))
+            if cells < 1024:
+                stats.corridor_reason = "the validity checker is too slow for a lattice"
+                return None
+        t1 = time.perf_counter()
+        result = search(self._model, start, goal, seconds, cells, ptc,
+                        v["corridor_alternatives"])  # fmt: skip
+        if result.path is None and seconds is not None and not ptc():
+            # No route at all: there is nothing for the later stages to refine, so a finer try
+            # may take more of the budget.
+            more = t0 + _CORRIDOR_NO_ROUTE_SHARE * budget - time.perf_counter()
+            if more > 2.0 * result.time:
+                result = search(self._model, start, goal, more, cells, ptc,
+                                v["corridor_alternatives"])  # fmt: skip
+        stats.corridor_time = time.perf_counter() - t1
+        stats.corridor_cells = result.lattice.n_cells if result.lattice else 0
+        stats.corridor_routes = result.routes
+        stats.corridor_reason = result.reason
+        if result.path is None:
+            return None
+        stats.corridor_length = result.length
+        return result.path
+
+    def _candidates(self, corridor, ptc, t0: float, stats: RRTstarPSOStats):
+        """Stage 2: ``(source, raw waypoints, shortened waypoints)`` of every candidate path:
+        RRT*'s (or BIT*'s) after OMPL's simplifier, and the corridor stage's (already taut in
+        its corridor) after a greedy shortcut."""
+        pdef = self.getProblemDefinition()
+        out = []
+        if pdef.hasSolution():
+            raw = pdef.getSolutionPath()  # shared ownership: stays valid after clearSolutionPaths
+            xy = path_to_array(raw)
+            stats.rrt_length = path_length(xy)
+            stats.rrt_waypoints = len(xy)
+            stats.rrt_path = xy.tolist()
+            if not pdef.hasApproximateSolution():
+                short = self._simplify(raw, xy, stats, ptc, t0) if self._values["simplify"] else xy
+                out.append((stats.first_solution, xy, short))
+        if corridor is not None:
+            # Taut within its corridor already: a short look-ahead suffices.
+            out.append(("corridor", corridor, shortcut(corridor, self._model.segments_free,
+                                                       self._stop(ptc, t0), window=8)))  # fmt: skip
+        return out
+
+    def _finish_by(self, t0: float) -> float | None:
+        """When the stages must be done (``time.perf_counter()`` s): the end of the budget, less
+        :data:`FINISH_RESERVE` of it for handing the path over; None without a budget."""
+        budget = self._values["budget"]
+        return t0 + (1.0 - FINISH_RESERVE) * budget if budget > 0 else None
+
+    def _stop(self, ptc, t0: float):
+        """The outer condition or :meth:`_finish_by`."""
+        deadline = self._finish_by(t0)
+        if deadline is None:
+            return lambda: bool(ptc())
+        return lambda: bool(ptc()) or time.perf_counter() >= deadline
+
+    def _anytime(self, best: np.ndarray, stats: RRTstarPSOStats, t0: float, ptc) -> np.ndarray:
+        """RRT* stalled and the swarm converged with time left: grow the same tree on, and run
+        the swarm again whenever RRT* finds a path that, shortened, beats the seed so far."""
+        pdef = self.getProblemDefinition()
+        while self._resumable(t0, ptc):
+            seed_cost = self.inner.bestCost().value()
+            self._run_rrtstar(ptc, t0, stats, resume=True)
+            if not self.inner.bestCost().value() < seed_cost * (1.0 - 1e-9):
+                break
+            if pdef.hasApproximateSolution() or not pdef.hasSolution():
+                break
+            raw = pdef.getSolutionPath()
+            xy = path_to_array(raw)
+            seed = xy
+            if self._values["simplify"] and not ptc():
+                xy = self._simplify(raw, xy, stats, ptc, t0)
+            if path_length(xy) >= stats.seed_length:
+                continue  # still no better start than the one the swarm had
+            again = self._swarm(xy, stats, t0, ptc)
+            if again.length < path_length(best):
+                best, stats.seed_path, stats.seed_source = again.path, seed.tolist(), "RRTstar"
+                stats.seed_length = path_length(xy)
+        return best
+
     def _simplify(self, raw: og.PathGeometric, xy: np.ndarray, stats: RRTstarPSOStats, ptc, t0):
         """OMPL's simplifier on a copy of RRT*'s path; the shorter of the two waypoints.
 
-        ``simplifyMax`` (about a millisecond on a typical path) without a budget; with one, at
-        most half of what is left, so a path of hundreds of waypoints through a maze cannot eat
-        the swarm's share.
+        ``simplifyMax`` (about a millisecond on a typical path) without a budget; with one, its
+        steps in small batches for at most half of what is left (:func:`simplify_until`), so a
+        path of hundreds of waypoints through a maze cannot eat the swarm's share or the budget.
         """
         t1 = time.perf_counter()
         budget = self._values["budget"]
         if budget > 0 and not self._simplifier_fits(xy, 0.5 * (t0 + budget - t1)):
             return xy
         simplified = og.PathGeometric(raw)  # a copy: RRT*'s own path stays as it was
-        simplifier = og.PathSimplifier(self.getSpaceInformation())
         if budget > 0:
             left = max(0.5 * (t0 + budget - t1), 1e-4)
             with refusing_motions_after(self._model, t1 + left):
-                simplifier.simplify(simplified, ob.plannerOrTerminationCondition(
-                    ptc, ob.timedPlannerTerminationCondition(left)))  # fmt: skip
+                simplify_until(self.getSpaceInformation(), simplified, t1 + left)
         else:
-            simplifier.simplifyMax(simplified)
+            og.PathSimplifier(self.getSpaceInformation()).simplifyMax(simplified)
         candidate = path_to_array(simplified)
         better = path_length(candidate) < path_length(xy) and self._fine_valid(candidate, t0)
         stats.simplify_time = time.perf_counter() - t1
@@ -350,12 +463,11 @@ class RRTstarPSO(PythonPlanner):
         self, xy: np.ndarray, stats: RRTstarPSOStats, t0: float, ptc: ob.PlannerTerminationCondition
     ):
         """The path optimiser over the candidate nodes, until the budget's end."""
-        budget = self._values["budget"]
         # With a known budget the PSO stops at its end (and at the outer condition); without one
         # the outer condition has already fired, so the swarm is bounded by its iterations only.
-        terminate = deadline = None
-        if budget > 0:
-            deadline = t0 + budget
+        terminate = None
+        deadline = self._finish_by(t0)
+        if deadline is not None:
 
             def terminate() -> bool:
                 return ptc() or time.perf_counter() >= deadline
@@ -428,11 +540,12 @@ class RRTstarPSO(PythonPlanner):
         t0: float,
         stats: RRTstarPSOStats,
         resume: bool = False,
+        fallback: bool = True,
     ) -> None:
         """Grow RRT* until its share of the budget, its iteration cap or the outer condition, or
         until its best cost stalls (the swarm gets the rest); with no path at ``connect_after``
-        of its share, BIT* looks for the first one. ``resume`` grows the tree on after a swarm
-        run, for at most 70 % of the time left.
+        of its share (and ``fallback``: no corridor path either), BIT* looks for the first one.
+        ``resume`` grows the tree on after a swarm run, for at most 70 % of the time left.
 
         The tree is grown in short slices (repeated ``solve`` calls continue the same tree) so that
         the best cost can be sampled over time: OMPL's progress properties are not reachable from
@@ -440,8 +553,10 @@ class RRTstarPSO(PythonPlanner):
         """
         values = self._values
         budget = values["budget"]
-        rrt_end = t0 + values["rrt_time_fraction"] * budget if budget > 0 else None
         t_begin = time.perf_counter()
+        # RRT*'s share of what the corridor stage left.
+        rrt_end = (t_begin + values["rrt_time_fraction"] * max(t0 + budget - t_begin, 0.0)
+                   if budget > 0 else None)  # fmt: skip
         if resume:  # grown on after a swarm run: until a stall again, or 70 % of what is left
             rrt_end = t_begin + 0.7 * max(t0 + budget - t_begin, 0.0)
         max_iter = values["rrt_max_iterations"]
@@ -463,14 +578,15 @@ class RRTstarPSO(PythonPlanner):
             slice_s = 0.05 if budget <= 0 else max(0.01, values["rrt_time_fraction"] * budget / 20)
             connect_at = None
             if rrt_end is not None and values["connect_after"] < 1.0 and not resume:
-                connect_at = t0 + values["connect_after"] * (rrt_end - t0)
+                connect_at = t_begin + values["connect_after"] * (rrt_end - t_begin)
             while not ptc():
                 now = time.perf_counter()
                 if rrt_end is not None and now >= rrt_end:
                     break
                 if connect_at is not None and now >= connect_at and not self._has_exact():
-                    self._connect(ptc, rrt_end, stats)
-                    break
+                    if fallback:
+                        self._connect(ptc, rrt_end, stats)
+                    break  # with the corridor's path in hand, the swarm gets the time instead
                 if self._stalled(stats.rrt_progress, now - t0, budget, t_begin - t0):
                     break
                 step = slice_s if rrt_end is None else min(slice_s, rrt_end - now)

@@ -68,11 +68,16 @@ def test_stall_is_relative_and_looks_back_only_since_a_resume():
 
 def test_rrtstarpso_uses_its_budget_and_finds_a_path_through_a_narrow_maze():
     # A perfect maze with corridors 1.3 % of the width and a point robot: RRT* alone finds no
-    # path in 2 s; BIT*, started halfway through RRT*'s share, does.
+    # path in 2 s. The corridor stage finds one at once; without it, BIT*, started a fifth of
+    # the way through RRT*'s share, does.
     maze = problem_from_dict(generate("maze", 1, cells=12, robot_radius=0.0, wall=7.0))
+    world = World.from_problem(maze)
     r = solve(maze, "RRTstarPSO", time_limit=2.0, seed=1)
+    assert r.solved and r.stages["seed_source"] == "corridor"
+    assert world.path_valid(np.array(r.path))
+    r = solve(maze, "RRTstarPSO", time_limit=2.0, seed=1, params={"corridor_cells": 0})
     assert r.solved and r.stages["first_solution"] == "BITstar"
-    assert World.from_problem(maze).path_valid(np.array(r.path))
+    assert world.path_valid(np.array(r.path))
     easy = load_problem(PROBLEMS / "static" / "single_circle.yaml")
     r = solve(easy, "RRTstarPSO", time_limit=0.5, seed=1)
-    assert r.stages["first_solution"] == "RRTstar" and r.stages["pso_rounds"] > 1
+    assert r.stages["pso_rounds"] > 1

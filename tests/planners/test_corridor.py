@@ -1,0 +1,158 @@
+"""The corridor stage: lattices, which cells are free, routes and the funnel."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import shapely
+
+from rrtpso_ompl.model import World
+from rrtpso_ompl.model.geometry import path_length
+from rrtpso_ompl.model.raster import Lattice, MapRaster
+from rrtpso_ompl.planners.corridor import channel, corridor_path, funnel, lattice_route
+
+
+def _map_world(blocked_image, radius=0.0, res=1.0, origin=(0.0, 0.0), bounds=None):
+    from rrtpso_ompl.model.occupancy import merge_cells
+
+    img = np.asarray(blocked_image, dtype=bool)
+    raster = MapRaster.from_image(img, origin, res)
+    h, w = img.shape
+    bounds = bounds or ((origin[0], origin[1]), (origin[0] + w * res, origin[1] + h * res))
+    boxes = merge_cells(img, res, origin)
+    return World(bounds, robot_radius=radius, boxes=boxes, raster=raster, raster_boxes=len(boxes))
+
+
+def _brute_free(world: World, lat: Lattice) -> np.ndarray:
+    """A cell is free when shapely finds no blocked square within the radius of it."""
+    r = world.robot_radius
+    squares = [shapely.box(*b) for b in world.boxes]
+    union = shapely.union_all(squares) if squares else shapely.Polygon()
+    out = np.zeros((lat.nx, lat.ny), dtype=bool)
+    ox, oy = lat.origin
+    for i in range(lat.nx):
+        for j in range(lat.ny):
+            cell = shapely.box(ox + i * lat.h, oy + j * lat.h, ox + (i + 1) * lat.h,
+                               oy + (j + 1) * lat.h)  # fmt: skip
+            if r > 0:
+                out[i, j] = cell.distance(union) >= r - 1e-12
+            else:
+                out[i, j] = cell.intersection(union).area == 0.0
+    return out
+
+
+@pytest.mark.parametrize("radius", [0.0, 0.3, 1.0, 2.2])
+@pytest.mark.parametrize("sub", [0.5, 1.0, 2.0])
+def test_free_cells_of_a_map_agree_with_shapely(radius, sub):
+    rng = np.random.default_rng(int(radius * 10 + sub * 3))
+    img = rng.random((12, 15)) < 0.2
+    world = _map_world(img, radius)
+    lat = Lattice.over(world.bounds, 1.0 / sub, world.raster.origin)
+    got = world.free_cells(lat)
+    want = _brute_free(world, lat)
+    if sub >= 1.0:
+        assert np.array_equal(got, want)
+    else:  # a coarser lattice than the map: conservative
+        assert not (got & ~want).any()
+
+
+def test_free_cells_of_circles_are_conservative():
+    world = World(((0, 0), (50, 40)), circles=[(10, 10, 4), (30, 25, 6), (40, 8, 2.5)],
+                  robot_radius=1.5)  # fmt: skip
+    lat = world.lattice(900)
+    got = world.free_cells(lat)
+    assert got.sum() > 0.5 * got.size
+    ox, oy = lat.origin
+    for i, j in zip(*np.nonzero(got), strict=True):
+        # the whole cell (its corners and centre) is free
+        xs = ox + lat.h * np.array([i, i + 1, i, i + 1, i + 0.5])
+        ys = oy + lat.h * np.array([j, j, j + 1, j + 1, j + 0.5])
+        assert (world.point_clearance(np.column_stack([xs, ys])) >= world.threshold).all()
+
+
+def test_funnel_pulls_the_string_round_the_inner_corner():
+    # an L-shaped channel of unit cells: along the bottom row, then up the right column
+    cells = [(0, 0), (1, 0), (2, 0), (2, 1), (2, 2)]
+    from rrtpso_ompl.planners.corridor import _portals
+
+    lat = Lattice((0.0, 0.0), 1.0, 3, 3)
+    rects = np.array([(i, i + 1, j, j + 1) for i, j in cells])
+    path = funnel((0.5, 0.5), (2.5, 2.5), _portals(list(range(5)), rects, lat, 0.0))
+    assert np.allclose(path, [[0.5, 0.5], [2.0, 1.0], [2.5, 2.5]])
+
+
+def test_channel_cells_share_edges():
+    route = [(0, 0), (1, 1), (3, 2), (4, 4), (3, 3), (1, 2)]
+    cells = channel(route)
+    for (i0, j0), (i1, j1) in zip(cells[:-1], cells[1:], strict=True):
+        assert abs(i1 - i0) + abs(j1 - j0) == 1
+
+
+def test_a_one_cell_maze_gives_the_exact_shortest_path():
+    # a zig-zag corridor one cell wide, point robot: the taut path touches the corners
+    img = np.array(
+        [
+            [1, 1, 1, 1, 1, 1, 1],
+            [1, 0, 0, 0, 0, 0, 1],
+            [1, 1, 1, 1, 1, 0, 1],
+            [1, 0, 0, 0, 0, 0, 1],
+            [1, 0, 1, 1, 1, 1, 1],
+            [1, 0, 0, 0, 0, 0, 1],
+            [1, 1, 1, 1, 1, 1, 1],
+        ]
+    )
+    world = _map_world(img)
+    start, goal = (1.5, 5.5), (5.5, 1.5)  # top-left corridor to bottom-right
+    res = corridor_path(world, start, goal, 10_000)
+    assert res.path is not None and world.path_valid(res.path)
+    # the exact answer, by hand: start -> (5, 5) -> (5, 4)... corners of the walls
+    from rrtpso_ompl.evaluation import shortest_path
+    from rrtpso_ompl.model.problem import problem_from_dict
+
+    # compare with the exact optimum of the same world
+    exact = _optimum(world, start, goal)
+    assert res.length == pytest.approx(exact, rel=1e-4)
+    assert res.length >= exact * (1 - 1e-9)
+    del shortest_path, problem_from_dict
+
+
+def _optimum(world: World, start, goal) -> float:
+    from rrtpso_ompl.evaluation.optimum import shortest_path
+
+    class P:  # the few fields shortest_path reads
+        pass
+
+    p = P()
+    p.start, p.goal, p.goal_tolerance, p.name, p.source = start, goal, 0.0, "t", "t"
+    p.bounds = world.bounds
+    return shortest_path(p, world, upper_bound=math.inf).length
+
+
+def test_no_route_is_reported_honestly():
+    img = np.zeros((6, 6), dtype=bool)
+    img[:, 3] = True  # a wall splits the map
+    world = _map_world(img)
+    res = corridor_path(world, (1.0, 3.0), (5.0, 3.0), 1000)
+    assert res.path is None and "no route" in res.reason
+
+
+def test_routes_prefer_the_shorter_door():
+    img = np.zeros((20, 20), dtype=bool)
+    img[10, :] = True
+    img[10, 2:4] = False  # a door far to the left
+    img[10, 12:14] = False  # a door right above the goal's column
+    world = _map_world(img, radius=0.4)
+    res = corridor_path(world, (12.5, 2.5), (13.5, 17.5), 10_000)
+    assert res.path is not None and world.path_valid(res.path)
+    assert res.length < 16.0  # through the near door: about 15, via the far one over 28
+
+
+def test_lattice_route_is_none_between_walled_off_cells():
+    free = np.ones((5, 5), dtype=bool)
+    free[2, :] = False
+    assert lattice_route(free, (0, 0), (4, 4)) is None
+    route = lattice_route(np.ones((5, 5), dtype=bool), (0, 0), (4, 4))
+    assert route[0] == (0, 0) and route[-1] == (4, 4) and len(route) == 5
+    assert path_length(np.array(route, float)) == pytest.approx(4 * math.sqrt(2))
