@@ -135,8 +135,8 @@ class World:
         occupancy = getattr(problem, "map", None)
         raster = None
         if occupancy is not None:
-            raster = MapRaster.from_image(occupancy.blocked, occupancy.origin,
-                                          occupancy.resolution, occupancy.unknown_blocks)  # fmt: skip
+            o = occupancy
+            raster = MapRaster.from_image(o.blocked, o.origin, o.resolution, o.unknown_blocks)
         return cls.from_obstacles(problem.bounds, problem.obstacles, problem.robot.radius, extra,
                                   raster)  # fmt: skip
 

@@ -763,7 +763,7 @@ def _corridors(model, coarse: Lattice, opened, fine_band, start, goal, alternati
     routes = alternative_routes(opened, ends[0], ends[1], alternatives, ALTERNATIVE_SLACK, apart)
     stages["coarse_route"] = time.perf_counter() - t1
     best = None
-    grow = int(math.ceil(BAND_CELLS))
+    grow = math.ceil(BAND_CELLS)
     for route in routes:
         if best is not None and terminate():
             break

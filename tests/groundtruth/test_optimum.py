@@ -345,7 +345,8 @@ def _write_map(folder, blocked: np.ndarray, res: float = 1.0, name: str = "m"):
     img = np.where(blocked, 0, 254).astype(np.uint8)
     (folder / f"{name}.pgm").write_bytes(f"P5\n{w} {h}\n255\n".encode() + img.tobytes())
     (folder / f"{name}.yaml").write_text(
-        f"image: {name}.pgm\nresolution: {res}\norigin: [0.0, 0.0, 0.0]\n")
+        f"image: {name}.pgm\nresolution: {res}\norigin: [0.0, 0.0, 0.0]\n"
+    )
     return folder / f"{name}.yaml"
 
 

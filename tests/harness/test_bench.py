@@ -174,8 +174,13 @@ def test_bad_options_exit_2(args, message, tmp_path):
 def test_property_mapping_takes_each_planner_s_own_figures():
     """The row's ``benchmark`` record (made by the planner's stats) decides the mapping; nothing
     is guessed from the keys of ``stages``."""
-    swarm = BenchmarkRun(time=0.85, solution_length=700.0, simplification_time=0.15,
-                         simplified_length=650.0, properties={"pso rounds": ("INTEGER", 3)})
+    swarm = BenchmarkRun(
+        time=0.85,
+        solution_length=700.0,
+        simplification_time=0.15,
+        simplified_length=650.0,
+        properties={"pso rounds": ("INTEGER", 3)},
+    )
     ids = {"file": "f", "planner": "A", "run": 0}
     pso_row = {**ids, "solved": True, "status": "exact", "ompl_status": "Exact solution",
                "valid": True, "length": 650.0, "time": 1.0, "optimum": 647.5, "seed": 3,

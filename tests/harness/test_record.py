@@ -51,8 +51,15 @@ def _result() -> SolveResult:
 
 def _legacy_row(task: Task, result: SolveResult, wall: float, optimum: float) -> dict:
     """A solved row as the batch built it before the record existed (``run_task`` of issue 22)."""
-    base = {"file": task.file, "planner": task.planner, "seed": task.seed, "run": task.run,
-            "budget": task.time_limit, "source": task.key.source, "inputs_sha256": task.digest}
+    base = {
+        "file": task.file,
+        "planner": task.planner,
+        "seed": task.seed,
+        "run": task.run,
+        "budget": task.time_limit,
+        "source": task.key.source,
+        "inputs_sha256": task.digest,
+    }
     row = {**base, **result.to_dict(), **base}  # fmt: skip
     row["wall"] = wall
     row["error"] = None
@@ -157,8 +164,9 @@ def test_a_row_with_a_malformed_benchmark_is_not_a_row(tmp_path):
     text = json.dumps(OLD_ROW) + "\n" + json.dumps({**OLD_ROW, "benchmark": [1]}) + "\n"
     out.write_text(text)
     assert read_rows(out) == [RunRecord.from_json(OLD_ROW)]
-    with pytest.raises(UsageError, match="line 2 is not one of its rows"), ResultsFile(
-        out, resume=True
+    with (
+        pytest.raises(UsageError, match="line 2 is not one of its rows"),
+        ResultsFile(out, resume=True),
     ):
         pass
     assert out.read_text() == text

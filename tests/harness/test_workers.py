@@ -77,9 +77,7 @@ def test_same_seed_same_path_as_a_separate_solve(tmp_path):
                        params=params)  # fmt: skip
     rows = run_batch(tasks, tmp_path / "r.jsonl", jobs=2, optimum=False)
     for row in rows:
-        extra = [
-            a for k, v in params.get(row.planner, {}).items() for a in ("--param", f"{k}={v}")
-        ]
+        extra = [a for k, v in params.get(row.planner, {}).items() for a in ("--param", f"{k}={v}")]
         out = tmp_path / f"{row.planner}_{row.seed}.json"
         subprocess.run([*rrtpso_exe(), "solve", problem, "--planner", row.planner, "--seed",
                         str(row.seed), "--time", "5", *extra, "--json", str(out)],

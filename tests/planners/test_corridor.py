@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -86,7 +87,7 @@ def test_funnel_pulls_the_string_round_the_inner_corner():
 def test_channel_cells_share_edges():
     route = [(0, 0), (1, 1), (3, 2), (4, 4), (3, 3), (1, 2)]
     cells = channel(route)
-    for (i0, j0), (i1, j1) in zip(cells[:-1], cells[1:], strict=True):
+    for (i0, j0), (i1, j1) in itertools.pairwise(cells):
         assert abs(i1 - i0) + abs(j1 - j0) == 1
 
 
