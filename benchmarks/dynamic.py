@@ -135,7 +135,7 @@ def run_case(case: Case, replan_time: float, initial_time: float,
 
     set_ompl_log_level(0)
     seed = case.seed
-    head = {"group": case.group, "seed": seed}
+    head = {"group": case.group, "seed": seed, "obstacles_turn": case.heading_changes > 0}
     base = load_problem(case.base)
     static = solve(base, "RRTstarPSO", initial_time, seed)
     chosen = [(s, p) for s, p in STRATEGIES if strategies is None or s in strategies]
@@ -415,7 +415,8 @@ def dwa_target(verdicts: list, rows: list[dict]) -> list[str]:
             f"{r.get('collisions')}, min clearance {_fmt(r.get('min_clearance'))}, "
             f"arrival {_fmt(r.get('total_time'))} s, status {r.get('status', '–')}; "
             + ("a collision-free motion exists (clairvoyant arrival " + _fmt(free) + " s)"
-               if free else "no collision-free motion is known")
+               if free else "the obstacles turn at random (no clairvoyant baseline)"
+               if r.get("obstacles_turn") else "no collision-free motion is known")
             + f" {r.get('error', '')}".rstrip()
         )  # fmt: skip
     return lines

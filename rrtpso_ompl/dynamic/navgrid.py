@@ -24,8 +24,9 @@ from ..model.world import World
 
 __all__ = ["MAX_CELLS", "OCTILE", "NavGrid"]
 
-#: Most cells of a grid: a finer resolution over a larger world is coarsened to this many.
-MAX_CELLS = 2_000_000
+#: Most cells of a grid (its graph takes about 100 bytes a cell): a finer resolution over a
+#: larger world is coarsened to this many.
+MAX_CELLS = 1_000_000
 #: Length given to the edges out of a cell blocked for one field (beyond any limit).
 _BLOCKED = 1e300
 #: Octile distances exceed Euclidean ones by at most this factor (1 / cos 22.5 degrees).

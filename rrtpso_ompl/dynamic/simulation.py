@@ -12,6 +12,9 @@ The robot drives its planned path (the differential-drive stop-and-turn motion o
    the collision zone (the stretch of its path during which they stay that close);
 3. on a predicted collision, **replans** (:class:`~rrtpso_ompl.dynamic.manager.
    ReplanningManager`: contour detours up and down, verified, or a verified wait or step aside).
+
+:func:`simulate_local` is the same harness for a local controller (a :class:`LocalController`,
+such as the DWA peer of :mod:`.dwa`), which instead chooses the velocities every period.
 """
 
 from __future__ import annotations
