@@ -81,6 +81,16 @@ def add_shared_flags(parser: argparse.ArgumentParser) -> None:
 # ----------------------------------------------------------------------------------------------
 # One problem and its planner (solve, simulate)
 # ----------------------------------------------------------------------------------------------
+def add_planner_flags(p: argparse.ArgumentParser, *, planner: str, time: str, param: str) -> None:
+    """``--planner``, ``--time``, ``--seed`` and ``--param``, the flags :func:`choose_planner`
+    resolves against the problem file; ``planner``, ``time`` and ``param`` are their help (what
+    the planner plans and its time is for, in the command's words)."""
+    p.add_argument("--planner", help=planner)
+    p.add_argument("--time", type=float, metavar="SECONDS", help=time)
+    p.add_argument("--seed", type=int, help="random seed (default: the file's planner.seed)")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help=param)
+
+
 def choose_planner(args: argparse.Namespace) -> PlannerRequest:
     """Load ``args.problem`` and resolve ``--planner``, ``--post``/``--simplify``, ``--param``,
     ``--time`` and ``--seed`` against it (:func:`~rrtpso_ompl.planners.request.resolve`).

@@ -11,6 +11,7 @@ from .common import (
     EXIT_OK,
     EXIT_UNSOLVED,
     Output,
+    add_planner_flags,
     check_outputs,
     check_positive_seconds,
     check_seed_flag,
@@ -35,17 +36,12 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     m.add_argument("--json", metavar="OUT", help="write the simulation as JSON")
     m.add_argument("--gif", metavar="OUT.gif", help="write an animation")
     m.add_argument("--plot", metavar="OUT.png", help="draw the driven path (paper Fig. 24)")
-    m.add_argument("--seed", type=int, help="random seed (default: the file's planner.seed)")
-    m.add_argument(
-        "--planner",
-        help="planner of the static path and the detours (default: the "
-        "file's planner.type, else RRTstarPSO)",
-    )
-    m.add_argument(
-        "--time",
-        type=float,
-        metavar="SECONDS",
-        help="budget of the initial static path (default: the file's planner.time_limit, else 1.0)",
+    add_planner_flags(
+        m,
+        planner="planner of the static path and the detours (default: the file's planner.type, "
+        "else RRTstarPSO)",
+        time="budget of the initial static path (default: the file's planner.time_limit, else 1.0)",
+        param="planner parameter, repeatable",
     )
     m.add_argument(
         "--replan-time",
@@ -75,13 +71,6 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         default=0.0,
         metavar="RATE",
         help="random heading changes per obstacle per second (default 0: constant velocity)",
-    )
-    m.add_argument(
-        "--param",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="planner parameter, repeatable",
     )
     m.set_defaults(func=run)
 

@@ -12,33 +12,44 @@ The robot drives its planned path (the differential-drive stop-and-turn motion o
    the collision zone (the stretch of its path during which they stay that close);
 3. on a predicted collision, **replans** (:class:`~rrtpso_ompl.dynamic.manager.
    ReplanningManager`: contour detours up and down, verified, or a verified wait or step aside).
+
+:func:`simulate_local` is the same harness for a local controller (a :class:`LocalController`,
+such as the DWA peer of :mod:`.dwa`), which instead chooses the velocities every period.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
 from ..errors import RrtpsoError
 from ..model.geometry import path_length
 from ..model.problem import Problem
+from ..model.world import World
 from ..validation import MAX_STEPS as _MAX_STEPS
-from .manager import Replan, ReplanningManager
-from .motion import Motion, ObstacleTrack, closest_approach
+from .manager import Observations, Replan, ReplanningManager
+from .motion import Motion, ObstacleTrack, arc_position, closest_approach
 from .prediction import predict_threats
 
 __all__ = [
     "MAX_REPLANS",
     "MAX_STEPS",
     "STRATEGIES",
+    "SUBSTEPS",
     "DynamicOptions",
+    "LocalController",
+    "RobotModel",
+    "RobotState",
     "SimulationError",
     "SimulationResult",
+    "goal_tolerance",
     "simulate",
+    "simulate_local",
 ]
 
 
@@ -55,6 +66,11 @@ MAX_REPLANS = 500
 
 #: Least simulated time between two attempts to shortcut the rest of the plan, s.
 RESHORTEN_PERIOD = 1.0
+
+#: Knots per control period of a local controller's executed motion (the arc between knots is
+#: replaced by its chord: at most ``v w dt^2 / (8 SUBSTEPS^2)`` off, 0.001 cm for the paper's
+#: robot).
+SUBSTEPS = 5
 
 #: The strategies: the paper's contour detours, replanning the whole remaining path (baseline),
 #: or driving the static path blindly (baseline).
@@ -190,17 +206,34 @@ class SimulationResult:
 
 
 @dataclass(frozen=True)
-class _Robot:
-    """The robot as the simulation drives it (units, units/s, rad/s, s)."""
+class RobotModel:
+    """The robot as the simulation drives it (units, units/s, rad/s, s).
+
+    Attributes
+    ----------
+    speed : float
+        Top linear speed: the least of ``robot.speed``, ``max_speed`` and ``max_wheel_speed``.
+    turn_rate : float or None
+        Top turn rate in place, ``2 v_w / L`` (None without a track width: instantaneous turns).
+    sample_time, radius, sensor_range : float
+        The control period Ts, the safety radius SR and the sensor range.
+    wheel_speed : float
+        Top wheel speed ``v_w`` (``max_wheel_speed``, else ``speed``): a differential drive
+        needs ``|v| + |w| L / 2 <= v_w``.
+    track_width : float or None
+        ``L``.
+    """
 
     speed: float
     turn_rate: float | None
     sample_time: float
     radius: float
     sensor_range: float
+    wheel_speed: float = math.inf
+    track_width: float | None = None
 
     @classmethod
-    def of(cls, problem: Problem) -> _Robot:
+    def of(cls, problem: Problem) -> RobotModel:
         robot = problem.robot
         for key in ("speed", "sample_time", "sensor_range"):
             if getattr(robot, key) is None:
@@ -208,10 +241,12 @@ class _Robot:
         speed = min(
             v for v in (robot.speed, robot.max_speed, robot.max_wheel_speed) if v is not None
         )
+        wheel = robot.max_wheel_speed or robot.speed
         turn_rate = None
         if robot.track_width:
-            turn_rate = 2.0 * (robot.max_wheel_speed or robot.speed) / robot.track_width
-        return cls(speed, turn_rate, float(robot.sample_time), robot.radius, robot.sensor_range)
+            turn_rate = 2.0 * wheel / robot.track_width
+        return cls(speed, turn_rate, float(robot.sample_time), robot.radius, robot.sensor_range,
+                   float(wheel), robot.track_width or None)  # fmt: skip
 
 
 def simulate(
@@ -243,7 +278,7 @@ def simulate(
     SimulationResult
     """
     options = options or DynamicOptions()
-    robot = _Robot.of(problem)
+    robot = RobotModel.of(problem)
     radii = [m.radius for m in problem.moving_obstacles]
     margin = options.margin
     if margin is None:
@@ -276,6 +311,167 @@ def simulate(
     return result
 
 
+@dataclass(frozen=True)
+class RobotState:
+    """What a local controller knows of the robot at a control instant.
+
+    Attributes
+    ----------
+    xy : (2,) ndarray
+        Position, units.
+    theta : float
+        Heading, rad (unwrapped).
+    v, w : float
+        Linear (units/s, negative backwards) and angular (rad/s) velocity of the last period.
+    """
+
+    xy: np.ndarray
+    theta: float
+    v: float
+    w: float
+
+
+class LocalController(Protocol):
+    """A local planner that :func:`simulate_local` drives: every control period it gets the
+    robot's state and the sensed obstacles and returns the velocities for the next period.
+
+    ``name`` is what the result reports as its planner (its strategy in lower case).
+    """
+
+    name: str
+
+    def reset(self, xy: np.ndarray, theta: float) -> None:
+        """Start a new run at ``xy`` facing ``theta``."""
+
+    def step(self, state: RobotState, obstacles: Observations, t: float) -> tuple[float, float]:
+        """``(v, w)`` for the period from ``t``; ``obstacles`` as :func:`simulate` senses them
+        (index -> (position, velocity, radius), measured at ``t``)."""
+
+
+def simulate_local(
+    problem: Problem,
+    controller: LocalController,
+    reference_path: np.ndarray,
+    options: DynamicOptions | None = None,
+    seed: int | None = None,
+    progress: Callable[[float, float], None] | None = None,
+) -> SimulationResult:
+    """Drive the robot with a local controller among the problem's moving obstacles.
+
+    Every ``sample_time`` the robot senses as in :func:`simulate`, asks ``controller.step`` for
+    ``(v, w)`` and drives them for one period on an exact arc (knots every
+    ``sample_time / SUBSTEPS``). The plant saturates commands at the robot's limits (speed,
+    turn rate, ``|v| + |w| L / 2 <= v_w``). Within one period's travel (or SR/10) of the goal,
+    with the straight line free, it drives the last chord in. The executed motion's static
+    validity is checked exactly afterwards: unlike a planned path, a controller's arcs are not,
+    and the result's ``status`` says when the robot clipped a static obstacle.
+
+    Parameters
+    ----------
+    problem : Problem
+        As for :func:`simulate`.
+    controller : LocalController
+    reference_path : (n, 2) array
+        The path the controller follows (units): its first point is the start, its first
+        segment the initial heading, its length sets the time limit (``4 L / v + 60`` s unless
+        ``options.max_time``); fewer than two points report "no static path".
+    options : DynamicOptions, optional
+        Only ``max_time``, ``heading_changes`` and ``heading_change_deg`` are used (the same
+        obstacles and the same random turns as :func:`simulate` with the same seed).
+    seed : int, optional
+        Seeds the obstacles' random heading changes exactly as :func:`simulate` does.
+    progress : callable, optional
+        Called as ``progress(t, t_max)`` after every step.
+
+    Returns
+    -------
+    SimulationResult
+        ``planner`` is ``controller.name``, ``strategy`` its lower case; no replans.
+    """
+    options = options or DynamicOptions()
+    robot = RobotModel.of(problem)
+    name = str(controller.name)
+    opts = dataclasses.replace(options, strategy="none", planner=name)
+    path = np.asarray(reference_path, dtype=float).reshape(-1, 2)
+    tracks = [ObstacleTrack.from_obstacle(m) for m in problem.moving_obstacles]
+    blocked = _blocked(problem, tracks, robot) if len(path) >= 2 else "no static path"
+    if blocked:
+        result = _no_static_path(problem, opts, seed, robot, path, tracks, blocked)
+    else:
+        _, world_rng = np.random.default_rng(seed).spawn(2)
+        t_max = options.max_time
+        if t_max is None:
+            t_max = 4.0 * path_length(path) / robot.speed + 60.0
+        _check_steps(t_max, robot.sample_time)
+        world = World.from_problem(problem)
+        motion, reached = _drive_local(problem, controller, robot, world, path, tracks, options,
+                                       t_max, world_rng, progress)  # fmt: skip
+        # The driven motion is the only "plan" a local controller has (the animation draws it).
+        result = _measure(problem, opts, seed, robot, motion, reached, path, tracks, [],
+                          [(0.0, motion)])  # fmt: skip
+        free = world.segments_free(motion.xy[:-1], motion.xy[1:])
+        if not (free.all() and world.points_in_bounds(motion.xy).all()):
+            result.status = "clipped a static obstacle or left the bounds"
+    result.strategy = name.lower()
+    return result
+
+
+def _drive_local(problem, controller, robot, world, path, tracks, options, t_max, world_rng,
+                 progress) -> tuple[Motion, bool]:  # fmt: skip
+    """The control loop of :func:`simulate_local`: the executed motion and whether it arrived."""
+    dt = robot.sample_time
+    goal = np.asarray(problem.goal, dtype=float)
+    x = path[0].copy()
+    th = math.atan2(path[1, 1] - path[0, 1], path[1, 0] - path[0, 0])
+    controller.reset(x.copy(), th)
+    v = w = 0.0
+    ts, xs, ths = [0.0], [x.copy()], [th]
+    change_p = options.heading_changes * dt
+    tol = goal_tolerance(robot)
+    taus = dt * np.arange(1, SUBSTEPS + 1) / SUBSTEPS
+    k = 0
+    while k * dt <= t_max and k < MAX_STEPS:
+        t = k * dt
+        d = math.dist(x, goal)
+        if d <= tol and world.motion_free(*x, *goal):
+            ts.append(t + d / robot.speed)
+            xs.append(goal.copy())
+            ths.append(th)
+            return Motion(np.array(ts), np.array(xs), np.array(ths)), True
+        obs = _sense(x, tracks, t, robot.sensor_range)
+        v, w = _saturate(robot, *controller.step(RobotState(x.copy(), th, v, w), obs, t))
+        xs.extend(arc_position(x, th, v, w, taus))
+        ths.extend(th + w * taus)
+        ts.extend(t + taus)
+        x, th = xs[-1].copy(), float(ths[-1])
+        k += 1
+        if change_p > 0:
+            _turn_at_random(tracks, k * dt, change_p, options.heading_change_deg, world_rng)
+        if progress is not None:
+            progress(k * dt, t_max)
+    return Motion(np.array(ts), np.array(xs), np.array(ths)), False
+
+
+def goal_tolerance(robot: RobotModel) -> float:
+    """How near the goal a local controller's robot must be at a control instant for
+    :func:`simulate_local` to drive the last chord in: one period's travel, at least SR/10."""
+    return max(robot.speed * robot.sample_time, 0.1 * robot.radius)
+
+
+def _saturate(robot: RobotModel, v: float, w: float) -> tuple[float, float]:
+    """The command the wheels can drive: speed and turn rate clipped, then both scaled down
+    until ``|v| + |w| L / 2 <= v_w``."""
+    if not (math.isfinite(v) and math.isfinite(w)):
+        raise SimulationError(f"the local controller commanded v = {v}, w = {w}")
+    v = min(max(v, -robot.speed), robot.speed)
+    if robot.turn_rate is not None:
+        w = min(max(w, -robot.turn_rate), robot.turn_rate)
+        need = abs(v) + abs(w) * 0.5 * (robot.track_width or 0.0)
+        if need > robot.wheel_speed:
+            v, w = v * robot.wheel_speed / need, w * robot.wheel_speed / need
+    return v, w
+
+
 def _check_steps(t_max: float, sample_time: float) -> None:
     """Refuse a run that would take more than MAX_STEPS control steps."""
     steps = t_max / sample_time
@@ -287,7 +483,7 @@ def _check_steps(t_max: float, sample_time: float) -> None:
         )
 
 
-def _blocked(problem: Problem, tracks: list[ObstacleTrack], robot: _Robot) -> str:
+def _blocked(problem: Problem, tracks: list[ObstacleTrack], robot: RobotModel) -> str:
     """Why the robot cannot set off: an obstacle on its start at t = 0, or one that never moves
     on its goal (empty when neither)."""
     for j, tr in enumerate(tracks):
