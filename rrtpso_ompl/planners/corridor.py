@@ -50,6 +50,11 @@ BAND_CELLS = 3.0
 #: Lattice cells per second a map's cells are marked free or not (array work over the whole
 #: lattice; the search itself stays in the band), on the safe side.
 MARK_CELLS_PER_SECOND = 8_000_000
+#: Lattice cells of a map routed (with alternatives) and funnelled whole per second, on the safe
+#: side (measured 1.0-1.3 million on 256 x 256 mazes and random maps). A map whose lattice fits
+#: in the time left at this rate is searched whole: pooling its cells into a coarse lattice opens
+#: gaps through walls one cell thick, and the coarse routes then miss a maze's only corridor.
+DIRECT_CELLS_PER_SECOND = 1_200_000
 #: Among shapes, fine cells per coarse cell side in the bands.
 SHAPE_SPLIT = 4
 
@@ -70,6 +75,7 @@ __all__ = [
     "BAND_CELLS",
     "CELLS_PER_SECOND",
     "CENTRE_ROUTE_ROUNDS",
+    "DIRECT_CELLS_PER_SECOND",
     "SHAPE_SPLIT",
     "CorridorResult",
     "alternative_routes",
@@ -674,7 +680,7 @@ def search(
         if getattr(model, "raster", None) is not None:
             fine_cells = int(min(max_cells, max(0.4 * MARK_CELLS_PER_SECOND * left(), 4096)))
             result = _map_corridors(model, fine_cells, route_cells, start, goal, alternatives,
-                                    out_of_time, t0, stages)  # fmt: skip
+                                    out_of_time, t0, stages, left)  # fmt: skip
         else:
             result = _shape_corridors(model, route_cells, max_cells, start, goal, alternatives,
                                       out_of_time, t0, stages)  # fmt: skip
@@ -692,8 +698,11 @@ def search(
 
 
 def _map_corridors(model, fine_cells, route_cells, start, goal, alternatives, terminate, t0,
-                   stages) -> CorridorResult:  # fmt: skip
-    """:func:`search` on a map: the fine cells marked once, pooled into the coarse lattice."""
+                   stages, left) -> CorridorResult:  # fmt: skip
+    """:func:`search` on a map: the fine cells marked once, searched whole when the time
+    ``left()`` affords it (:data:`DIRECT_CELLS_PER_SECOND`), else pooled into a coarse lattice;
+    when no coarse corridor holds a fine route, the whole fine lattice without alternatives if
+    it still fits."""
     fine = model.lattice(fine_cells)
     if fine.nx < 2 or fine.ny < 2:
         return CorridorResult(None, reason="the lattice is too small")
@@ -701,9 +710,21 @@ def _map_corridors(model, fine_cells, route_cells, start, goal, alternatives, te
     stages["cells"] = time.perf_counter() - t0
     k = max(1, math.ceil(math.sqrt(fine.n_cells / route_cells)))
     nx, ny = fine.nx // k, fine.ny // k
-    if k == 1 or nx < 2 or ny < 2:
+    if k == 1 or nx < 2 or ny < 2 or fine.n_cells <= DIRECT_CELLS_PER_SECOND * left():
         return _route_and_funnel(model, fine, free, start, goal, alternatives, terminate, t0,
                                  stages)  # fmt: skip
+    result = _pooled_corridors(model, fine, free, k, start, goal, alternatives, terminate, t0,
+                               stages)  # fmt: skip
+    if result.path is None and fine.n_cells <= DIRECT_CELLS_PER_SECOND * left():
+        return _route_and_funnel(model, fine, free, start, goal, 0, terminate, t0, stages)
+    return result
+
+
+def _pooled_corridors(model, fine, free, k, start, goal, alternatives, terminate, t0,
+                      stages) -> CorridorResult:  # fmt: skip
+    """Corridors on the coarse lattice pooling ``k`` x ``k`` fine cells (open when any is wholly
+    free: no passage of the fine lattice is closed), each searched again on the fine cells."""
+    nx, ny = fine.nx // k, fine.ny // k
     pooled = free[: nx * k, : ny * k].reshape(nx, k, ny, k).any(axis=(1, 3))
     coarse = Lattice(fine.origin, fine.h * k, nx, ny)
 
