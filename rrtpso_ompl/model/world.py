@@ -191,6 +191,8 @@ class World:
         cells when the world has one (a map cell split in at most ``split`` per side), else
         square cells centred in the bounds."""
         if self.raster is not None:
+            if self.robot_radius <= 0.0 and not self._non_raster.n_obstacles:
+                split = 1  # a point robot's free space is a union of map cells: finer adds nothing
             return self.raster.lattice(self.bounds, max_cells, split)
         (xmin, ymin), (xmax, ymax) = self.bounds
         h = math.sqrt((xmax - xmin) * (ymax - ymin) / max(max_cells, 1))
