@@ -324,15 +324,9 @@ class RRTstarPSO(PythonPlanner):
                 stats.corridor_reason = "the validity checker is too slow for a lattice"
                 return None
         t1 = time.perf_counter()
-        result = search(self._model, start, goal, seconds, cells, ptc,
-                        v["corridor_alternatives"])  # fmt: skip
-        if result.path is None and seconds is not None and not ptc():
-            # No route at all: there is nothing for the later stages to refine, so a finer try
-            # may take more of the budget.
-            more = t0 + _CORRIDOR_NO_ROUTE_SHARE * budget - time.perf_counter()
-            if more > 2.0 * result.time:
-                result = search(self._model, start, goal, more, cells, ptc,
-                                v["corridor_alternatives"])  # fmt: skip
+        more = None if seconds is None else t0 + _CORRIDOR_NO_ROUTE_SHARE * budget - t1
+        result = search(self._model, start, goal, seconds, cells, ptc, v["corridor_alternatives"],
+                        no_route_seconds=more)  # fmt: skip
         stats.corridor_time = time.perf_counter() - t1
         stats.corridor_cells = result.lattice.n_cells if result.lattice else 0
         stats.corridor_routes = result.routes
