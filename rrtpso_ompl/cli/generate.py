@@ -85,12 +85,16 @@ def _value(value: Any) -> str:
 
 def run(args: argparse.Namespace) -> int:
     from ..groundtruth import generate_to_file
+    from ..groundtruth.generate import GENERATORS
 
     check_seed_flag(args.seed)
     options = {k: getattr(args, k) for k in _options() if getattr(args, k) is not None}
-    check_outputs([Output("--out", args.out)])
-    if os.path.lexists(args.out) and not args.overwrite and not is_stream(args.out):
-        raise UsageError(f"--out: '{args.out}' exists; pass --overwrite to replace it")
+    # A map kind writes the map beside the problem (<stem>_map.yaml and .pgm): each is checked.
+    paths = GENERATORS[args.kind].output_paths(args.out) if args.out != "-" else [args.out]
+    check_outputs([Output("--out", str(p)) for p in paths])
+    for p in paths:
+        if os.path.lexists(p) and not args.overwrite and not is_stream(p):
+            raise UsageError(f"--out: '{p}' exists; pass --overwrite to replace it")
     try:
         path = generate_to_file(args.kind, args.seed, args.out, **options)
     except (GenerationError, ValueError) as exc:
