@@ -64,10 +64,15 @@ TUNING_SEEDS = (1, 2, 3)
 REPORT_SEEDS = (101, 102, 103)
 #: The part of problems/ the defaults were tuned on; the rest is for reporting.
 TUNING_FILES = (
-    "static/paper_static.yaml", "static/single_circle.yaml", "static/narrow_passage.yaml",
-    "static/cluttered_circles.yaml", "static/polygon_map.yaml", "static/dense_circles.yaml",
-    "static/maze.yaml", "static/bug_trap.yaml",
-)  # fmt: skip
+    "static/paper_static.yaml",
+    "static/single_circle.yaml",
+    "static/narrow_passage.yaml",
+    "static/cluttered_circles.yaml",
+    "static/polygon_map.yaml",
+    "static/dense_circles.yaml",
+    "static/maze.yaml",
+    "static/bug_trap.yaml",
+)
 PLANNERS = ("RRTstarPSO", "BITstar+simplify", "BITstar+simplify+pso")
 
 
@@ -110,14 +115,29 @@ def run_one(path: Path, planner: str, budget: float, seed: int, params: dict) ->
             set_ompl_log_level(0)
             problem = load_problem(path)
             world = World.from_problem(problem)
-            res = solve(problem, planner, time_limit=budget, seed=seed,
-                        params=params if planner == "RRTstarPSO" else None, world=world)  # fmt: skip
+            res = solve(
+                problem,
+                planner,
+                time_limit=budget,
+                seed=seed,
+                params=params if planner == "RRTstarPSO" else None,
+                world=world,
+            )
             valid = bool(res.solved and world.path_valid(__import__("numpy").array(res.path)))
-            row = {"solved": bool(res.solved), "valid": valid, "length": res.length,
-                   "time": res.time}  # fmt: skip
+            row = {
+                "solved": bool(res.solved),
+                "valid": valid,
+                "length": res.length,
+                "time": res.time,
+            }
         except Exception as exc:  # a failed run is a row, not the end of the benchmark
-            row = {"solved": False, "valid": False, "length": None, "time": None,
-                   "error": f"{type(exc).__name__}: {exc}"}  # fmt: skip
+            row = {
+                "solved": False,
+                "valid": False,
+                "length": None,
+                "time": None,
+                "error": f"{type(exc).__name__}: {exc}",
+            }
         os.write(w, json.dumps(row).encode())
         os._exit(0)
     os.close(w)
@@ -141,8 +161,11 @@ def summary(rows: list[dict], budget: float, planners) -> tuple[list[list], list
     for fam in families:
         cells, stats = [], {}
         for planner in planners:
-            mine = [r for r in rows if (r["family"], r["planner"], r["budget"]) ==
-                    (fam, planner, budget)]  # fmt: skip
+            mine = [
+                r
+                for r in rows
+                if (r["family"], r["planner"], r["budget"]) == (fam, planner, budget)
+            ]
             vals = [r["ratio"] for r in mine if r.get("ratio") is not None]
             miss = len(mine) - len(vals)
             if not vals:
@@ -153,12 +176,26 @@ def summary(rows: list[dict], budget: float, planners) -> tuple[list[list], list
             stats[planner] = (med, p90, miss)
             cells.append(f"{med:.4f} ({p90:.4f})" + (f", {miss} unsolved" if miss else ""))
         ours = stats.get("RRTstarPSO")
-        worse = [p for p, s in stats.items() if p != "RRTstarPSO" and ours and
-                 (ours[2] > s[2] or ours[0] > s[0] + 1e-4 or ours[1] > s[1] + 1e-4)]  # fmt: skip
+        worse = [
+            p
+            for p, s in stats.items()
+            if p != "RRTstarPSO"
+            and ours
+            and (ours[2] > s[2] or ours[0] > s[0] + 1e-4 or ours[1] > s[1] + 1e-4)
+        ]
         if worse:
             behind.append(f"{fam} ({', '.join(worse)})")
-        overrun = max((r["time"] / budget for r in rows if r["family"] == fam and r["budget"] ==
-                       budget and r["planner"] == "RRTstarPSO" and r.get("time")), default=0.0)  # fmt: skip
+        overrun = max(
+            (
+                r["time"] / budget
+                for r in rows
+                if r["family"] == fam
+                and r["budget"] == budget
+                and r["planner"] == "RRTstarPSO"
+                and r.get("time")
+            ),
+            default=0.0,
+        )
         table.append([fam, *cells, f"{overrun:.3f}"])
     return table, behind
 
@@ -182,10 +219,16 @@ def report(rows: list[dict], args, seeds, planners) -> str:
     invalid = [r for r in rows if r.get("solved") and not r.get("valid")]
     for budget in args.time:
         table, behind = summary(rows, budget, planners)
-        lines += ["", f"## {budget:g} s", "",
-                  markdown_table(["family", *planners, "deadline"], table), "",
-                  "RRTstarPSO behind in median, 90th percentile or solved runs: "
-                  + ("; ".join(behind) if behind else "nowhere") + "."]  # fmt: skip
+        lines += [
+            "",
+            f"## {budget:g} s",
+            "",
+            markdown_table(["family", *planners, "deadline"], table),
+            "",
+            "RRTstarPSO behind in median, 90th percentile or solved runs: "
+            + ("; ".join(behind) if behind else "nowhere")
+            + ".",
+        ]
     lines += ["", f"Invalid paths: {len(invalid)}."]
     errors = [r for r in rows if r.get("error")]
     lines += [f"Failed runs: {len(errors)}."] + [
@@ -208,12 +251,11 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     args.argv = sys.argv[1:] if argv is None else argv
 
-    from rrtpso_ompl.groundtruth import shortest_path
-    from rrtpso_ompl.model import World, load_problem
-
     # Loaded once here, used only in the children: importing OMPL starts no random stream, so
     # each forked run still seeds its own (docs: "forking after OMPL was used").
     import rrtpso_ompl.planners  # noqa: F401
+    from rrtpso_ompl.groundtruth import shortest_path
+    from rrtpso_ompl.model import World, load_problem
 
     params = dict(p.split("=", 1) for p in args.param)
     planners = args.planners.split(",")
@@ -229,9 +271,15 @@ def main(argv: list[str] | None = None) -> int:
                     for run in args.runs:
                         row = run_one(path, planner, budget, run, params)
                         length = row.get("length")
-                        row.update(family=family, file=path.name, planner=planner,
-                                   budget=budget, seed=run, optimum=best,
-                                   ratio=length / best if row["valid"] and best else None)  # fmt: skip
+                        row.update(
+                            family=family,
+                            file=path.name,
+                            planner=planner,
+                            budget=budget,
+                            seed=run,
+                            optimum=best,
+                            ratio=length / best if row["valid"] and best else None,
+                        )
                         rows.append(row)
             print(f"{path.name} done ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
     if args.rows:
