@@ -48,16 +48,18 @@ SHAPE_FAMILIES = {
     "spiral": ("spiral", {}),
     "rooms": ("rooms", {}),
 }
-#: Generated occupancy-grid map families (ROS map_server YAML + PGM), two queries per map.
+#: Generated occupancy-grid map families (ROS map_server YAML + PGM), two queries per map. Mazes,
+#: random fields, caves and cities with a point robot on the grid, as MovingAI's grid benchmarks
+#: pose them; rooms, warehouses and wide mazes with the generator's robot (a quarter cell).
 MAP_FAMILIES = {
     "rooms_map": ("rooms_map", {"cells": 128}),
-    "maze_map_c1": ("maze_map", {"cells": 128, "corridor": 1, "wall_cells": 1}),
-    "maze_map_c2": ("maze_map", {"cells": 128, "corridor": 2, "wall_cells": 1, "loops": 0.1}),
+    "maze_map_c1": ("maze_map", {"cells": 128, "corridor": 1, "wall_cells": 1, "robot_radius": 0}),
+    "maze_map_c2": ("maze_map", {"cells": 128, "corridor": 2, "loops": 0.1, "robot_radius": 0}),
     "maze_map_c4_256": ("maze_map", {"cells": 256, "corridor": 4, "wall_cells": 2}),
-    "city_map_256": ("city_map", {"cells": 256}),
+    "city_map_256": ("city_map", {"cells": 256, "robot_radius": 0}),
     "warehouse_map": ("warehouse_map", {"cells": 128}),
-    "caves_map": ("caves_map", {"cells": 128}),
-    "random_map_256": ("random_map", {"cells": 256, "density": 0.3}),
+    "caves_map": ("caves_map", {"cells": 128, "robot_radius": 0}),
+    "random_map_256": ("random_map", {"cells": 256, "density": 0.3, "robot_radius": 0}),
 }
 QUERIES = (0, 1)
 TUNING_SEEDS = (1, 2, 3)
