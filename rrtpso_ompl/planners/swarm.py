@@ -165,38 +165,25 @@ def minimize(
     lower = np.asarray(lower, dtype=float)
     upper = np.asarray(upper, dtype=float)
     dims = lower.shape[0]
-    n = options.swarm_size
     if blocks < 1 or dims % blocks:
         raise ValueError(f"blocks must divide the {dims} dimensions, got {blocks}")
-    if init is None:
-        x = rng.uniform(lower, upper, size=(n, dims))
-    else:
-        x = np.clip(np.asarray(init, dtype=float).reshape(n, dims), lower, upper)
-    v = np.zeros((n, dims)) if init_velocity is None else np.asarray(init_velocity, float).copy()
     if v_max is not None and not v_max > 0:
         raise ValueError(f"v_max must be > 0 or None, got {v_max}")
-    k_blocks, width = blocks, dims // blocks
-    cols = np.arange(k_blocks)
+    x, v = _initial_swarm(lower, upper, options.swarm_size, rng, init, init_velocity)
 
     def evaluate(pos: np.ndarray) -> np.ndarray:
-        return np.asarray(cost(pos), dtype=float).reshape(len(pos), k_blocks)
-
-    def block_view(a: np.ndarray) -> np.ndarray:
-        return a.reshape(a.shape[0], k_blocks, width)
+        return np.asarray(cost(pos), dtype=float).reshape(len(pos), blocks)
 
     t_eval = time.perf_counter()
     cut = False
     if deadline is None:
         f = evaluate(x)
     else:
-        f, cut = _first_costs(evaluate, x, deadline, k_blocks)
+        f, cut = _first_costs(evaluate, x, deadline, blocks)
     t_eval = time.perf_counter() - t_eval
-    pbest_x, pbest_f = x.copy(), f.copy()
-    g = np.argmin(pbest_f, axis=0)
-    gbest_x = block_view(pbest_x)[g, cols].reshape(dims)  # a copy (fancy indexing)
-    gbest_f = pbest_f[g, cols].copy()
-    history = [float(gbest_f.sum())]
-    n_eval = n
+    best = _Bests.start(x, f, blocks)
+    history = [best.cost]
+    n_eval = len(x)
     w = options.w
     stopped_by = "deadline" if cut else "iterations"
     for k in range(1, 0 if cut else options.iterations + 1):
@@ -206,45 +193,103 @@ def minimize(
         if deadline is not None and time.perf_counter() + t_eval > deadline:
             stopped_by = "deadline"
             break
-        r1 = rng.random((n, dims))
-        r2 = rng.random((n, dims))
-        v = w * v + options.c1 * r1 * (pbest_x - x) + options.c2 * r2 * (gbest_x - x)  # eq. 4
-        if v_max is not None:
-            np.clip(v, -v_max, v_max, out=v)
-        x = x + v  # eq. 5
-        out = (x < lower) | (x > upper)
-        if out.any():
-            np.clip(x, lower, upper, out=x)
-            v[out] = 0.0  # a particle stopped by the wall keeps no momentum into it
+        x, v = _move(x, v, best, w, options, rng, lower, upper, v_max)
         t_eval = time.perf_counter()
         f = evaluate(x)
         t_eval = time.perf_counter() - t_eval
-        n_eval += n
-        better = f < pbest_f
-        pbest_f[better] = f[better]
-        block_view(pbest_x)[better] = block_view(x)[better]
-        g = np.argmin(pbest_f, axis=0)
-        improved = pbest_f[g, cols] < gbest_f
-        if improved.any():
-            gb = gbest_x.reshape(k_blocks, width)
-            gb[improved] = block_view(pbest_x)[g[improved], cols[improved]]
-            gbest_f[improved] = pbest_f[g[improved], cols[improved]]
-        history.append(float(gbest_f.sum()))
+        n_eval += len(x)
+        best.update(x, f)
+        history.append(best.cost)
         w *= options.w_damping
-        if options.tolerance > 0 and k >= options.patience:
-            old = history[-1 - options.patience]
-            if old - history[-1] <= options.tolerance * max(abs(old), 1e-300):
-                stopped_by = "tolerance"
-                break
+        if _converged(history, options, k):
+            stopped_by = "tolerance"
+            break
     return PSOResult(
-        position=gbest_x,
-        cost=float(gbest_f.sum()),
+        position=best.gbest_x,
+        cost=best.cost,
         history=np.asarray(history),
         n_iterations=len(history) - 1,
         n_evaluations=n_eval,
         time=time.perf_counter() - t0,
         stopped_by=stopped_by,
     )
+
+
+def _initial_swarm(lower, upper, n: int, rng, init, init_velocity):
+    """Positions (``init`` clipped to the box, or uniform in it) and velocities (``init_velocity``
+    or zero) of ``n`` particles."""
+    dims = lower.shape[0]
+    if init is None:
+        x = rng.uniform(lower, upper, size=(n, dims))
+    else:
+        x = np.clip(np.asarray(init, dtype=float).reshape(n, dims), lower, upper)
+    v = np.zeros((n, dims)) if init_velocity is None else np.asarray(init_velocity, float).copy()
+    return x, v
+
+
+def _move(x, v, best: _Bests, w: float, options: PSOOptions, rng, lower, upper, v_max):
+    """One step of every particle: eqs. 4-5, the velocity clamped to ``v_max``, positions clipped
+    to the box (a particle stopped by the wall keeps no momentum into it)."""
+    n, dims = x.shape
+    r1 = rng.random((n, dims))
+    r2 = rng.random((n, dims))
+    v = w * v + options.c1 * r1 * (best.pbest_x - x) + options.c2 * r2 * (best.gbest_x - x)  # eq. 4
+    if v_max is not None:
+        np.clip(v, -v_max, v_max, out=v)
+    x = x + v  # eq. 5
+    out = (x < lower) | (x > upper)
+    if out.any():
+        np.clip(x, lower, upper, out=x)
+        v[out] = 0.0
+    return x, v
+
+
+def _converged(history: list[float], options: PSOOptions, k: int) -> bool:
+    """Whether the best cost fell by at most ``tolerance`` (relative) over ``patience`` steps."""
+    if options.tolerance <= 0 or k < options.patience:
+        return False
+    old = history[-1 - options.patience]
+    return old - history[-1] <= options.tolerance * max(abs(old), 1e-300)
+
+
+@dataclass
+class _Bests:
+    """Each particle's best position and costs per block, and the swarm's best per block (the
+    blocks are independent: each takes its best coordinates from whichever particle has them)."""
+
+    pbest_x: np.ndarray
+    pbest_f: np.ndarray
+    gbest_x: np.ndarray
+    gbest_f: np.ndarray
+
+    @classmethod
+    def start(cls, x: np.ndarray, f: np.ndarray, blocks: int) -> _Bests:
+        cols = np.arange(blocks)
+        g = np.argmin(f, axis=0)
+        gbest_x = _by_block(x, blocks)[g, cols].reshape(x.shape[1])  # a copy (fancy indexing)
+        return cls(x.copy(), f.copy(), gbest_x, f[g, cols].copy())
+
+    @property
+    def cost(self) -> float:
+        return float(self.gbest_f.sum())
+
+    def update(self, x: np.ndarray, f: np.ndarray) -> None:
+        blocks = f.shape[1]
+        cols = np.arange(blocks)
+        better = f < self.pbest_f
+        self.pbest_f[better] = f[better]
+        _by_block(self.pbest_x, blocks)[better] = _by_block(x, blocks)[better]
+        g = np.argmin(self.pbest_f, axis=0)
+        improved = self.pbest_f[g, cols] < self.gbest_f
+        if improved.any():
+            gb = self.gbest_x.reshape(blocks, -1)
+            gb[improved] = _by_block(self.pbest_x, blocks)[g[improved], cols[improved]]
+            self.gbest_f[improved] = self.pbest_f[g[improved], cols[improved]]
+
+
+def _by_block(a: np.ndarray, blocks: int) -> np.ndarray:
+    """``(n, dims)`` viewed as ``(n, blocks, dims / blocks)``."""
+    return a.reshape(a.shape[0], blocks, -1)
 
 
 #: Particles evaluated at a time in the first evaluation of a swarm with a deadline.
