@@ -343,6 +343,35 @@ def _windows(n_interior: int, width: int, offset: int) -> np.ndarray:
     return out
 
 
+def _window_boxes(seed_path: np.ndarray, world, options: PathOptimizerOptions, offset: int):
+    """The windows of one round (:func:`_windows`, ``-1`` for an empty slot) and what their
+    swarm needs: each slot's waypoint index (an empty slot's: the closing fixed one), the search box of each slot ``(K, W, 2)`` (an empty
+    slot's box is its window's closing fixed waypoint), the fixed waypoints before and after
+    each window, the seed's segment lengths and the violation measure, culled to the boxes of
+    the windows' segments."""
+    width = options.window
+    win = _windows(len(seed_path) - 2, width, offset)
+    real = win >= 0
+    # Each window's closing fixed waypoint: after its last real slot.
+    last = win.max(axis=1)
+    first = win[:, 0]
+    slot_idx = np.where(real, win, last[:, None] + 1)  # empty slots sit on the closing point
+    lo_all, hi_all, seg_len = _search_boxes(seed_path, world, options.box_fraction)
+    lo_pts = np.vstack([seed_path[:1], lo_all, seed_path[-1:]])
+    hi_pts = np.vstack([seed_path[:1], hi_all, seed_path[-1:]])
+    lo = np.where(real[..., None], lo_pts[slot_idx], seed_path[slot_idx])  # (K, W, 2)
+    hi = np.where(real[..., None], hi_pts[slot_idx], seed_path[slot_idx])
+    before, after = seed_path[first - 1], seed_path[last + 1]  # (K, 2)
+    chain_lo = np.concatenate([before[:, None], lo, after[:, None]], axis=1)  # (K, W + 2, 2)
+    chain_hi = np.concatenate([before[:, None], hi, after[:, None]], axis=1)
+    # Segment boxes of every chain, for the culled exact check.
+    seg_lo = np.minimum(chain_lo[:, :-1], chain_lo[:, 1:]).reshape(-1, 2)
+    seg_hi = np.maximum(chain_hi[:, :-1], chain_hi[:, 1:]).reshape(-1, 2)
+    violation = (world.local_model(seg_lo, seg_hi).violation if hasattr(world, "local_model")
+                 else world.segment_violation)  # fmt: skip
+    return win, slot_idx, lo, hi, before, after, seg_len, violation
+
+
 def _window_round(
     seed_path: np.ndarray,
     cost_model: PathCost,
@@ -363,26 +392,11 @@ def _window_round(
     """
     world = cost_model.world
     width = options.window
-    win = _windows(len(seed_path) - 2, width, offset)
-    n_win = len(win)
+    win, slot_idx, lo, hi, before, after, seg_len, violation = _window_boxes(
+        seed_path, world, options, offset
+    )
     real = win >= 0
-    # Each window's closing fixed waypoint: after its last real slot.
-    last = np.where(real, win, -1).max(axis=1)
-    first = win[:, 0]
-    slot_idx = np.where(real, win, last[:, None] + 1)  # empty slots sit on the closing point
-    lo_all, hi_all, seg_len = _search_boxes(seed_path, world, options.box_fraction)
-    lo_pts = np.vstack([seed_path[:1], lo_all, seed_path[-1:]])
-    hi_pts = np.vstack([seed_path[:1], hi_all, seed_path[-1:]])
-    lo = np.where(real[..., None], lo_pts[slot_idx], seed_path[slot_idx])  # (K, W, 2)
-    hi = np.where(real[..., None], hi_pts[slot_idx], seed_path[slot_idx])
-    before, after = seed_path[first - 1], seed_path[last + 1]  # (K, 2)
-    chain_lo = np.concatenate([before[:, None], lo, after[:, None]], axis=1)  # (K, W + 2, 2)
-    chain_hi = np.concatenate([before[:, None], hi, after[:, None]], axis=1)
-    # Segment boxes of every chain, for the culled exact check.
-    seg_lo = np.minimum(chain_lo[:, :-1], chain_lo[:, 1:]).reshape(-1, 2)
-    seg_hi = np.maximum(chain_hi[:, :-1], chain_hi[:, 1:]).reshape(-1, 2)
-    violation = (world.local_model(seg_lo, seg_hi).violation if hasattr(world, "local_model")
-                 else world.segment_violation)  # fmt: skip
+    n_win = len(win)
 
     def chains(x: np.ndarray) -> np.ndarray:
         n = x.shape[0]
