@@ -345,10 +345,10 @@ def _windows(n_interior: int, width: int, offset: int) -> np.ndarray:
 
 def _window_boxes(seed_path: np.ndarray, world, options: PathOptimizerOptions, offset: int):
     """The windows of one round (:func:`_windows`, ``-1`` for an empty slot) and what their
-    swarm needs: each slot's waypoint index (an empty slot's: the closing fixed one), the search box of each slot ``(K, W, 2)`` (an empty
-    slot's box is its window's closing fixed waypoint), the fixed waypoints before and after
-    each window, the seed's segment lengths and the violation measure, culled to the boxes of
-    the windows' segments."""
+    swarm needs: each slot's waypoint index (an empty slot's: its window's closing fixed
+    waypoint), the search box of each slot ``(K, W, 2)`` (an empty slot's is that waypoint),
+    the fixed waypoints before and after each window, the seed's segment lengths and the
+    violation measure, culled to the boxes of the windows' segments."""
     width = options.window
     win = _windows(len(seed_path) - 2, width, offset)
     real = win >= 0
