@@ -108,19 +108,13 @@ def test_a_one_cell_maze_gives_the_exact_shortest_path():
     start, goal = (1.5, 5.5), (5.5, 1.5)  # top-left corridor to bottom-right
     res = corridor_path(world, start, goal, 10_000)
     assert res.path is not None and world.path_valid(res.path)
-    # the exact answer, by hand: start -> (5, 5) -> (5, 4)... corners of the walls
-    from rrtpso_ompl.evaluation import shortest_path
-    from rrtpso_ompl.model.problem import problem_from_dict
-
-    # compare with the exact optimum of the same world
-    exact = _optimum(world, start, goal)
+    exact = _optimum(world, start, goal)  # the exact optimum of the same world
     assert res.length == pytest.approx(exact, rel=1e-4)
     assert res.length >= exact * (1 - 1e-9)
-    del shortest_path, problem_from_dict
 
 
 def _optimum(world: World, start, goal) -> float:
-    from rrtpso_ompl.evaluation.optimum import shortest_path
+    from rrtpso_ompl.groundtruth.optimum import shortest_path
 
     class P:  # the few fields shortest_path reads
         pass
