@@ -58,6 +58,9 @@ DIRECT_CELLS_PER_SECOND = 1_200_000
 #: Lattice cells per second :func:`centre_route` builds and routes over among shapes, on the
 #: safe side (measured 0.6-1 million among 10,000 circles).
 CENTRE_CELLS_PER_SECOND = 600_000
+#: Among shapes, the share of the stage's time for the bands of wholly free cells; the rest is
+#: kept for :func:`centre_route` in case they hold no route.
+SHAPE_BAND_SHARE = 0.5
 #: Among shapes, fine cells per coarse cell side in the bands.
 SHAPE_SPLIT = 4
 
@@ -80,6 +83,7 @@ __all__ = [
     "CENTRE_CELLS_PER_SECOND",
     "CENTRE_ROUTE_ROUNDS",
     "DIRECT_CELLS_PER_SECOND",
+    "SHAPE_BAND_SHARE",
     "SHAPE_SPLIT",
     "CorridorResult",
     "alternative_routes",
@@ -688,8 +692,9 @@ def search(
     route_cells = int(min(max_cells, max(CELLS_PER_SECOND * left() / 3.0, 1024)))
     on_map = getattr(model, "raster", None) is not None
     # Among shapes the wholly free cells may miss gaps narrower than a cell (a dense field of
-    # circles): half the time is kept for the route through free cell centres.
-    first = out_of_time if on_map or end is None else _Deadline(t0 + 0.5 * seconds, terminate)
+    # circles): time is kept for the route through free cell centres.
+    first = (out_of_time if on_map or end is None
+             else _Deadline(t0 + SHAPE_BAND_SHARE * seconds, terminate))  # fmt: skip
     while True:
         t1 = time.perf_counter()
         if on_map:
