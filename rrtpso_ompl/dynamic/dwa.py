@@ -46,31 +46,34 @@ path, not by replanning it. :class:`DWAController` is that planner, built as Nav
 
 Everything is vectorised over samples, horizon steps and obstacles (the static checks through
 the :class:`~rrtpso_ompl.model.world.World`'s spatial index). :func:`simulate_dwa` runs it in
-:func:`~rrtpso_ompl.dynamic.simulation.simulate_local`, the harness of every local controller.
+:func:`~rrtpso_ompl.dynamic.local.simulate_local`, the harness of every local controller.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass, fields
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..model.geometry import cumulative_length, point_segment_distance, wrap_angle
 from ..model.problem import PlannerConfig, Problem
 from ..model.world import World
-from .manager import Observations
+from .dwa_params import DWAParams
+from .local import simulate_local
 from .motion import arc_position
 from .navgrid import NavGrid
-from .simulation import (
+from .options import (
     DynamicOptions,
+    Observations,
     RobotModel,
     RobotState,
-    SimulationResult,
+    default_margin,
     goal_tolerance,
-    simulate_local,
 )
+from .result import SimulationResult
 
 __all__ = ["DWAController", "DWAParams", "guide_path", "simulate_dwa"]
 
@@ -79,91 +82,13 @@ __all__ = ["DWAController", "DWAParams", "guide_path", "simulate_dwa"]
 _MAX_OBSTACLE_COST = 20.0
 
 
-@dataclass(frozen=True)
-class DWAParams:
-    """The DWA's parameters (seconds, radians; lengths in robot radii SR).
-
-    Attributes
-    ----------
-    sim_time : float
-        Roll-out time of each trajectory, s (at least one period plus half of ``accel_time``
-        is rolled out, so that every braking arc is checked).
-    obstacle_time : float
-        How far ahead the moving obstacles are predicted, s: a trajectory goes on straight at
-        full speed after ``sim_time`` (the robot turns, then drives), a stop stays.
-    v_samples, w_samples : int
-        Linear and angular velocities sampled across the dynamic window.
-    accel_time : float
-        Time to reach full speed (or full turn rate) from rest, s: the acceleration limits are
-        ``v_max / accel_time`` and ``w_max / accel_time``.
-    reverse : float
-        Fastest backwards speed as a fraction of ``v_max`` (0: never backwards).
-    prune_distance : float
-        Length of the local plan ahead of the robot's progress, SR.
-    forward_point : float
-        Distance ahead of a trajectory's end at which the align critics look, SR.
-    path_dist, goal_dist, path_align, goal_align, obstacle, prefer_forward : float
-        Weights of the critics.
-    inflation : float
-        Decay length of the obstacle cost ``exp(-clearance / inflation)``, SR.
-    oscillation_distance, oscillation_angle : float
-        Motion (SR) or turn (rad) after which the oscillation critic forgets a sign flip.
-    rotate_threshold_deg : float
-        Heading error to the local plan beyond which a nearly stopped robot turns in place.
-    progress_distance, progress_time : float
-        The progress checker: moving less than ``progress_distance`` (SR) in ``progress_time``
-        (s) starts a recovery.
-    backup_time : float
-        How long a recovery backs up (at half the reverse speed), s.
-    max_recoveries : int
-        Most recoveries in a run.
-    resolution : float
-        Cell size of the grid of the distance critics, SR.
-    """
-
-    sim_time: float = 2.0
-    obstacle_time: float = 6.0
-    v_samples: int = 9
-    w_samples: int = 15
-    accel_time: float = 0.3
-    reverse: float = 1.0
-    prune_distance: float = 12.0
-    forward_point: float = 1.3
-    path_dist: float = 1.0
-    goal_dist: float = 2.0
-    path_align: float = 0.5
-    goal_align: float = 0.5
-    obstacle: float = 2.0
-    prefer_forward: float = 2.0
-    inflation: float = 1.0
-    oscillation_distance: float = 0.2
-    oscillation_angle: float = 0.2
-    rotate_threshold_deg: float = 60.0
-    progress_distance: float = 0.5
-    progress_time: float = 10.0
-    backup_time: float = 1.0
-    max_recoveries: int = 10
-    resolution: float = 0.25
-
-    def __post_init__(self) -> None:
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if not (math.isfinite(value) and value >= 0):
-                raise ValueError(f"DWAParams.{f.name} must be a finite number >= 0, got {value}")
-        if self.v_samples < 2 or self.w_samples < 2 or self.v_samples * self.w_samples > 10_000:
-            raise ValueError("DWAParams: 2 to 10,000 samples per axis product are needed")
-        if not (self.sim_time > 0 and self.accel_time > 0 and self.resolution > 0):
-            raise ValueError("DWAParams.sim_time, accel_time and resolution must be > 0")
-        if self.reverse > 1 or self.max_recoveries > 1000:
-            raise ValueError("DWAParams.reverse must be <= 1 and max_recoveries <= 1000")
-
-
 def simulate_dwa(
     problem: Problem,
     guide_path: np.ndarray,
     params: DWAParams | None = None,
     options: DynamicOptions | None = None,
     seed: int | None = None,
+    progress: Callable[[float, float], None] | None = None,
 ) -> SimulationResult:
     """Drive the robot with the DWA along ``guide_path`` among the problem's moving obstacles.
 
@@ -180,6 +105,8 @@ def simulate_dwa(
         same obstacles, the same random turns as :func:`simulate` with the same seed).
     seed : int, optional
         Seeds the obstacles' random heading changes exactly as :func:`simulate` does.
+    progress : callable, optional
+        Called as ``progress(t, t_max)`` after every step.
 
     Returns
     -------
@@ -192,7 +119,7 @@ def simulate_dwa(
     controller = None
     if len(path) >= 2:
         controller = DWAController(problem, path, params, options.margin)
-    return simulate_local(problem, controller or _NoController(), path, options, seed)
+    return simulate_local(problem, controller or _NoController(), path, options, seed, progress)
 
 
 def guide_path(
@@ -278,7 +205,7 @@ class Evaluation:
 
 
 class DWAController:
-    """The DWB-like controller (see the module doc); a :class:`~rrtpso_ompl.dynamic.simulation.
+    """The DWB-like controller (see the module doc); a :class:`~rrtpso_ompl.dynamic.local.
     LocalController`.
 
     Parameters
@@ -307,10 +234,7 @@ class DWAController:
         self.robot = robot = RobotModel.of(problem)
         self.world = World.from_problem(problem)
         self.goal = np.asarray(problem.goal, dtype=float)
-        radii = [m.radius for m in problem.moving_obstacles]
-        if margin is None:
-            margin = 0.1 * (robot.radius + min(radii, default=0.0))
-        self.margin = float(margin)
+        self.margin = default_margin(problem, margin)
         sr = robot.radius
         self.sr = sr
         self.dt = dt = robot.sample_time
