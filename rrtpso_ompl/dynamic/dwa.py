@@ -55,6 +55,7 @@ import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -102,9 +103,11 @@ def simulate_dwa(
     params : DWAParams, optional
     options : DynamicOptions, optional
         ``margin``, ``max_time``, ``heading_changes`` and ``heading_change_deg`` are used (the
-        same obstacles, the same random turns as :func:`simulate` with the same seed).
+        same obstacles, the same random turns as :func:`~rrtpso_ompl.dynamic.simulate` with
+        the same seed).
     seed : int, optional
-        Seeds the obstacles' random heading changes exactly as :func:`simulate` does.
+        Seeds the obstacles' random heading changes as :func:`~rrtpso_ompl.dynamic.simulate`
+        does.
     progress : callable, optional
         Called as ``progress(t, t_max)`` after every step.
 
@@ -202,6 +205,17 @@ class Evaluation:
     d_stop: np.ndarray
     chosen: int
     mode: str
+
+
+class _StaticCheck(NamedTuple):
+    """The static world's verdict on the sampled commands (see :meth:`DWAController.
+    _static_check`)."""
+
+    admissible: np.ndarray  # (m,) a stop after the period keeps off the static world
+    k_s: np.ndarray  # (m,) index of the first roll-out step that meets it (n: none)
+    go: np.ndarray  # (m, n, 2) the roll-outs, held at their last free point
+    reached: np.ndarray  # (m,) how long each roll-out drives, s
+    clear_static: np.ndarray  # (m,) least clearance to the static world, units
 
 
 class DWAController:
@@ -376,22 +390,46 @@ class DWAController:
         return np.append(V, v0 * keep), np.append(W, w0 * keep)
 
     def _evaluate(self, x, th, v0, w0, obstacles, pd, gd, t) -> Evaluation:
-        p, dt, sr = self.p, self.dt, self.sr
+        """Roll out the dynamic window's commands, check them against the static world and the
+        predicted moving obstacles, score the safe ones and choose (see the module doc)."""
         V, W = self._window(v0, w0)
-        m, n = len(V), len(self.t_roll)
-        t_roll = self.t_roll
-        # Driving on: the arc for the whole roll-out ...
-        go = arc_position(x, th, V[:, None], W[:, None], t_roll[None, :])  # (m, n, 2)
-        # ... and stopping: the period, then both velocities ramped down together in t_b (the
-        # same arc, at the position reached by then), over the prediction's horizon.
+        go, stop, tau_stop = self._rollouts(x, th, V, W)
+        static = self._static_check(x, V, W, go, tau_stop)
+        # Moving obstacles, predicted at constant velocity: the first predicted contact and the
+        # least margin, driving on (straight on after the roll-out, unless it met the static
+        # world) and stopping.
+        heading = th + W * static.reached
+        drive = self._drive_on(static.go, heading, V, static.k_s)
+        (ttc_go, d_go), (ttc_stop, d_stop) = (
+            self._dynamic_clearance(x, traj, V, obstacles) for traj in (drive, stop)
+        )
+        safe = static.admissible & (np.isinf(ttc_go) | np.isinf(ttc_stop))
+        cost = self._critics(x, V, static, heading, d_go, pd, gd)
+        choice, mode = self._choose(x, th, v0, t, V, W, safe, cost, static, (ttc_go, ttc_stop),
+                                    (d_go, d_stop))  # fmt: skip
+        return Evaluation(V, W, static.admissible, safe, np.where(safe, cost, np.inf), d_go,
+                          d_stop, choice, mode)  # fmt: skip
+
+    def _rollouts(self, x, th, V, W) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(go, stop, tau_stop)``: driving on, the arc for the whole roll-out (``(m, n, 2)``);
+        stopping, the period then both velocities ramped down together in ``t_b`` (the same
+        arc, at the position reached by then), over the prediction's horizon; and the time
+        from now to the stop, s."""
+        dt = self.dt
+        go = arc_position(x, th, V[:, None], W[:, None], self.t_roll[None, :])
         t_b = np.maximum(np.abs(V) / self.acc, np.abs(W) / self.alpha)
         tb = t_b[:, None]
         after = np.clip(self.t_pred[None, :] - dt, 0.0, tb)
         ramp = np.where(tb > 0, after - after**2 / (2.0 * np.where(tb > 0, tb, 1.0)), 0.0)
         tau = np.minimum(self.t_pred[None, :], dt) + ramp
         stop = arc_position(x, th, V[:, None], W[:, None], tau)
-        tau_stop = dt + 0.5 * t_b
+        return go, stop, dt + 0.5 * t_b
 
+    def _static_check(self, x, V, W, go, tau_stop) -> _StaticCheck:
+        """Admissibility (a stop keeps off the static world and in the bounds), each roll-out
+        cut at its last free point, and the least clearance to the static world."""
+        p, dt, sr, t_roll = self.p, self.dt, self.sr, self.t_roll
+        m, n = len(V), len(t_roll)
         # Static world: exact distance of each chord of the roll-out, less the arc's sagitta
         # (once for the chord of the roll-out, once for the executed motion's own chords).
         pad = 0.25 * np.abs(V) * np.abs(W) * dt**2 + self.world.tol
@@ -419,28 +457,28 @@ class DWAController:
         idx = np.minimum(np.arange(n)[None, :], k_s[:, None] - 1)
         held = np.take_along_axis(go, np.maximum(idx, 0)[..., None], axis=1)
         go = np.where((idx >= 0)[..., None], held, x)
-        reached = np.minimum(t_free, t_roll[-1])
         clear_static = np.where(np.arange(n)[None, :] < k_s[:, None], clear_s, np.inf).min(axis=1)
-        clear_static = np.minimum(clear_static, here)
+        return _StaticCheck(admissible, k_s, go, np.minimum(t_free, t_roll[-1]),
+                            np.minimum(clear_static, here))  # fmt: skip
 
-        # Moving obstacles, predicted at constant velocity: the first predicted contact and the
-        # least margin, driving on (straight on after the roll-out, unless it met the static
-        # world) and stopping.
-        heading = th + W * reached
-        extra = self.t_pred[n:] - t_roll[-1]
-        # (At full speed: a turn in place is how the robot starts to get out of the way.)
+    def _drive_on(self, go, heading, V, k_s) -> np.ndarray:
+        """The roll-outs continued over the prediction's horizon: straight on at full speed
+        (a turn in place is how the robot starts to get out of the way), or standing where a
+        roll-out met the static world."""
+        n = len(self.t_roll)
+        extra = self.t_pred[n:] - self.t_roll[-1]
         onward = np.where(V < 0, -self.v_max, self.v_max)
         onward = np.where(k_s == n, onward, 0.0)[:, None, None] * extra[None, :, None]
         direction = np.column_stack([np.cos(heading), np.sin(heading)])
-        drive = np.concatenate([go, go[:, -1:] + onward * direction[:, None, :]], axis=1)
-        (ttc_go, d_go), (ttc_stop, d_stop) = (
-            self._dynamic_clearance(x, traj, V, obstacles) for traj in (drive, stop)
-        )
-        safe = admissible & (np.isinf(ttc_go) | np.isinf(ttc_stop))
+        return np.concatenate([go, go[:, -1:] + onward * direction[:, None, :]], axis=1)
 
+    def _critics(self, x, V, static, heading, d_go, pd, gd) -> np.ndarray:
+        """The critics' total per command (lower is better; ``inf`` where not finite); the
+        weighted scores, one row per critic, are kept in :attr:`parts`."""
+        p, sr, go = self.p, self.sr, static.go
+        m, t_roll = len(V), self.t_roll
         end = go[:, -1]
         front = end + self.forward * np.column_stack([np.cos(heading), np.sin(heading)])
-        near_goal = math.dist(x, self.goal) <= self.forward
         path_d = self._path_distance(pd, end) / sr
         goal_d = self._goal_distance(gd, end) / sr
         if self._local_end >= self.s_at[-1]:
@@ -451,14 +489,14 @@ class DWAController:
             arrive = np.where(near.any(axis=1), t_roll[near.argmax(axis=1)], np.inf)
             goal_d = np.where(np.isfinite(arrive), -self.v_max * (t_roll[-1] - arrive) / sr, goal_d)
         align_path = align_goal = np.zeros(m)
-        if not near_goal:
+        if math.dist(x, self.goal) > self.forward:
             # A point ahead in a wall or off the field does not veto a trajectory (as in DWB,
             # the align critics only score): it counts as far as the field reaches.
             far = self.goal_limit / sr
             align_path = p.path_align * np.minimum(self._path_distance(pd, front) / sr, far)
             align_goal = p.goal_align * np.minimum(self._goal_distance(gd, front) / sr, far)
         lam = p.inflation * sr
-        obstacle = np.exp(-np.maximum(clear_static, 0.0) / lam)
+        obstacle = np.exp(-np.maximum(static.clear_static, 0.0) / lam)
         obstacle += np.minimum(np.exp(-d_go / lam), _MAX_OBSTACLE_COST)
         #: The critics' weighted scores, one row each (kept for diagnostics).
         self.parts = np.array([
@@ -470,39 +508,38 @@ class DWAController:
             p.prefer_forward * np.maximum(-V, 0.0) / self.v_max,
         ])  # fmt: skip
         cost = self.parts.sum(axis=0)
-        cost = np.where(np.isfinite(cost), cost, np.inf)
+        return np.where(np.isfinite(cost), cost, np.inf)
 
-        osc = self._v_trend.refuses(V)
-        osc |= (np.abs(V) <= 0.1 * self.v_max) & self._w_trend.refuses(W)
-        mode = "critics"
+    def _choose(self, x, th, v0, t, V, W, safe, cost, static, ttc, d) -> tuple[int, str]:
+        """``(index, mode)`` of the command taken: a recovery's back-up, the rotation shim, the
+        cheapest safe command the oscillation critic allows, or when nothing is safe the
+        admissible one that meets the predicted obstacle last (``ttc``, ``d``: driving on and
+        stopping)."""
         if t < self._backup_until:
-            choice = self._backup(V, W, safe)
-            mode = "backup"
+            choice, mode = self._backup(V, W, safe), "backup"
         else:
             choice = self._rotate(x, th, v0, V, W, safe)
-            if choice is not None:
-                mode = "rotate"
-        if choice is None:
-            legal = safe & np.isfinite(cost)
-            if legal.any() and (legal & ~osc).any():
-                legal &= ~osc
-            if legal.any():
-                choice = int(np.argmin(np.where(legal, cost, np.inf)))
-            elif safe.any():
-                # Off the fields' reach: the safe command nearest the local plan's end.
-                choice = int(
-                    np.argmin(np.where(safe, np.hypot(*(end - self._local[-1]).T), np.inf))
-                )
-            else:
-                # Whatever it does, a predicted obstacle comes too close: the admissible command
-                # whose better continuation meets it last, and of those the one that comes
-                # least close.
-                ttc = np.where(admissible, np.maximum(ttc_go, ttc_stop), -np.inf)
-                least = np.where(admissible, np.maximum(d_go, d_stop), -np.inf)
-                choice = int(np.lexsort((-ttc, -np.round(least, 9)))[0])
-                mode = "unavoidable"
-        return Evaluation(V, W, admissible, safe, np.where(safe, cost, np.inf), d_go, d_stop,
-                          choice, mode)  # fmt: skip
+            mode = "critics" if choice is None else "rotate"
+        if choice is not None:
+            return choice, mode
+        osc = self._v_trend.refuses(V)
+        osc |= (np.abs(V) <= 0.1 * self.v_max) & self._w_trend.refuses(W)
+        legal = safe & np.isfinite(cost)
+        if legal.any() and (legal & ~osc).any():
+            legal &= ~osc
+        if legal.any():
+            return int(np.argmin(np.where(legal, cost, np.inf))), mode
+        if safe.any():
+            # Off the fields' reach: the safe command nearest the local plan's end.
+            end = static.go[:, -1]
+            near = np.hypot(*(end - self._local[-1]).T)
+            return int(np.argmin(np.where(safe, near, np.inf))), mode
+        # Whatever it does, a predicted obstacle comes too close: the admissible command whose
+        # better continuation meets it last, and of those the one that comes least close.
+        admissible = static.admissible
+        late = np.where(admissible, np.maximum(*ttc), -np.inf)
+        least = np.where(admissible, np.maximum(*d), -np.inf)
+        return int(np.lexsort((-late, -np.round(least, 9)))[0]), "unavoidable"
 
     def _dynamic_clearance(self, x, traj, V, obstacles) -> tuple[np.ndarray, np.ndarray]:
         """First predicted contact (s; ``inf`` when none) and least margin (units) to the sensed

@@ -50,7 +50,7 @@ class LocalController(Protocol):
         """Start a new run at ``xy`` facing ``theta``."""
 
     def step(self, state: RobotState, obstacles: Observations, t: float) -> tuple[float, float]:
-        """``(v, w)`` for the period from ``t``; ``obstacles`` as :func:`simulate` senses them
+        """``(v, w)`` for the period from ``t``; ``obstacles`` as every strategy senses them
         (index -> (position, velocity, radius), measured at ``t``)."""
 
 
@@ -64,28 +64,27 @@ def simulate_local(
 ) -> SimulationResult:
     """Drive the robot with a local controller among the problem's moving obstacles.
 
-    Every ``sample_time`` the robot senses as in :func:`simulate`, asks ``controller.step`` for
-    ``(v, w)`` and drives them for one period on an exact arc (knots every
-    ``sample_time / SUBSTEPS``). The plant saturates commands at the robot's limits (speed,
-    turn rate, ``|v| + |w| L / 2 <= v_w``). Within one period's travel (or SR/10) of the goal,
-    with the straight line free, it drives the last chord in. The executed motion's static
-    validity is checked exactly afterwards: unlike a planned path, a controller's arcs are not,
-    and the result's ``status`` says when the robot clipped a static obstacle.
+    Every ``sample_time`` the robot senses as in :func:`~rrtpso_ompl.dynamic.simulate`, asks
+    ``controller.step`` for ``(v, w)``, saturates them at the robot's limits (speed, turn rate,
+    ``|v| + |w| L / 2 <= v_w``) and drives them for one period on an exact arc (knots every
+    ``sample_time / SUBSTEPS``). Within one period's travel (or SR/10) of the goal, with the
+    straight line free, it drives the last chord in. The result's ``status`` says when the
+    executed motion clipped a static obstacle (checked exactly afterwards).
 
     Parameters
     ----------
     problem : Problem
-        As for :func:`simulate`.
+        As for :func:`~rrtpso_ompl.dynamic.simulate`.
     controller : LocalController
     reference_path : (n, 2) array
-        The path the controller follows (units): its first point is the start, its first
-        segment the initial heading, its length sets the time limit (``4 L / v + 60`` s unless
-        ``options.max_time``); fewer than two points report "no static path".
+        The path followed (units): its first point the start, its first segment the heading,
+        its length the time limit (``4 L / v + 60`` s); under two points: "no static path".
     options : DynamicOptions, optional
-        Only ``max_time``, ``heading_changes`` and ``heading_change_deg`` are used (the same
-        obstacles and the same random turns as :func:`simulate` with the same seed).
+        Only ``max_time``, ``heading_changes`` and ``heading_change_deg`` are used (the
+        obstacles and their random turns of :func:`~rrtpso_ompl.dynamic.simulate`).
     seed : int, optional
-        Seeds the obstacles' random heading changes exactly as :func:`simulate` does.
+        Seeds the obstacles' random heading changes as :func:`~rrtpso_ompl.dynamic.simulate`
+        does.
     progress : callable, optional
         Called as ``progress(t, t_max)`` after every step.
 
@@ -96,8 +95,7 @@ def simulate_local(
     """
     options = options or DynamicOptions()
     robot = RobotModel.of(problem)
-    name = str(controller.name)
-    label = (name.lower(), name)
+    label = (str(controller.name).lower(), str(controller.name))
     path = np.asarray(reference_path, dtype=float).reshape(-1, 2)
     tracks = [ObstacleTrack.from_obstacle(m) for m in problem.moving_obstacles]
     why = blocked(problem, tracks, robot) if len(path) >= 2 else "no static path"
@@ -105,8 +103,7 @@ def simulate_local(
         return no_static_path(problem, label, seed, robot, path, tracks, why)
     _, world_rng = np.random.default_rng(seed).spawn(2)
     t_max = options.max_time
-    if t_max is None:
-        t_max = 4.0 * path_length(path) / robot.speed + 60.0
+    t_max = 4.0 * path_length(path) / robot.speed + 60.0 if t_max is None else t_max
     check_steps(t_max, robot.sample_time)
     world = World.from_problem(problem)
     motion, reached = _drive_local(problem, controller, robot, world, path, tracks, options,
@@ -114,10 +111,16 @@ def simulate_local(
     # The driven motion is the only "plan" a local controller has (the animation draws it).
     result = measure(problem, label, seed, robot, motion, reached, path, tracks, [],
                      [(0.0, motion)])  # fmt: skip
-    free = world.segments_free(motion.xy[:-1], motion.xy[1:])
-    if not (free.all() and world.points_in_bounds(motion.xy).all()):
+    if not _statically_valid(world, motion):
         result.status = "clipped a static obstacle or left the bounds"
     return result
+
+
+def _statically_valid(world: World, motion: Motion) -> bool:
+    """Whether the executed motion's chords keep off the static world and in the bounds
+    (checked exactly: unlike a planned path, a controller's arcs are not checked before)."""
+    free = world.segments_free(motion.xy[:-1], motion.xy[1:])
+    return bool(free.all() and world.points_in_bounds(motion.xy).all())
 
 
 def _drive_local(problem, controller, robot, world, path, tracks, options, t_max, world_rng,
