@@ -9,7 +9,7 @@ __all__ = ["DWAParams"]
 
 
 def _positive(*names: str) -> Rule:
-    return Rule(names, lambda *v: all(x > 0 for x in v), " and ".join(names) + " > 0")
+    return Rule(names, lambda *v: all(x > 0 for x in v), ", ".join(names) + " > 0")
 
 
 @declared(

@@ -17,10 +17,10 @@ __all__ = ["Replan", "SimulationResult"]
 class Replan:
     """One reaction of the manager (JSON-ready through :meth:`to_dict`).
 
-    ``kind`` is ``"contour"``/``"global"`` for a planned reaction (``side`` ``"up"``, ``"down"``,
-    ``"wait"`` or None for global), ``"wait"`` or ``"evade"`` for a fallback, ``"unavoidable"``
-    when nothing verified. ``planning_time`` is the measured wall-clock
-    time of the planners, ``budget`` the simulated time it was charged.
+    ``kind`` is the strategy's name (``"contour"``, ``"global"``) for a planned reaction
+    (``side`` ``"up"``, ``"down"``, ``"wait"`` or None for one plan), ``"wait"`` or ``"evade"``
+    for a fallback, ``"unavoidable"`` when nothing verified. ``planning_time`` is the measured
+    wall-clock time of the planners, ``budget`` the simulated time it was charged.
     """
 
     t: float
