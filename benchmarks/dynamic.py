@@ -47,12 +47,16 @@ REPO = Path(__file__).resolve().parent.parent
 DYNAMIC = REPO / "problems" / "dynamic"
 BASE = DYNAMIC / "paper_dynamic.yaml"
 MAP_BASE = DYNAMIC / "office_people.yaml"
+#: The strategies the benchmark runs (names of the strategy registry), each with the planner of
+#: its static path, replans or guide path.
 STRATEGIES = (
     ("contour", "RRTstarPSO"),
     ("global", "RRTstar"),
     ("none", "RRTstarPSO"),
-    ("dwa", "DWA"),
+    ("dwa", "RRTstarPSO"),
 )
+#: Options of their own (the strategy's declared option set): the DWA's guide path gets 0.5 s.
+STRATEGY_OPTIONS = {"dwa": {"guide_time": 0.5}}
 #: Random heading changes of the ``turning`` family: per obstacle per second, and degrees.
 TURN_RATE, TURN_DEG = 0.2, 45.0
 #: The cases the DWA's parameters were tuned on (``--first``, ``--first-turning``,
@@ -125,9 +129,9 @@ def run_case(case: Case, replan_time: float, initial_time: float,
         ObstacleTrack,
         arrival_lower_bound,
         clairvoyant_wait,
-        simulate,
+        default_strategies,
     )
-    from rrtpso_ompl.dynamic.dwa import guide_path, simulate_dwa
+    from rrtpso_ompl.dynamic.manager import FALLBACK_KINDS
     from rrtpso_ompl.model.geometry import path_length
     from rrtpso_ompl.model.problem import load_problem
     from rrtpso_ompl.ompl_setup import set_ompl_log_level
@@ -160,16 +164,12 @@ def run_case(case: Case, replan_time: float, initial_time: float,
     rows = []
     for strategy, planner in chosen:
         t0 = time.perf_counter()
-        if strategy == "dwa":
-            opts = DynamicOptions(heading_changes=case.heading_changes, heading_change_deg=TURN_DEG)
-            guide = guide_path(problem, static.path, "RRTstarPSO", 0.5, {"seed": seed})
-            sim = simulate_dwa(problem, guide, options=opts, seed=seed)
-        else:
-            opts = DynamicOptions(planner=planner, strategy=strategy, replan_time=replan_time,
-                                  heading_changes=case.heading_changes,
-                                  heading_change_deg=TURN_DEG)  # fmt: skip
-            sim = simulate(problem, opts, seed=seed, initial_path=static.path)
-        planned = [r for r in sim.replans if r.kind in ("contour", "global")]
+        opts = DynamicOptions(planner=planner, strategy=strategy, replan_time=replan_time,
+                              heading_changes=case.heading_changes,
+                              heading_change_deg=TURN_DEG)  # fmt: skip
+        runner = default_strategies().make(strategy, STRATEGY_OPTIONS.get(strategy))
+        sim = runner.simulate(problem, opts, seed=seed, initial_path=static.path)
+        planned = [r for r in sim.replans if r.kind not in FALLBACK_KINDS]
         clearance = [d - c for d, c in
                      zip(sim.min_separation_continuous, sim.contact_distance, strict=True)
                      if d is not None]  # fmt: skip
@@ -178,7 +178,7 @@ def run_case(case: Case, replan_time: float, initial_time: float,
                 **head,
                 "scenario": problem.name,
                 "strategy": strategy,
-                "planner": planner,
+                "planner": sim.planner,
                 "status": sim.status,
                 "obstacles": len(problem.moving_obstacles),
                 "reached_goal": sim.reached_goal,
@@ -193,7 +193,7 @@ def run_case(case: Case, replan_time: float, initial_time: float,
                 "waits": sum(r.side == "wait" for r in planned),
                 "fallbacks": {
                     k: sum(r.kind == k for r in sim.replans)
-                    for k in ("wait", "evade", "unavoidable")
+                    for k in FALLBACK_KINDS
                 },
                 "planning_times": [r.planning_time for r in planned],
                 "wall": time.perf_counter() - t0,
@@ -215,19 +215,22 @@ def _warm() -> None:
     """What a worker imports once, before it forks a process per case."""
     import rrtpso_ompl.dynamic.dwa
     import rrtpso_ompl.groundtruth.optimum  # noqa: F401
+    from rrtpso_ompl.dynamic import default_strategies
     from rrtpso_ompl.planners import default_registry
 
     default_registry()
+    default_strategies()
 
 
 def summarise(rows: list[dict], group: str) -> list[dict]:
     """Per strategy, over the rows of ``group``."""
     out = []
-    for strategy, planner in STRATEGIES:
+    for strategy, _ in STRATEGIES:
         rs = [r for r in rows if r["group"] == group and r["strategy"] == strategy
               and "error" not in r]  # fmt: skip
         if not rs:
             continue
+        planner = rs[0]["planner"]
         reached = [r for r in rs if r["reached_goal"]]
         plan_t = [t for r in rs for t in r["planning_times"]]
         over_lb = [100 * (r["total_time"] / r["lower_bound_time"] - 1) for r in reached
@@ -238,7 +241,7 @@ def summarise(rows: list[dict], group: str) -> list[dict]:
         out.append(
             {
                 "strategy": strategy,
-                "planner": planner if strategy != "none" else "-",
+                "planner": planner,
                 "runs": len(rs),
                 "success": sum(r["success"] for r in rs),
                 "reached": len(reached),

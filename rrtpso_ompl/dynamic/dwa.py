@@ -46,31 +46,35 @@ path, not by replanning it. :class:`DWAController` is that planner, built as Nav
 
 Everything is vectorised over samples, horizon steps and obstacles (the static checks through
 the :class:`~rrtpso_ompl.model.world.World`'s spatial index). :func:`simulate_dwa` runs it in
-:func:`~rrtpso_ompl.dynamic.simulation.simulate_local`, the harness of every local controller.
+:func:`~rrtpso_ompl.dynamic.local.simulate_local`, the harness of every local controller.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass, fields
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from ..model.geometry import cumulative_length, point_segment_distance, wrap_angle
 from ..model.problem import PlannerConfig, Problem
 from ..model.world import World
-from .manager import Observations
+from .dwa_params import DWAParams
+from .local import simulate_local
 from .motion import arc_position
 from .navgrid import NavGrid
-from .simulation import (
+from .options import (
     DynamicOptions,
+    Observations,
     RobotModel,
     RobotState,
-    SimulationResult,
+    default_margin,
     goal_tolerance,
-    simulate_local,
 )
+from .result import SimulationResult
 
 __all__ = ["DWAController", "DWAParams", "guide_path", "simulate_dwa"]
 
@@ -79,91 +83,13 @@ __all__ = ["DWAController", "DWAParams", "guide_path", "simulate_dwa"]
 _MAX_OBSTACLE_COST = 20.0
 
 
-@dataclass(frozen=True)
-class DWAParams:
-    """The DWA's parameters (seconds, radians; lengths in robot radii SR).
-
-    Attributes
-    ----------
-    sim_time : float
-        Roll-out time of each trajectory, s (at least one period plus half of ``accel_time``
-        is rolled out, so that every braking arc is checked).
-    obstacle_time : float
-        How far ahead the moving obstacles are predicted, s: a trajectory goes on straight at
-        full speed after ``sim_time`` (the robot turns, then drives), a stop stays.
-    v_samples, w_samples : int
-        Linear and angular velocities sampled across the dynamic window.
-    accel_time : float
-        Time to reach full speed (or full turn rate) from rest, s: the acceleration limits are
-        ``v_max / accel_time`` and ``w_max / accel_time``.
-    reverse : float
-        Fastest backwards speed as a fraction of ``v_max`` (0: never backwards).
-    prune_distance : float
-        Length of the local plan ahead of the robot's progress, SR.
-    forward_point : float
-        Distance ahead of a trajectory's end at which the align critics look, SR.
-    path_dist, goal_dist, path_align, goal_align, obstacle, prefer_forward : float
-        Weights of the critics.
-    inflation : float
-        Decay length of the obstacle cost ``exp(-clearance / inflation)``, SR.
-    oscillation_distance, oscillation_angle : float
-        Motion (SR) or turn (rad) after which the oscillation critic forgets a sign flip.
-    rotate_threshold_deg : float
-        Heading error to the local plan beyond which a nearly stopped robot turns in place.
-    progress_distance, progress_time : float
-        The progress checker: moving less than ``progress_distance`` (SR) in ``progress_time``
-        (s) starts a recovery.
-    backup_time : float
-        How long a recovery backs up (at half the reverse speed), s.
-    max_recoveries : int
-        Most recoveries in a run.
-    resolution : float
-        Cell size of the grid of the distance critics, SR.
-    """
-
-    sim_time: float = 2.0
-    obstacle_time: float = 6.0
-    v_samples: int = 9
-    w_samples: int = 15
-    accel_time: float = 0.3
-    reverse: float = 1.0
-    prune_distance: float = 12.0
-    forward_point: float = 1.3
-    path_dist: float = 1.0
-    goal_dist: float = 2.0
-    path_align: float = 0.5
-    goal_align: float = 0.5
-    obstacle: float = 2.0
-    prefer_forward: float = 2.0
-    inflation: float = 1.0
-    oscillation_distance: float = 0.2
-    oscillation_angle: float = 0.2
-    rotate_threshold_deg: float = 60.0
-    progress_distance: float = 0.5
-    progress_time: float = 10.0
-    backup_time: float = 1.0
-    max_recoveries: int = 10
-    resolution: float = 0.25
-
-    def __post_init__(self) -> None:
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if not (math.isfinite(value) and value >= 0):
-                raise ValueError(f"DWAParams.{f.name} must be a finite number >= 0, got {value}")
-        if self.v_samples < 2 or self.w_samples < 2 or self.v_samples * self.w_samples > 10_000:
-            raise ValueError("DWAParams: 2 to 10,000 samples per axis product are needed")
-        if not (self.sim_time > 0 and self.accel_time > 0 and self.resolution > 0):
-            raise ValueError("DWAParams.sim_time, accel_time and resolution must be > 0")
-        if self.reverse > 1 or self.max_recoveries > 1000:
-            raise ValueError("DWAParams.reverse must be <= 1 and max_recoveries <= 1000")
-
-
 def simulate_dwa(
     problem: Problem,
     guide_path: np.ndarray,
     params: DWAParams | None = None,
     options: DynamicOptions | None = None,
     seed: int | None = None,
+    progress: Callable[[float, float], None] | None = None,
 ) -> SimulationResult:
     """Drive the robot with the DWA along ``guide_path`` among the problem's moving obstacles.
 
@@ -177,9 +103,13 @@ def simulate_dwa(
     params : DWAParams, optional
     options : DynamicOptions, optional
         ``margin``, ``max_time``, ``heading_changes`` and ``heading_change_deg`` are used (the
-        same obstacles, the same random turns as :func:`simulate` with the same seed).
+        same obstacles, the same random turns as :func:`~rrtpso_ompl.dynamic.simulate` with
+        the same seed).
     seed : int, optional
-        Seeds the obstacles' random heading changes exactly as :func:`simulate` does.
+        Seeds the obstacles' random heading changes as :func:`~rrtpso_ompl.dynamic.simulate`
+        does.
+    progress : callable, optional
+        Called as ``progress(t, t_max)`` after every step.
 
     Returns
     -------
@@ -192,7 +122,7 @@ def simulate_dwa(
     controller = None
     if len(path) >= 2:
         controller = DWAController(problem, path, params, options.margin)
-    return simulate_local(problem, controller or _NoController(), path, options, seed)
+    return simulate_local(problem, controller or _NoController(), path, options, seed, progress)
 
 
 def guide_path(
@@ -277,8 +207,19 @@ class Evaluation:
     mode: str
 
 
+class _StaticCheck(NamedTuple):
+    """The static world's verdict on the sampled commands (see :meth:`DWAController.
+    _static_check`)."""
+
+    admissible: np.ndarray  # (m,) a stop after the period keeps off the static world
+    k_s: np.ndarray  # (m,) index of the first roll-out step that meets it (n: none)
+    go: np.ndarray  # (m, n, 2) the roll-outs, held at their last free point
+    reached: np.ndarray  # (m,) how long each roll-out drives, s
+    clear_static: np.ndarray  # (m,) least clearance to the static world, units
+
+
 class DWAController:
-    """The DWB-like controller (see the module doc); a :class:`~rrtpso_ompl.dynamic.simulation.
+    """The DWB-like controller (see the module doc); a :class:`~rrtpso_ompl.dynamic.local.
     LocalController`.
 
     Parameters
@@ -307,10 +248,7 @@ class DWAController:
         self.robot = robot = RobotModel.of(problem)
         self.world = World.from_problem(problem)
         self.goal = np.asarray(problem.goal, dtype=float)
-        radii = [m.radius for m in problem.moving_obstacles]
-        if margin is None:
-            margin = 0.1 * (robot.radius + min(radii, default=0.0))
-        self.margin = float(margin)
+        self.margin = default_margin(problem, margin)
         sr = robot.radius
         self.sr = sr
         self.dt = dt = robot.sample_time
@@ -452,22 +390,46 @@ class DWAController:
         return np.append(V, v0 * keep), np.append(W, w0 * keep)
 
     def _evaluate(self, x, th, v0, w0, obstacles, pd, gd, t) -> Evaluation:
-        p, dt, sr = self.p, self.dt, self.sr
+        """Roll out the dynamic window's commands, check them against the static world and the
+        predicted moving obstacles, score the safe ones and choose (see the module doc)."""
         V, W = self._window(v0, w0)
-        m, n = len(V), len(self.t_roll)
-        t_roll = self.t_roll
-        # Driving on: the arc for the whole roll-out ...
-        go = arc_position(x, th, V[:, None], W[:, None], t_roll[None, :])  # (m, n, 2)
-        # ... and stopping: the period, then both velocities ramped down together in t_b (the
-        # same arc, at the position reached by then), over the prediction's horizon.
+        go, stop, tau_stop = self._rollouts(x, th, V, W)
+        static = self._static_check(x, V, W, go, tau_stop)
+        # Moving obstacles, predicted at constant velocity: the first predicted contact and the
+        # least margin, driving on (straight on after the roll-out, unless it met the static
+        # world) and stopping.
+        heading = th + W * static.reached
+        drive = self._drive_on(static.go, heading, V, static.k_s)
+        (ttc_go, d_go), (ttc_stop, d_stop) = (
+            self._dynamic_clearance(x, traj, V, obstacles) for traj in (drive, stop)
+        )
+        safe = static.admissible & (np.isinf(ttc_go) | np.isinf(ttc_stop))
+        cost = self._critics(x, V, static, heading, d_go, pd, gd)
+        choice, mode = self._choose(x, th, v0, t, V, W, safe, cost, static, (ttc_go, ttc_stop),
+                                    (d_go, d_stop))  # fmt: skip
+        return Evaluation(V, W, static.admissible, safe, np.where(safe, cost, np.inf), d_go,
+                          d_stop, choice, mode)  # fmt: skip
+
+    def _rollouts(self, x, th, V, W) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(go, stop, tau_stop)``: driving on, the arc for the whole roll-out (``(m, n, 2)``);
+        stopping, the period then both velocities ramped down together in ``t_b`` (the same
+        arc, at the position reached by then), over the prediction's horizon; and the time
+        from now to the stop, s."""
+        dt = self.dt
+        go = arc_position(x, th, V[:, None], W[:, None], self.t_roll[None, :])
         t_b = np.maximum(np.abs(V) / self.acc, np.abs(W) / self.alpha)
         tb = t_b[:, None]
         after = np.clip(self.t_pred[None, :] - dt, 0.0, tb)
         ramp = np.where(tb > 0, after - after**2 / (2.0 * np.where(tb > 0, tb, 1.0)), 0.0)
         tau = np.minimum(self.t_pred[None, :], dt) + ramp
         stop = arc_position(x, th, V[:, None], W[:, None], tau)
-        tau_stop = dt + 0.5 * t_b
+        return go, stop, dt + 0.5 * t_b
 
+    def _static_check(self, x, V, W, go, tau_stop) -> _StaticCheck:
+        """Admissibility (a stop keeps off the static world and in the bounds), each roll-out
+        cut at its last free point, and the least clearance to the static world."""
+        p, dt, sr, t_roll = self.p, self.dt, self.sr, self.t_roll
+        m, n = len(V), len(t_roll)
         # Static world: exact distance of each chord of the roll-out, less the arc's sagitta
         # (once for the chord of the roll-out, once for the executed motion's own chords).
         pad = 0.25 * np.abs(V) * np.abs(W) * dt**2 + self.world.tol
@@ -495,28 +457,28 @@ class DWAController:
         idx = np.minimum(np.arange(n)[None, :], k_s[:, None] - 1)
         held = np.take_along_axis(go, np.maximum(idx, 0)[..., None], axis=1)
         go = np.where((idx >= 0)[..., None], held, x)
-        reached = np.minimum(t_free, t_roll[-1])
         clear_static = np.where(np.arange(n)[None, :] < k_s[:, None], clear_s, np.inf).min(axis=1)
-        clear_static = np.minimum(clear_static, here)
+        return _StaticCheck(admissible, k_s, go, np.minimum(t_free, t_roll[-1]),
+                            np.minimum(clear_static, here))  # fmt: skip
 
-        # Moving obstacles, predicted at constant velocity: the first predicted contact and the
-        # least margin, driving on (straight on after the roll-out, unless it met the static
-        # world) and stopping.
-        heading = th + W * reached
-        extra = self.t_pred[n:] - t_roll[-1]
-        # (At full speed: a turn in place is how the robot starts to get out of the way.)
+    def _drive_on(self, go, heading, V, k_s) -> np.ndarray:
+        """The roll-outs continued over the prediction's horizon: straight on at full speed
+        (a turn in place is how the robot starts to get out of the way), or standing where a
+        roll-out met the static world."""
+        n = len(self.t_roll)
+        extra = self.t_pred[n:] - self.t_roll[-1]
         onward = np.where(V < 0, -self.v_max, self.v_max)
         onward = np.where(k_s == n, onward, 0.0)[:, None, None] * extra[None, :, None]
         direction = np.column_stack([np.cos(heading), np.sin(heading)])
-        drive = np.concatenate([go, go[:, -1:] + onward * direction[:, None, :]], axis=1)
-        (ttc_go, d_go), (ttc_stop, d_stop) = (
-            self._dynamic_clearance(x, traj, V, obstacles) for traj in (drive, stop)
-        )
-        safe = admissible & (np.isinf(ttc_go) | np.isinf(ttc_stop))
+        return np.concatenate([go, go[:, -1:] + onward * direction[:, None, :]], axis=1)
 
+    def _critics(self, x, V, static, heading, d_go, pd, gd) -> np.ndarray:
+        """The critics' total per command (lower is better; ``inf`` where not finite); the
+        weighted scores, one row per critic, are kept in :attr:`parts`."""
+        p, sr, go = self.p, self.sr, static.go
+        m, t_roll = len(V), self.t_roll
         end = go[:, -1]
         front = end + self.forward * np.column_stack([np.cos(heading), np.sin(heading)])
-        near_goal = math.dist(x, self.goal) <= self.forward
         path_d = self._path_distance(pd, end) / sr
         goal_d = self._goal_distance(gd, end) / sr
         if self._local_end >= self.s_at[-1]:
@@ -527,14 +489,14 @@ class DWAController:
             arrive = np.where(near.any(axis=1), t_roll[near.argmax(axis=1)], np.inf)
             goal_d = np.where(np.isfinite(arrive), -self.v_max * (t_roll[-1] - arrive) / sr, goal_d)
         align_path = align_goal = np.zeros(m)
-        if not near_goal:
+        if math.dist(x, self.goal) > self.forward:
             # A point ahead in a wall or off the field does not veto a trajectory (as in DWB,
             # the align critics only score): it counts as far as the field reaches.
             far = self.goal_limit / sr
             align_path = p.path_align * np.minimum(self._path_distance(pd, front) / sr, far)
             align_goal = p.goal_align * np.minimum(self._goal_distance(gd, front) / sr, far)
         lam = p.inflation * sr
-        obstacle = np.exp(-np.maximum(clear_static, 0.0) / lam)
+        obstacle = np.exp(-np.maximum(static.clear_static, 0.0) / lam)
         obstacle += np.minimum(np.exp(-d_go / lam), _MAX_OBSTACLE_COST)
         #: The critics' weighted scores, one row each (kept for diagnostics).
         self.parts = np.array([
@@ -546,39 +508,38 @@ class DWAController:
             p.prefer_forward * np.maximum(-V, 0.0) / self.v_max,
         ])  # fmt: skip
         cost = self.parts.sum(axis=0)
-        cost = np.where(np.isfinite(cost), cost, np.inf)
+        return np.where(np.isfinite(cost), cost, np.inf)
 
-        osc = self._v_trend.refuses(V)
-        osc |= (np.abs(V) <= 0.1 * self.v_max) & self._w_trend.refuses(W)
-        mode = "critics"
+    def _choose(self, x, th, v0, t, V, W, safe, cost, static, ttc, d) -> tuple[int, str]:
+        """``(index, mode)`` of the command taken: a recovery's back-up, the rotation shim, the
+        cheapest safe command the oscillation critic allows, or when nothing is safe the
+        admissible one that meets the predicted obstacle last (``ttc``, ``d``: driving on and
+        stopping)."""
         if t < self._backup_until:
-            choice = self._backup(V, W, safe)
-            mode = "backup"
+            choice, mode = self._backup(V, W, safe), "backup"
         else:
             choice = self._rotate(x, th, v0, V, W, safe)
-            if choice is not None:
-                mode = "rotate"
-        if choice is None:
-            legal = safe & np.isfinite(cost)
-            if legal.any() and (legal & ~osc).any():
-                legal &= ~osc
-            if legal.any():
-                choice = int(np.argmin(np.where(legal, cost, np.inf)))
-            elif safe.any():
-                # Off the fields' reach: the safe command nearest the local plan's end.
-                choice = int(
-                    np.argmin(np.where(safe, np.hypot(*(end - self._local[-1]).T), np.inf))
-                )
-            else:
-                # Whatever it does, a predicted obstacle comes too close: the admissible command
-                # whose better continuation meets it last, and of those the one that comes
-                # least close.
-                ttc = np.where(admissible, np.maximum(ttc_go, ttc_stop), -np.inf)
-                least = np.where(admissible, np.maximum(d_go, d_stop), -np.inf)
-                choice = int(np.lexsort((-ttc, -np.round(least, 9)))[0])
-                mode = "unavoidable"
-        return Evaluation(V, W, admissible, safe, np.where(safe, cost, np.inf), d_go, d_stop,
-                          choice, mode)  # fmt: skip
+            mode = "critics" if choice is None else "rotate"
+        if choice is not None:
+            return choice, mode
+        osc = self._v_trend.refuses(V)
+        osc |= (np.abs(V) <= 0.1 * self.v_max) & self._w_trend.refuses(W)
+        legal = safe & np.isfinite(cost)
+        if legal.any() and (legal & ~osc).any():
+            legal &= ~osc
+        if legal.any():
+            return int(np.argmin(np.where(legal, cost, np.inf))), mode
+        if safe.any():
+            # Off the fields' reach: the safe command nearest the local plan's end.
+            end = static.go[:, -1]
+            near = np.hypot(*(end - self._local[-1]).T)
+            return int(np.argmin(np.where(safe, near, np.inf))), mode
+        # Whatever it does, a predicted obstacle comes too close: the admissible command whose
+        # better continuation meets it last, and of those the one that comes least close.
+        admissible = static.admissible
+        late = np.where(admissible, np.maximum(*ttc), -np.inf)
+        least = np.where(admissible, np.maximum(*d), -np.inf)
+        return int(np.lexsort((-late, -np.round(least, 9)))[0]), "unavoidable"
 
     def _dynamic_clearance(self, x, traj, V, obstacles) -> tuple[np.ndarray, np.ndarray]:
         """First predicted contact (s; ``inf`` when none) and least margin (units) to the sensed

@@ -16,9 +16,9 @@ from helpers import PROBLEMS, ROBOT, corridor, rrtpso_exe
 
 from rrtpso_ompl.dynamic import DynamicOptions, RobotState, simulate_local
 from rrtpso_ompl.dynamic.dwa import DWAController, DWAParams, simulate_dwa
+from rrtpso_ompl.dynamic.local import SUBSTEPS
 from rrtpso_ompl.dynamic.motion import arc_position
 from rrtpso_ompl.dynamic.navgrid import NavGrid
-from rrtpso_ompl.dynamic.simulation import SUBSTEPS
 from rrtpso_ompl.model.problem import load_problem, problem_from_dict
 from rrtpso_ompl.model.world import World
 
