@@ -220,6 +220,15 @@ class World:
             free &= shapes._clear_cells(lat, margin + lat.h * math.sqrt(0.5), free)
         return free
 
+    def point_free_cells(self, lat: Lattice) -> np.ndarray | None:
+        """(nx, ny) booleans: the cells no obstacle enters, for a map with nothing but its cells
+        (exact); None for any other world. The free space of a disc robot is these cells shrunk
+        by its radius: a channel of them, with every corner it bends round wrapped at the radius,
+        holds the robot's shortest path where the corridors are wider than the robot."""
+        if self.raster is None or self._non_raster.n_obstacles:
+            return None
+        return self.raster.free_cells(lat, 0.0, self.bounds)
+
     def centres_free(self, lat: Lattice) -> np.ndarray:
         """(nx, ny) booleans: the lattice cells whose centre is a free configuration (exact;
         says nothing about the rest of the cell)."""

@@ -66,6 +66,8 @@ SHAPE_SPLIT = 4
 
 #: Most re-routings of :func:`centre_route` around segments that failed the check.
 CENTRE_ROUTE_ROUNDS = 32
+#: Most rounds of :func:`_wrapped_funnel` adding wall corners its path passed without a bend.
+WRAP_REPAIRS = 8
 #: The weight of a move found blocked: no route uses it while another exists.
 _CUT = 1e12
 
@@ -510,6 +512,11 @@ def _route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0
                 if best is None or length < best[1]:
                     best = (candidate, length, len(route), k)
                 break
+    if best is not None and model.robot_radius > 0.0 and not (terminate and terminate()):
+        wrapped = _wrapped_funnel(model, lat, free, routes[best[3]], a, b, start, goal, s_hop,
+                                  g_hop, terminate)  # fmt: skip
+        if wrapped is not None and path_length(wrapped) < best[1]:
+            best = (wrapped, path_length(wrapped), *best[2:])
     stages["funnel"] = stages.get("funnel", 0.0) + time.perf_counter() - t2
     if best is None:
         return done("the corridor's path did not pass the check", lattice=lat, cells=n_free,
@@ -517,6 +524,151 @@ def _route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0
     path, length, n_route, which = best
     return CorridorResult(path, length, lat, n_free, n_route, time.perf_counter() - t0, "",
                           stages, len(routes), which)  # fmt: skip
+
+
+def _wrapped_funnel(model, lat: Lattice, free, route, a, b, start, goal, s_hop, g_hop,
+                    terminate=None):  # fmt: skip
+    """A disc robot's path on a map through the same route, closer to the walls than the wholly
+    free cells allow (they lose up to a cell along every wall).
+
+    The funnel runs through the cells no obstacle enters, with each portal's end moved the
+    robot's radius in where a blocked cell touches it; every wall corner the funnel bends round
+    then becomes a circle of the robot's radius, and the path the taut string round those
+    circles (:func:`_round_corners`). Checked; None when it fails (a gap narrower than the
+    robot, a corner passed without a bend) or the world is not a map."""
+    point = model.point_free_cells(lat) if hasattr(model, "point_free_cells") else None
+    r = float(model.robot_radius) + 16.0 * model.tol
+    if point is None:
+        return None
+    # The cells along the walls next to the wholly free ones (and no others: a band stays a band).
+    point &= ndimage.binary_dilation(free, iterations=math.ceil(r / lat.h) + 1)
+    rects, label = free_rectangles(point)
+    seq = _rectangle_channel(channel(route), label)
+    # Lattice points a blocked cell (or the lattice's edge) touches.
+    pad = np.zeros((lat.nx + 2, lat.ny + 2), dtype=bool)
+    pad[1:-1, 1:-1] = point
+    walled = ~(pad[:-1, :-1] & pad[1:, :-1] & pad[:-1, 1:] & pad[1:, 1:])
+    (ox, oy), h = lat.origin, lat.h
+    portals, corner_of = [], {}
+    for left, right in _portals(seq, rects, lat, 0.0):
+        ends = [np.asarray(left, dtype=float), np.asarray(right, dtype=float)]
+        width = float(np.hypot(*(ends[1] - ends[0])))
+        moved = []
+        for e, other in ((ends[0], ends[1]), (ends[1], ends[0])):
+            i, j = round((e[0] - ox) / h), round((e[1] - oy) / h)
+            step = r if walled[i, j] else 16.0 * model.tol
+            if 2.0 * step >= width:
+                return None  # narrower than the robot
+            q = e + step * (other - e) / width
+            if walled[i, j]:
+                corner_of[(float(q[0]), float(q[1]))] = e
+            moved.append((float(q[0]), float(q[1])))
+        portals.append((moved[0], moved[1]))
+    inner = funnel(a, b, portals)
+    corners = [corner_of.get((float(x), float(y))) for x, y in inner[1:-1]]
+    walls = np.column_stack([ox + h * np.nonzero(walled)[0], oy + h * np.nonzero(walled)[1]])
+    for _ in range(WRAP_REPAIRS):
+        if terminate is not None and terminate():
+            return None
+        rounded = _round_corners(inner, corners, r)
+        if rounded is None:
+            return None
+        rounded, owner = rounded
+        candidate = np.vstack([start[None]] * s_hop + [rounded] + [goal[None]] * g_hop)
+        if model.path_valid(candidate):
+            return candidate
+        # A wall corner the string passes without wrapping it (a side of the channel that is
+        # free space, not wall, let the funnel pass it without a bend): it becomes a circle too.
+        bad = np.flatnonzero(model.segment_violation(rounded[:-1], rounded[1:]) > 0.0)
+        if not len(bad):
+            return None  # the hops to the end points failed: nothing to repair here
+        k = int(bad[0])
+        corner = _nearest_wall(rounded[k], rounded[k + 1], walls, r)
+        if corner is None:
+            return None
+        at = int(owner[k]) + 1  # after the circle the segment leaves
+        d, e = rounded[k + 1] - rounded[k], corner - rounded[k]
+        side = 1.0 if d[0] * e[1] - d[1] * e[0] > 0.0 else -1.0  # the corner's side of the path
+        inner = np.insert(inner, at, corner, axis=0)
+        corners.insert(at - 1, (corner, side))
+    return None
+
+
+def _nearest_wall(a: np.ndarray, b: np.ndarray, walls: np.ndarray, r: float):
+    """The point of ``walls`` nearest the segment ``a b`` if closer than ``r``, else None."""
+    lo, hi = np.minimum(a, b) - r, np.maximum(a, b) + r
+    near = walls[np.all((walls >= lo) & (walls <= hi), axis=1)]
+    if not len(near):
+        return None
+    d = b - a
+    f = np.clip(((near - a) @ d) / max(float(d @ d), 1e-300), 0.0, 1.0)
+    dist = np.hypot(*(a + f[:, None] * d - near).T)
+    k = int(np.argmin(dist))
+    return near[k] if dist[k] < r else None
+
+
+def _round_corners(path: np.ndarray, corners, r: float) -> np.ndarray | None:
+    """The taut string from ``path[0]`` to ``path[-1]`` round circles of radius ``r`` at the
+    ``corners`` (one per interior vertex: a point passed on the side the path turns to there,
+    a ``(point, side)`` pair, side +1 for a corner on the left, or None for a vertex kept as a
+    point); every arc replaced by the polygon circumscribed about it
+    (vertices at ``r / cos(delta / 2)``, ``delta`` at most 45 degrees), so no segment comes
+    closer than ``r`` to a corner. Also returns, for every vertex, the index of the path vertex
+    whose circle it lies on. None when two circles on opposite sides overlap or an arc would
+    turn back (the corners do not make a taut string)."""
+    centres, side = [path[0]], [0.0]
+    for k, corner in enumerate(corners, start=1):
+        d_in, d_out = path[k] - path[k - 1], path[k + 1] - path[k]
+        turn = d_in[0] * d_out[1] - d_in[1] * d_out[0]
+        if isinstance(corner, tuple):  # a corner given with its side
+            centres.append(np.asarray(corner[0], dtype=float))
+            side.append(corner[1])
+        elif corner is None or turn == 0.0:
+            centres.append(path[k])
+            side.append(0.0)
+        else:  # turning left: the corner is on the left, the path passes to its right
+            centres.append(np.asarray(corner, dtype=float))
+            side.append(1.0 if turn > 0 else -1.0)
+    centres.append(path[-1])
+    side.append(0.0)
+    c, s = np.asarray(centres), np.asarray(side)
+    d = np.diff(c, axis=0)
+    length = np.hypot(d[:, 0], d[:, 1])
+    if not np.all(length > 0.0):
+        return None
+    u = d / length[:, None]
+    # The common tangent of consecutive circles: travel t at angle phi to the line of centres,
+    # sin(phi) = (s_k - s_k+1) r / L; the tangent points lie s r along t's right normal m.
+    sin_phi = (s[:-1] - s[1:]) * r / length
+    if np.any(np.abs(sin_phi) >= 1.0):
+        return None
+    t = np.sqrt(1.0 - sin_phi**2)[:, None] * u + sin_phi[:, None] * np.column_stack(
+        [-u[:, 1], u[:, 0]]
+    )
+    m = np.column_stack([t[:, 1], -t[:, 0]])
+    leave = c[:-1] + (s[:-1] * r)[:, None] * m
+    arrive = c[1:] + (s[1:] * r)[:, None] * m
+    out, owner = [c[0]], [0]
+    for k in range(1, len(c) - 1):
+        if s[k] == 0.0:
+            out.append(c[k])
+            owner.append(k)
+            continue
+        a_in = math.atan2(arrive[k - 1][1] - c[k][1], arrive[k - 1][0] - c[k][0])
+        a_out = math.atan2(leave[k][1] - c[k][1], leave[k][0] - c[k][0])
+        sweep = (a_out - a_in) % (2.0 * math.pi)
+        if s[k] < 0:
+            sweep -= 2.0 * math.pi
+        if abs(sweep) > math.pi:
+            return None
+        pieces = max(1, math.ceil(abs(sweep) / (0.25 * math.pi)))
+        delta = sweep / pieces
+        ang = a_in + (np.arange(pieces) + 0.5) * delta
+        out.extend(c[k] + (r / math.cos(0.5 * delta)) * np.column_stack([np.cos(ang), np.sin(ang)]))
+        owner.extend([k] * pieces)
+    out.append(c[-1])
+    owner.append(len(c) - 1)
+    return np.asarray(out), np.asarray(owner)
 
 
 def centre_route(model: Any, start, goal, max_cells: int = 65_536, terminate=None,

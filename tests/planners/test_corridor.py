@@ -151,3 +151,21 @@ def test_lattice_route_is_none_between_walled_off_cells():
     route = lattice_route(np.ones((5, 5), dtype=bool), (0, 0), (4, 4))
     assert route[0] == (0, 0) and route[-1] == (4, 4) and len(route) == 5
     assert path_length(np.array(route, float)) == pytest.approx(4 * math.sqrt(2))
+
+
+@pytest.mark.parametrize("radius", [0.1, 0.24, 0.45])
+def test_a_disc_robot_on_a_map_is_pulled_round_the_door_jambs(radius):
+    # Rooms 10 cells wide joined by doors 2 cells wide at different heights: the wholly free
+    # lattice cells lose a cell along every wall, so their funnel swings wide round each jamb;
+    # the wrapped funnel bends round the jambs at the robot's radius, as the optimum does.
+    img = np.zeros((12, 34), dtype=bool)
+    img[0, :] = img[-1, :] = img[:, 0] = img[:, -1] = True
+    for col, door in ((11, 2), (22, 8)):
+        img[:, col] = True
+        img[door : door + 2, col] = False
+    world = _map_world(img, radius=radius)
+    start, goal = (1.5, 1.5), (32.5, 1.5)
+    res = corridor_path(world, start, goal, 10_000)
+    assert res.path is not None and world.path_valid(res.path)
+    exact = _optimum(world, start, goal)
+    assert exact * (1 - 1e-9) <= res.length <= exact * 1.002
