@@ -39,7 +39,7 @@ from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from ..model.geometry import path_length
+from ..model.geometry import path_length, shortcut
 from ..model.raster import Lattice
 
 #: Lattice cells the corridor stage builds, searches and funnels per second, on the safe side
@@ -517,6 +517,22 @@ def _route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0
                                   g_hop, terminate)  # fmt: skip
         if wrapped is not None and path_length(wrapped) < best[1]:
             best = (wrapped, path_length(wrapped), *best[2:])
+    if best is None and not (terminate and terminate()):
+        # The funnel's taut path grazes a corner it was not lifted off (a point robot squeezing
+        # between cells): the taut string round the corners at the touch tolerance.
+        wrapped = _wrapped_funnel(model, lat, free, routes[0], a, b, start, goal, s_hop, g_hop,
+                                  terminate)  # fmt: skip
+        if wrapped is not None:
+            best = (wrapped, path_length(wrapped), len(routes[0]), 0)
+    if best is None:
+        # Else the centres of the channel's cells, whose segments stay inside free cells,
+        # greedily shortcut.
+        centres = np.array([lat.centre(c) for c in channel(routes[0])])
+        candidate = np.vstack([start[None], centres[1 - s_hop : len(centres) - 1 + g_hop],
+                               goal[None]])  # fmt: skip
+        candidate = shortcut(candidate, model.segments_free, terminate, window=16)
+        if model.path_valid(candidate):
+            best = (candidate, path_length(candidate), len(routes[0]), 0)
     stages["funnel"] = stages.get("funnel", 0.0) + time.perf_counter() - t2
     if best is None:
         return done("the corridor's path did not pass the check", lattice=lat, cells=n_free,
