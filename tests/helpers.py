@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import json
 import os
 import shutil
@@ -13,20 +14,14 @@ import numpy as np
 
 from rrtpso_ompl.kinematics import ReferenceCurve
 from rrtpso_ompl.model.problem import Robot
+from rrtpso_ompl.testing import SIMPLE_PROBLEM
 
 REPO = Path(__file__).resolve().parent.parent
 PROBLEMS = REPO / "problems"
 
-#: The single-circle problem of the issue: its shortest path (tangent, arc, tangent) is 647.45.
-SINGLE_CIRCLE = {
-    "name": "single_circle",
-    "units": "cm",
-    "bounds": [[0, 0], [500, 500]],
-    "start": [20, 20],
-    "goal": [450, 450],
-    "robot": {"radius": 28.5},
-    "obstacles": [{"type": "circle", "center": [250, 250], "radius": 80}],
-}
+#: The single-circle problem of the issue: its shortest path (tangent, arc, tangent) is 647.45
+#: (the conformance kit's simple problem, under this name).
+SINGLE_CIRCLE = copy.deepcopy({**SIMPLE_PROBLEM, "name": "single_circle"})
 SINGLE_CIRCLE_OPTIMUM = 647.45
 
 
