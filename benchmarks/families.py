@@ -202,7 +202,7 @@ def summary(rows: list[dict], budget: float, planners) -> tuple[list[list], list
     return table, behind
 
 
-def report(rows: list[dict], args, seeds, planners) -> str:
+def report(rows: list[dict], args, seeds, planners) -> list[str]:
     from rrtpso_ompl.harness.report import markdown_table
 
     command = "python benchmarks/families.py " + " ".join(args.argv)
@@ -236,7 +236,7 @@ def report(rows: list[dict], args, seeds, planners) -> str:
     lines += [f"Failed runs: {len(errors)}."] + [
         f"- {r['file']} {r['planner']} {r['budget']:g} s: {r['error']}" for r in errors[:20]
     ]
-    return "\n".join(lines) + "\n"
+    return lines
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -257,6 +257,7 @@ def main(argv: list[str] | None = None) -> int:
     # each forked run still seeds its own (docs: "forking after OMPL was used").
     import rrtpso_ompl.planners  # noqa: F401
     from rrtpso_ompl.groundtruth import shortest_path
+    from rrtpso_ompl.harness.report import write_markdown
     from rrtpso_ompl.model import World, load_problem
 
     params = dict(p.split("=", 1) for p in args.param)
@@ -286,10 +287,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{path.name} done ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
     if args.rows:
         Path(args.rows).write_text("".join(json.dumps(r) + "\n" for r in rows))
-    text = report(rows, args, seeds, planners)
-    if args.out != "-":
-        Path(args.out).write_text(text)
-    print(text)
+    write_markdown(report(rows, args, seeds, planners), args.out)
     return 0
 
 

@@ -13,7 +13,7 @@ import errno
 import os
 import stat
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -427,6 +427,20 @@ def check_run_options(args: argparse.Namespace) -> None:
             raise UsageError(
                 "--executor dask: Dask is not installed: pip install 'rrtpso-ompl[dask]'"
             ) from None
+
+
+def run_keywords(args: argparse.Namespace, bar: RunProgress) -> dict[str, Any]:
+    """The keywords of :func:`~rrtpso_ompl.harness.run_batch` (and ``run_bench``) from the flags
+    of :func:`add_run_options`, with ``bar`` reporting the runs as they start and finish."""
+    return {"jobs": args.jobs, "resume": args.resume, "overwrite": args.overwrite,
+            "executor": args.executor, "scheduler": args.scheduler,
+            "progress": bar.row, "on_start": bar.started}  # fmt: skip
+
+
+def report_errors(errors: Iterable[str]) -> None:
+    """Print each error of a batch or bench to stderr (errors are printed also with ``-q``)."""
+    for error in errors:
+        print(f"rrtpso: {error}", file=sys.stderr)
 
 
 def batch_inputs(items: Sequence[str]) -> list[str]:

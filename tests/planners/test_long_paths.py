@@ -25,8 +25,8 @@ def perfect_maze(cells: int, seed: int) -> np.ndarray:
     wall[1, 1] = False
     while stack:  # each cell is pushed once: at most cells^2 rounds
         i, j = stack[-1]
-        nxt = [(i + di, j + dj) for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1))
-               if 0 <= i + di < cells and 0 <= j + dj < cells and not seen[i + di, j + dj]]  # fmt: skip
+        steps = ((i + di, j + dj) for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1)))
+        nxt = [(a, b) for a, b in steps if 0 <= a < cells and 0 <= b < cells and not seen[a, b]]
         if not nxt:
             stack.pop()
             continue
