@@ -51,9 +51,14 @@ def test_every_option_of_every_kind_is_one_flag_of_rrtpso_generate():
     for cls in GENERATORS.values():
         for spec in cls.PARAMS:
             flag = flags[spec.name]
-            assert flag.option_strings == [f"--{spec.name.replace('_', '-')}"]
-            assert flag.type is spec.type and spec.doc in flag.help
-            assert flag.nargs == spec.length  # a range is two numbers
+            name = spec.name.replace("_", "-")
+            if spec.type is bool:  # a switch
+                assert flag.option_strings == [f"--{name}", f"--no-{name}"]
+                assert spec.doc in flag.help
+            else:
+                assert flag.option_strings == [f"--{name}"]
+                assert flag.type is spec.type and spec.doc in flag.help
+                assert flag.nargs == spec.length  # a range is two numbers
             assert flag.choices == spec.choices and flag.default is None
     # Nothing but the options, the seed, the output and --overwrite.
     options = {n for cls in GENERATORS.values() for n in cls.PARAMS.names()}
