@@ -81,3 +81,20 @@ def test_the_stages_of_a_long_path_add_up_and_end_near_the_budget(maze_problem, 
     assert sum(stage_times) <= r.time * 1.001 + 1e-3
     if r.solved:
         assert world.path_valid(np.array(r.path))
+
+
+def test_a_point_robot_squeezing_through_a_random_field_gets_a_taut_path(tmp_path):
+    # A 256 x 256 field, 30 % of the cells blocked, a point robot: the funnel's path grazes
+    # corners between touching cells (before issue 25's fix the check refused it and the run
+    # found no path at 0.25 s); the taut string round the corners at the touch tolerance holds.
+    from rrtpso_ompl.groundtruth.generate import generate_to_file
+    from rrtpso_ompl.planners.corridor import corridor_path
+
+    path = generate_to_file("random_map", 2, tmp_path / "r.yaml", cells=256, density=0.3,
+                            robot_radius=0.0, query=1)  # fmt: skip
+    problem = load_problem(path)
+    world = World.from_problem(problem)
+    optimum = shortest_path(problem, world).length
+    res = corridor_path(world, problem.start, problem.goal, 65_536, alternatives=0)
+    assert res.path is not None and world.path_valid(res.path)
+    assert optimum * (1 - 1e-9) <= res.length <= optimum * 1.005
