@@ -512,9 +512,11 @@ def _route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0
                 if best is None or length < best[1]:
                     best = (candidate, length, len(route), k)
                 break
-    if best is not None and model.robot_radius > 0.0 and not (terminate and terminate()):
+    # Pulling a disc robot's path to the walls may take the time kept for a corridor not found.
+    late = getattr(terminate, "grace", terminate)
+    if best is not None and model.robot_radius > 0.0 and not (late and late()):
         wrapped = _wrapped_funnel(model, lat, free, routes[best[3]], a, b, start, goal, s_hop,
-                                  g_hop, terminate)  # fmt: skip
+                                  g_hop, late)  # fmt: skip
         if wrapped is not None and path_length(wrapped) < best[1]:
             best = (wrapped, path_length(wrapped), *best[2:])
     if best is None and not (terminate and terminate()):
@@ -853,6 +855,8 @@ def search(
     stages: dict[str, float] = {}
 
     out_of_time = _Deadline(end, terminate)
+    if end is not None and no_route_seconds is not None:
+        out_of_time.grace_end = max(end, t0 + no_route_seconds)
 
     def left() -> float:
         return math.inf if end is None else max(end - time.perf_counter(), 0.0)
@@ -1002,10 +1006,17 @@ def _corridors(model, coarse: Lattice, opened, fine_band, start, goal, alternati
 
 
 class _Deadline:
-    """A termination test: ``terminate()``, or the clock past ``end``."""
+    """A termination test: ``terminate()``, or the clock past ``end``; :meth:`grace` the same
+    with ``grace_end`` (later) for a step that improves a path already found."""
 
     def __init__(self, end: float | None, terminate=None) -> None:
         self.end, self.terminate = end, terminate
+        self.grace_end = end
+
+    def grace(self) -> bool:
+        return bool(self.terminate is not None and self.terminate()) or (
+            self.grace_end is not None and time.perf_counter() >= self.grace_end
+        )
 
     def __call__(self) -> bool:
         return bool(self.terminate is not None and self.terminate()) or (
