@@ -492,49 +492,12 @@ def _route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0
     if not routes:
         return done("no route through the lattice", lattice=lat, cells=n_free)
     t2 = time.perf_counter()
-    rects, label = free_rectangles(free)
     # Through a cell the end point lies in, the funnel starts at the point itself; entered from
     # outside, at the cell's centre (the segment there was checked).
-    a = lat.centre(s_cell) if s_hop else start
-    b = lat.centre(g_cell) if g_hop else goal
-    best = None
-    for k, route in enumerate(routes):
-        if k and terminate is not None and terminate():
-            break
-        seq = _rectangle_channel(channel(route), label)
-        for shrink in (max(1e-6 * lat.h, 16.0 * model.tol), 1e-3 * lat.h):
-            inner = funnel(a, b, _portals(seq, rects, lat, shrink))
-            if model.robot_radius <= 0.0:
-                inner = _lift(inner, lat, free, 2.0 * shrink)
-            candidate = np.vstack([start[None]] * s_hop + [inner] + [goal[None]] * g_hop)
-            if model.path_valid(candidate):
-                length = path_length(candidate)
-                if best is None or length < best[1]:
-                    best = (candidate, length, len(route), k)
-                break
-    # Pulling a disc robot's path to the walls may take the time kept for a corridor not found.
-    late = getattr(terminate, "grace", terminate)
-    if best is not None and model.robot_radius > 0.0 and not (late and late()):
-        wrapped = _wrapped_funnel(model, lat, free, routes[best[3]], a, b, start, goal, s_hop,
-                                  g_hop, late)  # fmt: skip
-        if wrapped is not None and path_length(wrapped) < best[1]:
-            best = (wrapped, path_length(wrapped), *best[2:])
-    if best is None and not (terminate and terminate()):
-        # The funnel's taut path grazes a corner it was not lifted off (a point robot squeezing
-        # between cells): the taut string round the corners at the touch tolerance.
-        wrapped = _wrapped_funnel(model, lat, free, routes[0], a, b, start, goal, s_hop, g_hop,
-                                  terminate)  # fmt: skip
-        if wrapped is not None:
-            best = (wrapped, path_length(wrapped), len(routes[0]), 0)
-    if best is None:
-        # Else the centres of the channel's cells, whose segments stay inside free cells,
-        # greedily shortcut.
-        centres = np.array([lat.centre(c) for c in channel(routes[0])])
-        candidate = np.vstack([start[None], centres[1 - s_hop : len(centres) - 1 + g_hop],
-                               goal[None]])  # fmt: skip
-        candidate = shortcut(candidate, model.segments_free, terminate, window=16)
-        if model.path_valid(candidate):
-            best = (candidate, path_length(candidate), len(routes[0]), 0)
+    ends = _Ends(lat.centre(s_cell) if s_hop else start, lat.centre(g_cell) if g_hop else goal,
+                 start, goal, s_hop, g_hop)  # fmt: skip
+    best = _funnel_routes(model, lat, free, routes, ends, terminate)
+    best = _pulled_taut(model, lat, free, routes, ends, terminate, best)
     stages["funnel"] = stages.get("funnel", 0.0) + time.perf_counter() - t2
     if best is None:
         return done("the corridor's path did not pass the check", lattice=lat, cells=n_free,
@@ -544,8 +507,72 @@ def _route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0
                           stages, len(routes), which)  # fmt: skip
 
 
-def _wrapped_funnel(model, lat: Lattice, free, route, a, b, start, goal, s_hop, g_hop,
-                    terminate=None):  # fmt: skip
+@dataclass(frozen=True)
+class _Ends:
+    """Where a channel's funnel starts and ends (``a``, ``b``: the end points, or the centres of
+    the cells they hop to when they lie outside every free cell) and the true end points."""
+
+    a: np.ndarray
+    b: np.ndarray
+    start: np.ndarray
+    goal: np.ndarray
+    s_hop: bool
+    g_hop: bool
+
+    def path(self, inner: np.ndarray) -> np.ndarray:
+        """``inner`` (from ``a`` to ``b``) with the hops to the true end points."""
+        return np.vstack([self.start[None]] * self.s_hop + [inner] + [self.goal[None]] * self.g_hop)
+
+
+def _funnel_routes(model, lat: Lattice, free, routes, ends: _Ends, terminate):
+    """``(path, length, route cells, route index)`` of the shortest checked funnel path over
+    ``routes`` (portals shrunk by the touch tolerance, then by a thousandth of a cell), or
+    None."""
+    rects, label = free_rectangles(free)
+    best = None
+    for k, route in enumerate(routes):
+        if k and terminate is not None and terminate():
+            break
+        seq = _rectangle_channel(channel(route), label)
+        for shrink in (max(1e-6 * lat.h, 16.0 * model.tol), 1e-3 * lat.h):
+            inner = funnel(ends.a, ends.b, _portals(seq, rects, lat, shrink))
+            if model.robot_radius <= 0.0:
+                inner = _lift(inner, lat, free, 2.0 * shrink)
+            candidate = ends.path(inner)
+            if model.path_valid(candidate):
+                length = path_length(candidate)
+                if best is None or length < best[1]:
+                    best = (candidate, length, len(route), k)
+                break
+    return best
+
+
+def _pulled_taut(model, lat: Lattice, free, routes, ends: _Ends, terminate, best):
+    """``best`` (see :func:`_funnel_routes`) improved or, when None, replaced: a disc robot's
+    path pulled to the walls (:func:`_wrapped_funnel`, which may take the time kept for a
+    corridor not found); with no checked funnel path (a point robot's grazing a corner it was
+    not lifted off), the taut string round the corners at the touch tolerance, else the centres
+    of the first channel's cells (segments inside free cells) greedily shortcut."""
+    late = getattr(terminate, "grace", terminate)
+    if best is not None and model.robot_radius > 0.0 and not (late and late()):
+        wrapped = _wrapped_funnel(model, lat, free, routes[best[3]], ends, late)
+        if wrapped is not None and path_length(wrapped) < best[1]:
+            best = (wrapped, path_length(wrapped), *best[2:])
+    if best is None and not (terminate and terminate()):
+        wrapped = _wrapped_funnel(model, lat, free, routes[0], ends, terminate)
+        if wrapped is not None:
+            best = (wrapped, path_length(wrapped), len(routes[0]), 0)
+    if best is None:
+        centres = np.array([lat.centre(c) for c in channel(routes[0])])
+        inner = centres[1 - ends.s_hop : len(centres) - 1 + ends.g_hop]
+        candidate = np.vstack([ends.start[None], inner, ends.goal[None]])
+        candidate = shortcut(candidate, model.segments_free, terminate, window=16)
+        if model.path_valid(candidate):
+            best = (candidate, path_length(candidate), len(routes[0]), 0)
+    return best
+
+
+def _wrapped_funnel(model, lat: Lattice, free, route, ends: _Ends, terminate=None):
     """A disc robot's path on a map through the same route, closer to the walls than the wholly
     free cells allow (they lose up to a cell along every wall).
 
@@ -566,24 +593,13 @@ def _wrapped_funnel(model, lat: Lattice, free, route, a, b, start, goal, s_hop, 
     pad = np.zeros((lat.nx + 2, lat.ny + 2), dtype=bool)
     pad[1:-1, 1:-1] = point
     walled = ~(pad[:-1, :-1] & pad[1:, :-1] & pad[:-1, 1:] & pad[1:, 1:])
-    (ox, oy), h = lat.origin, lat.h
-    portals, corner_of = [], {}
-    for left, right in _portals(seq, rects, lat, 0.0):
-        ends = [np.asarray(left, dtype=float), np.asarray(right, dtype=float)]
-        width = float(np.hypot(*(ends[1] - ends[0])))
-        moved = []
-        for e, other in ((ends[0], ends[1]), (ends[1], ends[0])):
-            i, j = round((e[0] - ox) / h), round((e[1] - oy) / h)
-            step = r if walled[i, j] else 16.0 * model.tol
-            if 2.0 * step >= width:
-                return None  # narrower than the robot
-            q = e + step * (other - e) / width
-            if walled[i, j]:
-                corner_of[(float(q[0]), float(q[1]))] = e
-            moved.append((float(q[0]), float(q[1])))
-        portals.append((moved[0], moved[1]))
-    inner = funnel(a, b, portals)
+    wall_portals = _wall_portals(_portals(seq, rects, lat, 0.0), lat, walled, r, 16.0 * model.tol)
+    if wall_portals is None:
+        return None  # narrower than the robot
+    portals, corner_of = wall_portals
+    inner = funnel(ends.a, ends.b, portals)
     corners = [corner_of.get((float(x), float(y))) for x, y in inner[1:-1]]
+    (ox, oy), h = lat.origin, lat.h
     walls = np.column_stack([ox + h * np.nonzero(walled)[0], oy + h * np.nonzero(walled)[1]])
     for _ in range(WRAP_REPAIRS):
         if terminate is not None and terminate():
@@ -592,7 +608,7 @@ def _wrapped_funnel(model, lat: Lattice, free, route, a, b, start, goal, s_hop, 
         if rounded is None:
             return None
         rounded, owner = rounded
-        candidate = np.vstack([start[None]] * s_hop + [rounded] + [goal[None]] * g_hop)
+        candidate = ends.path(rounded)
         if model.path_valid(candidate):
             return candidate
         # A wall corner the string passes without wrapping it (a side of the channel that is
@@ -610,6 +626,30 @@ def _wrapped_funnel(model, lat: Lattice, free, route, a, b, start, goal, s_hop, 
         inner = np.insert(inner, at, corner, axis=0)
         corners.insert(at - 1, (corner, side))
     return None
+
+
+def _wall_portals(portals, lat: Lattice, walled: np.ndarray, r: float, tol: float):
+    """``portals`` with each end moved ``r`` towards the other where a wall touches it
+    (``walled``: the lattice points a blocked cell touches), ``tol`` elsewhere; and, for every
+    end moved ``r``, the wall corner it came from (keyed by the moved end). None when a portal
+    is narrower than that."""
+    (ox, oy), h = lat.origin, lat.h
+    out, corner_of = [], {}
+    for left, right in portals:
+        pair = [np.asarray(left, dtype=float), np.asarray(right, dtype=float)]
+        width = float(np.hypot(*(pair[1] - pair[0])))
+        moved = []
+        for e, other in ((pair[0], pair[1]), (pair[1], pair[0])):
+            wall = walled[round((e[0] - ox) / h), round((e[1] - oy) / h)]
+            step = r if wall else tol
+            if 2.0 * step >= width:
+                return None
+            q = e + step * (other - e) / width
+            if wall:
+                corner_of[(float(q[0]), float(q[1]))] = e
+            moved.append((float(q[0]), float(q[1])))
+        out.append((moved[0], moved[1]))
+    return out, corner_of
 
 
 def _nearest_wall(a: np.ndarray, b: np.ndarray, walls: np.ndarray, r: float):
