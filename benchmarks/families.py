@@ -83,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     from rrtpso_ompl.groundtruth import shortest_path
-    from rrtpso_ompl.harness.report import markdown_table
+    from rrtpso_ompl.harness.report import markdown_table, write_markdown
     from rrtpso_ompl.model import World, load_problem
     from rrtpso_ompl.ompl_setup import set_ompl_log_level
     from rrtpso_ompl.planners import solve
@@ -138,12 +138,7 @@ def main(argv: list[str] | None = None) -> int:
             cells.append(cell + (f", {miss} unsolved" if miss else ""))
         table.append([fam, *cells])
     lines.append(markdown_table(["family", *(p for p, _ in planners)], table))
-    text = "\n".join(lines) + "\n"
-    if args.out == "-":
-        print(text)
-    else:
-        Path(args.out).write_text(text)
-        print(text)
+    write_markdown(lines, args.out)
     return 0
 
 

@@ -119,6 +119,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", default=str(REPO / "docs" / "foreign-checker.md"))
     args = ap.parse_args(argv)
+    from rrtpso_ompl.harness.report import write_markdown
+
     jobs = [(env, planner, budget, seed)
             for env, budgets in (("geo_env", (0.25, 0.5, 1.0)), ("square", (0.25, 1.0)))
             for budget in budgets for planner in ("RRTstar", "RRTstarPSO")
@@ -145,10 +147,7 @@ def main(argv: list[str] | None = None) -> int:
         "",
         depth_table(rows),
     ]
-    text = "\n".join(lines) + "\n"
-    if args.out != "-":
-        Path(args.out).write_text(text)
-    print(text)
+    write_markdown(lines, args.out)
     return 0
 
 

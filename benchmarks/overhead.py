@@ -88,7 +88,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     from rrtpso_ompl.harness.batch import make_tasks
-    from rrtpso_ompl.harness.report import markdown_table
+    from rrtpso_ompl.harness.report import markdown_table, write_markdown
 
     try:
         import distributed  # noqa: F401
@@ -124,10 +124,7 @@ def main(argv: list[str] | None = None) -> int:
                           f"{1000 * over:.0f}", f"{100 * useful:.0f}", errors])  # fmt: skip
             print(markdown_table(header, table[-1:]).splitlines()[-1], file=sys.stderr)
     lines.append(markdown_table(header, table))
-    text = "\n".join(lines) + "\n"
-    if args.out != "-":
-        Path(args.out).write_text(text)
-    print(text)
+    write_markdown(lines, args.out)
     return 0
 
 

@@ -71,10 +71,27 @@ def draw_world(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> list
     list
         The legend handles of what was drawn (the world's key), for :func:`world_legend`.
     """
-    r = problem.robot.radius
     key: list[Any] = []
     if problem.map is not None:
         key += draw_map(ax, problem, safety_zones=safety_zones)
+    key += _draw_obstacles(ax, problem, safety_zones=safety_zones)
+    (xmin, ymin), (xmax, ymax) = problem.bounds
+    ax.plot([xmin, xmax, xmax, xmin, xmin], [ymin, ymin, ymax, ymax, ymin], color="k", lw=0.8)
+    key += _draw_ends(ax, problem)
+    pad = 0.02 * max(xmax - xmin, ymax - ymin)
+    ax.set_xlim(xmin - pad, xmax + pad)
+    ax.set_ylim(ymin - pad, ymax + pad)
+    ax.set_aspect("equal")
+    unit = f" [{problem.units}]" if problem.units else ""
+    ax.set_xlabel(f"x{unit}")
+    ax.set_ylabel(f"y{unit}")
+    return key
+
+
+def _draw_obstacles(ax: Axes, problem: Problem, *, safety_zones: bool) -> list[Any]:
+    """The static obstacles, and their safety zones when asked and the robot has a radius;
+    returns their legend handles."""
+    r = problem.robot.radius
     # One collection per kind (not a patch per obstacle): 10,000 obstacles draw in a second.
     shapes, zones = [], []
     for obs in problem.obstacles:
@@ -94,13 +111,19 @@ def draw_world(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> list
     if zones:
         ax.add_collection(PatchCollection(zones, fc="none", ec=SAFETY, ls="--", lw=0.9, zorder=1),
                           autolim=False)  # fmt: skip
-    if problem.obstacles:
-        key.append(Patch(color=OBSTACLE, label="obstacle"))
-        if safety_zones and r > 0:
-            key.append(Line2D([], [], ls="--", lw=0.9, color=SAFETY,
-                              label="safety zone (robot centre stays out)"))  # fmt: skip
-    (xmin, ymin), (xmax, ymax) = problem.bounds
-    ax.plot([xmin, xmax, xmax, xmin, xmin], [ymin, ymin, ymax, ymax, ymin], color="k", lw=0.8)
+    if not problem.obstacles:
+        return []
+    key: list[Any] = [Patch(color=OBSTACLE, label="obstacle")]
+    if safety_zones and r > 0:
+        key.append(Line2D([], [], ls="--", lw=0.9, color=SAFETY,
+                          label="safety zone (robot centre stays out)"))  # fmt: skip
+    return key
+
+
+def _draw_ends(ax: Axes, problem: Problem) -> list[Any]:
+    """Start and goal, each a marker inside a circle: the robot's disc (or, at the goal, the
+    goal tolerance when it is larger); returns their legend handles."""
+    r = problem.robot.radius
     goal_r = max(r, problem.goal_tolerance)
     ax.add_patch(CirclePatch(problem.start, r, fill=False, ec=START, lw=1.0, zorder=4))
     ax.add_patch(CirclePatch(problem.goal, goal_r, fill=False, ec=GOAL, lw=1.0, zorder=4))
@@ -109,20 +132,12 @@ def draw_world(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> list
     # A marker inside a circle, as drawn; the circle is the robot (or the goal's tolerance).
     ring = {"ls": "", "marker": "o", "ms": 13, "mfc": "none", "mew": 1.0}
     goal_ring = "goal tolerance" if problem.goal_tolerance > r else "robot at the goal"
-    key += [
+    return [
         (Line2D([], [], color=START, marker="o", ls="", label="start (circle: the robot)"),
          Line2D([], [], mec=START, **ring)),
         (Line2D([], [], color=GOAL, marker="*", ms=9, ls="", label=f"goal (circle: {goal_ring})"),
          Line2D([], [], mec=GOAL, **ring)),
     ]  # fmt: skip
-    pad = 0.02 * max(xmax - xmin, ymax - ymin)
-    ax.set_xlim(xmin - pad, xmax + pad)
-    ax.set_ylim(ymin - pad, ymax + pad)
-    ax.set_aspect("equal")
-    unit = f" [{problem.units}]" if problem.units else ""
-    ax.set_xlabel(f"x{unit}")
-    ax.set_ylabel(f"y{unit}")
-    return key
 
 
 #: Room for :func:`world_legend` beside a world (inches).
@@ -236,18 +251,23 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
     ax.set_title(title)
     world_legend(ax, key)
     if history:
-        bx = axes[0, 1]
-        h = np.asarray(history, dtype=float)
-        bx.plot(np.arange(len(h)), h, color=PATH_COLOUR)
-        bx.xaxis.set_major_locator(ticker.MaxNLocator(integer=True))
-        bx.set_xlabel("PSO iteration (all rounds)")
-        # The swarm's best is always collision-free, so its cost is the path length plus the
-        # turning penalty (smoothness_weight, 0 by default): a length.
-        bx.set_ylabel(f"best cost: length + turning penalty [{problem.units or 'length units'}]")
-        bx.set_title("PSO best cost per iteration")
-        bx.grid(alpha=0.3)
+        _draw_pso_history(axes[0, 1], history, problem.units)
     fig.tight_layout()
     return fig
+
+
+def _draw_pso_history(bx: Axes, history: Any, units: str) -> None:
+    """Panel (b) of :func:`plot_solution`: the swarm's best cost per iteration, over all its
+    rounds."""
+    h = np.asarray(history, dtype=float)
+    bx.plot(np.arange(len(h)), h, color=PATH_COLOUR)
+    bx.xaxis.set_major_locator(ticker.MaxNLocator(integer=True))
+    bx.set_xlabel("PSO iteration (all rounds)")
+    # The swarm's best is always collision-free, so its cost is the path length plus the
+    # turning penalty (smoothness_weight, 0 by default): a length.
+    bx.set_ylabel(f"best cost: length + turning penalty [{units or 'length units'}]")
+    bx.set_title("PSO best cost per iteration")
+    bx.grid(alpha=0.3)
 
 
 def plot_optimum(problem: Problem, result: Any) -> Figure:
@@ -320,22 +340,7 @@ def plot_bench(summary: Any, what: str = "ratio") -> Figure:
                 ax.fill_between(b, lo, hi, color=style[planner]["color"], alpha=0.15, lw=0)
                 # A shifted line is not in the data limits by itself.
                 ax.update_datalim(np.column_stack([b, m]))
-        ax.set_xscale("log")
-        ax.set_xticks(budgets, [f"{b:g}" for b in budgets])
-        ax.minorticks_off()
-        # Room for the shifted markers beside the first and last budgets.
-        ax.set_xlim(budgets[0] / 1.4, budgets[-1] * 1.4)
-        ax.set_title(problem, fontsize=9)
-        ax.grid(alpha=0.3)
-        ax.set_xlabel("time budget [s]", fontsize=8)
-        if what == "success":
-            ax.set_ylabel("success [%]", fontsize=8)
-            ax.set_ylim(-5, 105)
-        else:
-            ax.set_ylabel("length over optimum [%]", fontsize=8)
-            _plain_log_yaxis(ax)
-            ax.autoscale_view()
-        ax.tick_params(labelsize=8)
+        _bench_axes(ax, problem, budgets, what)
     for ax in axes.flat[len(problems) :]:
         ax.axis("off")
     # Every planner in the key, also one that no panel could draw (no solved run anywhere).
@@ -344,6 +349,28 @@ def plot_bench(summary: Any, what: str = "ratio") -> Figure:
     key_rows = -(-len(planners) // 5)
     fig.tight_layout(rect=(0, (0.1 + 0.22 * key_rows) / fig.get_figheight(), 1, 1))
     return fig
+
+
+def _bench_axes(ax: Axes, title: str, budgets: list[float], what: str) -> None:
+    """The axes of a :func:`plot_bench` panel, once its lines are drawn: the budgets as the
+    ticks of a log x axis, success in percent or the excess length on a plainly labelled log y
+    axis."""
+    ax.set_xscale("log")
+    ax.set_xticks(budgets, [f"{b:g}" for b in budgets])
+    ax.minorticks_off()
+    # Room for the shifted markers beside the first and last budgets.
+    ax.set_xlim(budgets[0] / 1.4, budgets[-1] * 1.4)
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.set_xlabel("time budget [s]", fontsize=8)
+    if what == "success":
+        ax.set_ylabel("success [%]", fontsize=8)
+        ax.set_ylim(-5, 105)
+    else:
+        ax.set_ylabel("length over optimum [%]", fontsize=8)
+        _plain_log_yaxis(ax)
+        ax.autoscale_view()
+    ax.tick_params(labelsize=8)
 
 
 def _plain_log_yaxis(ax: Axes) -> None:
@@ -470,6 +497,15 @@ def plot_simulation(problem: Problem, sim: Any) -> Figure:
     verdict = "goal reached" if sim.reached_goal else "goal NOT reached"
     ax.set_title(f"{problem.name}: {sim.strategy}, {verdict}, {sim.collisions} collisions")
     world_legend(ax, key, fontsize=7)
+    _draw_separation(bx, sim, problem.units)
+    fig.tight_layout()
+    return fig
+
+
+def _draw_separation(bx: Axes, sim: Any, units: str) -> None:
+    """Panel (b) of :func:`plot_simulation`: the centre distance from the robot to each moving
+    obstacle over time, its contact distance dashed, the replans grey."""
+    traj = sim.trajectory
     for k, tr in enumerate(sim.tracks):
         if not len(traj):
             break
@@ -479,14 +515,12 @@ def plot_simulation(problem: Problem, sim: Any) -> Figure:
     for rep in sim.replans:
         bx.axvline(rep.t, color="0.6", lw=0.8)
     bx.set_xlabel("t [s]")
-    unit = f" [{problem.units}]" if problem.units else ""
+    unit = f" [{units}]" if units else ""
     bx.set_ylabel(f"centre distance{unit}")
     bx.set_title("separation (dashed: contact SR + SO; grey: replans)")
     bx.grid(alpha=0.3)
     if sim.tracks:
         bx.legend(loc="best", fontsize=8)
-    fig.tight_layout()
-    return fig
 
 
 def simulation_frames(
@@ -509,62 +543,82 @@ def simulation_frames(
     frames = np.unique(np.linspace(0, len(traj) - 1, min(max_frames, len(traj))).astype(int))
     fig, ax = plt.subplots(figsize=(world_width(problem, 6.5), 6.5))
     key = draw_world(ax, problem, safety_zones=False)
-    r = problem.robot.radius
-    sensor = CirclePatch((0, 0), problem.robot.sensor_range or 0.0, fill=False, ls=":",
-                         ec="tab:blue", lw=0.8, zorder=3)  # fmt: skip
-    body = CirclePatch((0, 0), r, color=PATH_COLOUR, alpha=0.6, zorder=6)
-    ax.add_patch(sensor)
-    ax.add_patch(body)
-    (heading,) = ax.plot([], [], "-", color="k", lw=1.2, zorder=7)
-    (trace,) = ax.plot([], [], "-", color=PATH_COLOUR, lw=1.5, zorder=4, label="driven path")
-    (plan_line,) = ax.plot([], [], "--", color=RRT_COLOUR, lw=1.0, zorder=3, label="plan ahead")
-    (cross,) = ax.plot([], [], "x", color="k", ms=9, zorder=7, label="predicted cross point")
-    obstacles = [CirclePatch((0, 0), tr.radius, color=MOVING, alpha=0.7, zorder=5)
-                 for tr in sim.tracks]  # fmt: skip
-    for patch in obstacles:
-        ax.add_patch(patch)
-    detour_lines = [ax.plot([], [], "-", color=DETOUR, lw=1.3, zorder=5)[0] for _ in sim.replans]
-    key += [
-        (Patch(color=PATH_COLOUR, alpha=0.6, label="robot (line: heading)"),
-         Line2D([], [], color="k", lw=1.2)),
-        Line2D([], [], ls=":", color="tab:blue", lw=0.8, label="sensor range"),
-        trace,
-        plan_line,
-    ]  # fmt: skip
-    if sim.tracks:
-        key.append(Patch(color=MOVING, alpha=0.7, label="moving obstacle"))
-    if sim.replans:  # only what the animation will show
-        key += [cross, Line2D([], [], color=DETOUR, lw=1.3, label="detour")]
-    world_legend(ax, key)
-    # The longest title, so that the layout leaves room for every frame's.
-    title = ax.set_title(f"{problem.name}: t = {traj[-1, 0]:5.1f} s, replans {len(sim.replans)}")
-    switch_times = np.array([t for t, _ in sim.plans])
+    scene = _MovingScene(ax, problem, sim)
+    world_legend(ax, key + scene.key())
+    fig.tight_layout()
+    return fig, scene.draw, frames
 
-    def draw(i: int) -> list[Any]:
+
+class _MovingScene:
+    """What moves in :func:`simulation_frames`: the robot (its disc, heading and sensor range),
+    its trace, the plan ahead, the predicted cross point, the detours, the moving obstacles and
+    the title's clock."""
+
+    def __init__(self, ax: Axes, problem: Problem, sim: Any) -> None:
+        self.name, self.sim, self.r = problem.name, sim, problem.robot.radius
+        self.sensor = CirclePatch((0, 0), problem.robot.sensor_range or 0.0, fill=False, ls=":",
+                                  ec="tab:blue", lw=0.8, zorder=3)  # fmt: skip
+        self.body = CirclePatch((0, 0), self.r, color=PATH_COLOUR, alpha=0.6, zorder=6)
+        ax.add_patch(self.sensor)
+        ax.add_patch(self.body)
+        (self.heading,) = ax.plot([], [], "-", color="k", lw=1.2, zorder=7)
+        (self.trace,) = ax.plot([], [], "-", color=PATH_COLOUR, lw=1.5, zorder=4,
+                                label="driven path")  # fmt: skip
+        (self.plan_line,) = ax.plot([], [], "--", color=RRT_COLOUR, lw=1.0, zorder=3,
+                                    label="plan ahead")  # fmt: skip
+        (self.cross,) = ax.plot([], [], "x", color="k", ms=9, zorder=7,
+                                label="predicted cross point")  # fmt: skip
+        self.obstacles = [CirclePatch((0, 0), tr.radius, color=MOVING, alpha=0.7, zorder=5)
+                          for tr in sim.tracks]  # fmt: skip
+        for patch in self.obstacles:
+            ax.add_patch(patch)
+        self.detours = [ax.plot([], [], "-", color=DETOUR, lw=1.3, zorder=5)[0]
+                        for _ in sim.replans]  # fmt: skip
+        # The longest title, so that the layout leaves room for every frame's.
+        t_end = sim.trajectory[-1, 0]
+        self.title = ax.set_title(f"{self.name}: t = {t_end:5.1f} s, replans {len(sim.replans)}")
+        self.switch_times = np.array([t for t, _ in sim.plans])
+
+    def key(self) -> list[Any]:
+        """The legend handles of what moves (only what the animation will show)."""
+        key = [
+            (Patch(color=PATH_COLOUR, alpha=0.6, label="robot (line: heading)"),
+             Line2D([], [], color="k", lw=1.2)),
+            Line2D([], [], ls=":", color="tab:blue", lw=0.8, label="sensor range"),
+            self.trace,
+            self.plan_line,
+        ]  # fmt: skip
+        if self.sim.tracks:
+            key.append(Patch(color=MOVING, alpha=0.7, label="moving obstacle"))
+        if self.sim.replans:
+            key += [self.cross, Line2D([], [], color=DETOUR, lw=1.3, label="detour")]
+        return key
+
+    def draw(self, i: int) -> list[Any]:
+        """Move everything to trajectory sample ``i``; returns the changed artists."""
+        sim, r = self.sim, self.r
+        traj = sim.trajectory
         t, x, y, th = traj[i]
-        body.center = sensor.center = (x, y)
-        heading.set_data([x, x + r * np.cos(th)], [y, y + r * np.sin(th)])
-        trace.set_data(traj[: i + 1, 1], traj[: i + 1, 2])
-        plan = sim.plans[int(np.searchsorted(switch_times, t, side="right")) - 1][1]
+        self.body.center = self.sensor.center = (x, y)
+        self.heading.set_data([x, x + r * np.cos(th)], [y, y + r * np.sin(th)])
+        self.trace.set_data(traj[: i + 1, 1], traj[: i + 1, 2])
+        plan = sim.plans[int(np.searchsorted(self.switch_times, t, side="right")) - 1][1]
         ahead = plan.waypoints_after(t)
-        plan_line.set_data(ahead[:, 0], ahead[:, 1])
+        self.plan_line.set_data(ahead[:, 0], ahead[:, 1])
         live = [rep for rep in sim.replans if rep.t <= t <= rep.t_cross]
         if live:
-            cross.set_data([live[-1].cross_point[0]], [live[-1].cross_point[1]])
+            self.cross.set_data([live[-1].cross_point[0]], [live[-1].cross_point[1]])
         else:
-            cross.set_data([], [])
-        for line, rep in zip(detour_lines, sim.replans, strict=True):
+            self.cross.set_data([], [])
+        for line, rep in zip(self.detours, sim.replans, strict=True):
             if rep.detour is not None and rep.t <= t:
                 line.set_data(*np.asarray(rep.detour).T)
-        for patch, tr in zip(obstacles, sim.tracks, strict=True):
+        for patch, tr in zip(self.obstacles, sim.tracks, strict=True):
             patch.center = tuple(tr.position(t))
-        title.set_text(
-            f"{problem.name}: t = {t:5.1f} s, replans {sum(rep.t <= t for rep in sim.replans)}"
-        )
-        return [body, sensor, heading, trace, plan_line, cross, title, *obstacles, *detour_lines]
-
-    fig.tight_layout()
-    return fig, draw, frames
+        replans = sum(rep.t <= t for rep in sim.replans)
+        self.title.set_text(f"{self.name}: t = {t:5.1f} s, replans {replans}")
+        return [self.body, self.sensor, self.heading, self.trace, self.plan_line, self.cross,
+                self.title, *self.obstacles, *self.detours]  # fmt: skip
 
 
 def animate_simulation(

@@ -2,24 +2,26 @@
 
 from __future__ import annotations
 
+import copy
+import json
 import os
 import shutil
+import subprocess
 import sys
 from pathlib import Path
+
+import numpy as np
+
+from rrtpso_ompl.kinematics import ReferenceCurve
+from rrtpso_ompl.model.problem import Robot
+from rrtpso_ompl.testing import SIMPLE_PROBLEM
 
 REPO = Path(__file__).resolve().parent.parent
 PROBLEMS = REPO / "problems"
 
-#: The single-circle problem of the issue: its shortest path (tangent, arc, tangent) is 647.45.
-SINGLE_CIRCLE = {
-    "name": "single_circle",
-    "units": "cm",
-    "bounds": [[0, 0], [500, 500]],
-    "start": [20, 20],
-    "goal": [450, 450],
-    "robot": {"radius": 28.5},
-    "obstacles": [{"type": "circle", "center": [250, 250], "radius": 80}],
-}
+#: The single-circle problem of the issue: its shortest path (tangent, arc, tangent) is 647.45
+#: (the conformance kit's simple problem, under this name).
+SINGLE_CIRCLE = copy.deepcopy({**SIMPLE_PROBLEM, "name": "single_circle"})
 SINGLE_CIRCLE_OPTIMUM = 647.45
 
 
@@ -27,6 +29,21 @@ def rrtpso_exe() -> list[str]:
     """The installed console script (tests drive the real command, as a user would)."""
     exe = shutil.which("rrtpso", path=os.path.dirname(sys.executable))
     return [exe] if exe else [sys.executable, "-m", "rrtpso_ompl"]
+
+
+def run(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
+    """``rrtpso *args`` in a subprocess, its output captured as text."""
+    return subprocess.run([*rrtpso_exe(), *args], capture_output=True, text=True, timeout=timeout)
+
+
+def _generate_parser():
+    """The parser of ``rrtpso generate`` (its flags are derived from the declared options)."""
+    import argparse
+
+    from rrtpso_ompl.cli.main import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    return sub.choices["generate"]
 
 
 def write_yaml(path: Path, text: str) -> Path:
@@ -80,3 +97,59 @@ def observe(problem, t):
     for j, m in enumerate(problem.moving_obstacles):
         out[j] = (m.position(t), m.velocity, m.radius)
     return out
+
+
+# -- wheels and trajectories (tests/kinematics) ---------------------------------------------
+#: The paper's robot: wheels, track, speed and sample time.
+PAPER_ROBOT = Robot(radius=28.5, wheel_radius=7.6, track_width=38.0, speed=20.0, sample_time=0.15)
+#: Their 500 x 500 cm workspace.
+BOUNDS = ((0.0, 0.0), (500.0, 500.0))
+
+
+def arc_curve(radius: float, angle: float, n: int = 2000) -> ReferenceCurve:
+    """An exact circular arc, counter-clockwise, sampled by arc length."""
+    phi = np.linspace(0.0, angle, n)
+    s = radius * phi
+    return ReferenceCurve(
+        s=s, x=250 + radius * np.sin(phi), y=250 - radius * np.cos(phi), theta=phi,
+        kappa=np.full(n, 1.0 / radius), turns=np.zeros(n), kind="spline", knots=np.zeros((0, 2)),
+    )  # fmt: skip
+
+
+# -- occupancy maps (tests/model, tests/cli) -------------------------------------------------
+def _pgm(path, img: np.ndarray, binary: bool = True, maxval: int = 255) -> None:
+    h, w = img.shape
+    if binary:
+        dtype = ">u2" if maxval > 255 else "u1"
+        path.write_bytes(f"P5\n# c\n{w} {h}\n{maxval}\n".encode() + img.astype(dtype).tobytes())
+    else:
+        rows = "\n".join(" ".join(str(int(v)) for v in row) for row in img)
+        path.write_text(f"P2\n# comment\n{w} {h}\n# another\n{maxval}\n{rows}\n")
+
+
+def _map(tmp_path, img, name="m", image=None, **keys) -> str:
+    """A map YAML next to its image (a PGM unless ``image`` names one already written)."""
+    if image is None:
+        image = f"{name}.pgm"
+        _pgm(tmp_path / image, img)
+    doc = {"image": image, "resolution": 0.5, "origin": [0.0, 0.0, 0.0], "negate": 0,
+           "occupied_thresh": 0.65, "free_thresh": 0.196, **keys}  # fmt: skip
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(json.dumps(doc))  # JSON is YAML
+    return str(path)
+
+
+def _corridor(tmp_path, **problem) -> str:
+    """A 20 x 10-cell map at 0.5 m: walls around, a wall with a gap in the middle, an unknown
+    patch."""
+    img = np.full((10, 20), 254, dtype=np.uint8)
+    img[[0, -1], :] = 0
+    img[:, [0, -1]] = 0
+    img[0:7, 10] = 0  # wall from the top, gap at the bottom
+    img[1:3, 14:17] = 205  # unknown
+    _map(tmp_path, img, name="corridor")
+    doc = {"map": "corridor.yaml", "start": [2.0, 3.0], "goal": [8.0, 2.5],
+           "robot": {"radius": 0.3}, **problem}  # fmt: skip
+    path = tmp_path / "prob.yaml"
+    path.write_text(json.dumps(doc))
+    return str(path)

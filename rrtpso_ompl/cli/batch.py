@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from typing import Any
 
 from .common import (
@@ -18,6 +17,8 @@ from .common import (
     check_run_options,
     note,
     planner_list,
+    report_errors,
+    run_keywords,
 )
 
 __all__ = ["add_parser", "run"]
@@ -72,21 +73,10 @@ def run(args: argparse.Namespace) -> int:
         keep_path=not args.no_path,
     )
     with RunProgress("batch", "rows") as bar:
-        rows = run_batch(
-            tasks,
-            args.out,
-            jobs=args.jobs,
-            resume=args.resume,
-            overwrite=args.overwrite,
-            executor=args.executor,
-            scheduler=args.scheduler,
-            progress=bar.row,
-            on_start=bar.started,
-        )
+        rows = run_batch(tasks, args.out, **run_keywords(args, bar))
     failed = [r for r in rows if not r.solved]
     errors = [r.error for r in rows if r.is_error]
-    for error in errors:
-        print(f"rrtpso: {error}", file=sys.stderr)  # errors, also with -q
+    report_errors(errors)
     note(f"batch: {len(rows)} rows, {len(rows) - len(failed)} solved, {len(errors)} errors -> "
          f"{args.out}")  # fmt: skip
     return EXIT_UNSOLVED if failed else EXIT_OK

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import shlex
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +21,8 @@ from .common import (
     check_run_options,
     note,
     planner_list,
+    report_errors,
+    run_keywords,
 )
 
 __all__ = ["add_parser", "run"]
@@ -90,22 +91,15 @@ def run(args: argparse.Namespace) -> int:
             times=times,
             seed=args.seed,
             params=params,
-            jobs=args.jobs,
-            executor=args.executor,
-            scheduler=args.scheduler,
-            resume=args.resume,
-            overwrite=args.overwrite,
-            progress=bar.row,
-            on_start=bar.started,
             command="rrtpso " + shlex.join(args.argv),
+            **run_keywords(args, bar),
         )
     from ..plotting import plot_bench, save_figure
 
     if result.summary:
         save_figure(plot_bench(result.summary, "ratio"), out / "ratio.png")
         save_figure(plot_bench(result.summary, "success"), out / "success.png")
-    for e in result.errors:
-        print(f"rrtpso: {e}", file=sys.stderr)  # errors, also with -q
+    report_errors(result.errors)
     note(
         f"bench: {len(result.rows)} runs, {len(result.logs)} experiments -> {out}/ "
         f"(benchmark.db, report.md)",

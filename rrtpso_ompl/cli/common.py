@@ -13,7 +13,7 @@ import errno
 import os
 import stat
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -81,6 +81,16 @@ def add_shared_flags(parser: argparse.ArgumentParser) -> None:
 # ----------------------------------------------------------------------------------------------
 # One problem and its planner (solve, simulate)
 # ----------------------------------------------------------------------------------------------
+def add_planner_flags(p: argparse.ArgumentParser, *, planner: str, time: str, param: str) -> None:
+    """``--planner``, ``--time``, ``--seed`` and ``--param``, the flags :func:`choose_planner`
+    resolves against the problem file; ``planner``, ``time`` and ``param`` are their help (what
+    the planner plans and its time is for, in the command's words)."""
+    p.add_argument("--planner", help=planner)
+    p.add_argument("--time", type=float, metavar="SECONDS", help=time)
+    p.add_argument("--seed", type=int, help="random seed (default: the file's planner.seed)")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help=param)
+
+
 def choose_planner(args: argparse.Namespace) -> PlannerRequest:
     """Load ``args.problem`` and resolve ``--planner``, ``--post``/``--simplify``, ``--param``,
     ``--time`` and ``--seed`` against it (:func:`~rrtpso_ompl.planners.request.resolve`).
@@ -417,6 +427,20 @@ def check_run_options(args: argparse.Namespace) -> None:
             raise UsageError(
                 "--executor dask: Dask is not installed: pip install 'rrtpso-ompl[dask]'"
             ) from None
+
+
+def run_keywords(args: argparse.Namespace, bar: RunProgress) -> dict[str, Any]:
+    """The keywords of :func:`~rrtpso_ompl.harness.run_batch` (and ``run_bench``) from the flags
+    of :func:`add_run_options`, with ``bar`` reporting the runs as they start and finish."""
+    return {"jobs": args.jobs, "resume": args.resume, "overwrite": args.overwrite,
+            "executor": args.executor, "scheduler": args.scheduler,
+            "progress": bar.row, "on_start": bar.started}  # fmt: skip
+
+
+def report_errors(errors: Iterable[str]) -> None:
+    """Print each error of a batch or bench to stderr (errors are printed also with ``-q``)."""
+    for error in errors:
+        print(f"rrtpso: {error}", file=sys.stderr)
 
 
 def batch_inputs(items: Sequence[str]) -> list[str]:

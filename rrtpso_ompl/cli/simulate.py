@@ -6,11 +6,14 @@ import argparse
 import math
 from typing import Any
 
+from ..dynamic.options import DynamicOptions
+from ..dynamic.registry import STRATEGY_ENTRY_POINT_GROUP, default_strategies
 from ..errors import UsageError
 from .common import (
     EXIT_OK,
     EXIT_UNSOLVED,
     Output,
+    add_planner_flags,
     check_outputs,
     check_positive_seconds,
     check_seed_flag,
@@ -19,7 +22,27 @@ from .common import (
     progress_bar,
 )
 
-__all__ = ["add_parser", "run"]
+__all__ = ["OPTION_FLAGS", "add_parser", "run"]
+
+#: The ``DynamicOptions`` the command sets, and their flags (``--time`` and ``--planner`` come
+#: from the planner flags; the others keep their declared defaults).
+OPTION_FLAGS = {
+    "planner": "--planner",
+    "strategy": "--strategy",
+    "replan_time": "--replan-time",
+    "reshorten": "--no-reshorten",
+    "initial_time": "--time",
+    "heading_changes": "--heading-changes",
+    "params": "--param",
+}
+
+
+def _help(name: str, default: str | None = None) -> str:
+    """A flag's help: the option's declared documentation and default."""
+    spec = DynamicOptions.PARAMS[name]
+    unit = f" {spec.unit}" if spec.unit and spec.unit != "length" else ""
+    shown = default if default is not None else f"{spec.default}{unit}"
+    return f"{spec.doc} (default: {shown})".replace("%", "%%")
 
 
 def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
@@ -35,54 +58,28 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     m.add_argument("--json", metavar="OUT", help="write the simulation as JSON")
     m.add_argument("--gif", metavar="OUT.gif", help="write an animation")
     m.add_argument("--plot", metavar="OUT.png", help="draw the driven path (paper Fig. 24)")
-    m.add_argument("--seed", type=int, help="random seed (default: the file's planner.seed)")
-    m.add_argument(
-        "--planner",
-        help="planner of the static path and the detours (default: the "
-        "file's planner.type, else RRTstarPSO)",
+    add_planner_flags(
+        m,
+        planner="planner of the static path and the detours (default: the file's planner.type, "
+        "else RRTstarPSO)",
+        time="budget of the initial static path (default: the file's planner.time_limit, else 1.0)",
+        param="planner parameter, repeatable",
     )
-    m.add_argument(
-        "--time",
-        type=float,
-        metavar="SECONDS",
-        help="budget of the initial static path (default: the file's planner.time_limit, else 1.0)",
-    )
-    m.add_argument(
-        "--replan-time",
-        type=float,
-        metavar="SECONDS",
-        help="simulated time one replan takes, split between the two detours (default: "
-        "DynamicOptions.replan_time, see docs/dynamic.md)",
-    )
-    m.add_argument(
-        "--no-reshorten",
-        dest="reshorten",
-        action="store_false",
-        help="contour: keep a detour's bends after the obstacle has passed (default: shortcut "
-        "the rest of the plan once no collision is predicted)",
-    )
+    m.add_argument("--replan-time", type=float, metavar="SECONDS", help=_help("replan_time"))
+    m.add_argument("--no-reshorten", dest="reshorten", action="store_false",
+                   help=_help("reshorten", "on"))  # fmt: skip
+    strategies = default_strategies()
     m.add_argument(
         "--strategy",
-        choices=("contour", "global", "none", "dwa"),
-        default="contour",
-        help="contour: detours up and down around the collision zone, or a wait (the paper); "
-        "global: replan the whole remaining path; none: never replan; dwa: a Dynamic Window "
-        "Approach local planner following the static path (default: contour)",
+        choices=strategies.names(),
+        default=DynamicOptions.PARAMS["strategy"].default,
+        help="; ".join(f"{n}: {strategies.description(n).rstrip('.')}" for n in strategies.names())
+        + f" (default: %(default)s; plugins register through the entry-point group "
+        f"{STRATEGY_ENTRY_POINT_GROUP}, docs/dynamic.md)",
     )
-    m.add_argument(
-        "--heading-changes",
-        type=float,
-        default=0.0,
-        metavar="RATE",
-        help="random heading changes per obstacle per second (default 0: constant velocity)",
-    )
-    m.add_argument(
-        "--param",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="planner parameter, repeatable",
-    )
+    m.add_argument("--heading-changes", type=float, metavar="RATE",
+                   default=DynamicOptions.PARAMS["heading_changes"].default,
+                   help=_help("heading_changes"))  # fmt: skip
     m.set_defaults(func=run)
 
 
@@ -108,12 +105,12 @@ def run(args: argparse.Namespace) -> int:
     ]
     check_outputs(outputs, inputs=problem.inputs)
 
-    from ..dynamic import DynamicOptions, simulate
+    from ..dynamic import simulate
 
     timing = {} if args.replan_time is None else {"replan_time": args.replan_time}
     options = DynamicOptions(
         planner=choice.entry.name,
-        strategy="none" if args.strategy == "dwa" else args.strategy,
+        strategy=args.strategy,
         **timing,
         reshorten=args.reshorten,
         initial_time=args.time,
@@ -128,10 +125,7 @@ def run(args: argparse.Namespace) -> int:
             bar.n = round(t, 1)
             bar.refresh()
 
-        if args.strategy == "dwa":
-            sim = _simulate_dwa(problem, options, seed, choice)
-        else:
-            sim = simulate(problem, options, seed=seed, progress=progress)
+        sim = simulate(problem, options, seed=seed, progress=progress)
     _write_outputs(args, problem, sim)
     verdict = "reached the goal" if sim.reached_goal else f"did not reach the goal ({sim.status})"
     note(
@@ -139,22 +133,6 @@ def run(args: argparse.Namespace) -> int:
         f"time {sim.total_time:.1f}s, length {sim.path_length:.1f}",
     )
     return EXIT_OK if sim.success else EXIT_UNSOLVED
-
-
-def _simulate_dwa(problem: Any, options: Any, seed: int | None, choice: Any) -> Any:
-    """The DWA peer: the static path planned with the chosen planner, then the DWA's guide path
-    (planned again with clearance for it, on the same budget), then the DWA drive."""
-    from ..dynamic.dwa import guide_path, simulate_dwa
-    from ..planners import solve
-
-    budget = options.initial_time
-    static = solve(
-        problem, options.planner, time_limit=budget, seed=seed, params=dict(options.params)
-    )
-    guide = static.path
-    if static.solved:
-        guide = guide_path(problem, static.path, options.planner, static.time, options.params)
-    return simulate_dwa(problem, guide, options=options, seed=seed)
 
 
 def _write_outputs(args: argparse.Namespace, problem: Any, sim: Any) -> None:

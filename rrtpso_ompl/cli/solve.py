@@ -10,6 +10,7 @@ from .common import (
     EXIT_OK,
     EXIT_UNSOLVED,
     Output,
+    add_planner_flags,
     check_outputs,
     choose_planner,
     note,
@@ -26,24 +27,12 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         description="Solve one problem file and report the path.",
     )
     p.add_argument("problem", help="problem file (YAML, see docs/problem-format.md)")
-    p.add_argument(
-        "--planner",
-        help="planner name (default: the file's planner.type, else "
-        "RRTstarPSO); see 'rrtpso planners'",
-    )
-    p.add_argument(
-        "--time",
-        type=float,
-        metavar="SECONDS",
-        help="time limit (default: the file's planner.time_limit, else 1.0)",
-    )
-    p.add_argument("--seed", type=int, help="random seed (default: the file's planner.seed)")
-    p.add_argument(
-        "--param",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="planner parameter, repeatable (e.g. --param swarm_size=50)",
+    add_planner_flags(
+        p,
+        planner="planner name (default: the file's planner.type, else RRTstarPSO); "
+        "see 'rrtpso planners'",
+        time="time limit (default: the file's planner.time_limit, else 1.0)",
+        param="planner parameter, repeatable (e.g. --param swarm_size=50)",
     )
     p.add_argument("--json", metavar="OUT", help="write the result as JSON")
     p.add_argument(
@@ -72,6 +61,12 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         action="store_true",
         help="alias of --post simplify (before any other --post step)",
     )
+    _add_drive_flags(p)
+    p.set_defaults(func=run)
+
+
+def _add_drive_flags(p: argparse.ArgumentParser) -> None:
+    """The flags of driving the path (:func:`_drive`): the wheel commands and their profile."""
     p.add_argument(
         "--trajectory",
         metavar="OUT.csv",
@@ -90,7 +85,6 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         help="velocity profile: the paper's constant robot.speed, or within the robot's "
         "limits from rest to rest (auto: limits when any limit is given)",
     )
-    p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:

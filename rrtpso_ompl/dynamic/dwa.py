@@ -1,104 +1,86 @@
-"""A Dynamic Window Approach (DWA) local planner: the peer robots use today, in the same harness.
+"""A Dynamic Window Approach local planner in the manner of Nav2's DWB controller: the peer.
 
-Fox, Burgard & Thrun's DWA (IEEE RAM 1997), as in ROS ``dwa_local_planner``: every control period
-the robot picks a pair of linear and angular velocities ``(v, w)`` from the *dynamic window*, the
-velocities reachable within one period under its acceleration limits (and its wheel-speed limit
-``|v| + |w| L / 2 <= v_w``). Each pair is rolled out as a circular arc over a horizon; arcs that
-come too close to a static obstacle or to a sensed moving obstacle's constant-velocity
-prediction (the same prediction the replanning manager uses) are inadmissible; among the rest the
-robot takes the best of
+Robots in the field mostly avoid moving obstacles with a local planner that follows a global
+path, not by replanning it. :class:`DWAController` is that planner, built as Nav2's DWB
+(``dwb_core`` + ``dwb_critics``) is, on exact geometry:
 
-- **path**: how close the arc's end comes to a *carrot*, the point of the guide path (the static
-  path) a fixed look-ahead beyond the robot's progress along it;
-- **clearance**: the least distance to any obstacle along the arc, capped;
+- **the plan**: a *guide path* from the project's static planner, planned with clearance
+  (:func:`guide_path`), of which every period only a *local plan* is used: from a little behind
+  the robot's progress along it to ``prune_distance`` ahead (DWB's pruned, shortened plan);
+- **the trajectories**: ``(v, w)`` pairs sampled across the *dynamic window* (the velocities
+  reachable within one period under the acceleration limits; ``|v| + |w| L / 2 <= v_w``; up to
+  ``reverse * v_max`` backwards), each rolled out as an exact arc over ``sim_time``;
+- **admissibility** (hard, classic DWA): the robot must be able to brake to a stop after the
+  period along the arc (both velocities ramped down together, so it stays on the arc) before it
+  meets a static obstacle or leaves the bounds, checked exactly on chords padded by the arc's
+  sagitta. The command that brakes along the current arc is always among the samples, and its
+  stop lies on the stop the last command was admitted with: some command is always admissible,
+  and the robot is never driven into a static obstacle that a stop could avoid;
+- **safety** against the sensed moving obstacles, predicted at constant velocity over
+  ``obstacle_time`` (longer than ``sim_time``: an obstacle overtaking the robot is seen coming):
+  a trajectory is safe when stopping, or driving on (straight at full speed after ``sim_time``),
+  keeps ``SR + SO + margin / 2`` from every prediction, exactly on each chord of the relative
+  motion;
+- **critics** (lower is better, weighted; distances in robot radii), over the safe
+  trajectories, at the trajectory's end (the last free point when it meets a static obstacle)
+  and at a point ``forward_point`` ahead of it: ``PathDist`` and ``PathAlign`` (distance to the
+  local plan), ``GoalDist`` and ``GoalAlign`` (distance to the local plan's end), all measured
+  through free space round the static world and the obstacles sensed now (Nav2's costmap with
+  its obstacle layer; :class:`~rrtpso_ompl.dynamic.navgrid.NavGrid`, DWB's map-grid critics,
+  exact where nothing is in the way), the align critics off near the goal, and ``GoalDist``
+  rewarding an early arrival when the local plan ends at the goal; ``Obstacle``: an
+  inflation-like cost of the least clearance to the static world and to the predicted moving
+  obstacles; ``PreferForward``: a penalty for driving backwards; ``Oscillation``: after the sign
+  of ``v`` (or of ``w`` while nearly stopped) flipped, commands flipping it back are refused
+  until the robot has moved ``oscillation_distance`` or turned ``oscillation_angle``;
+- **rotate to the path**: nearly stopped and facing more than ``rotate_threshold_deg`` away from
+  the local plan, the robot turns in place first (Nav2's rotation shim); the problems have no goal
+  heading, so there is no rotation at the goal;
+- **recovery** (Nav2's behaviour tree): when the robot has not moved ``progress_distance`` in
+  ``progress_time`` (the progress checker) it re-plans the guide path from where it stands on
+  the grid (Nav2's NavFn) and backs up for ``backup_time``; when it has left the reach of the
+  local plan's field it re-plans; at most ``max_recoveries`` times;
+- **no safe trajectory** (a predicted obstacle will come too close whatever the robot does):
+  the admissible command whose better continuation (stop or drive on) comes least close, of
+  those the one that meets the obstacle last.
 
-an arc is admissible when the robot can brake to a stop before it meets a static obstacle
-(classic DWA; it then rests at the last free point) and no sensed obstacle's prediction comes
-within the contact distance over the horizon;
-- **speed**: closeness to the wanted speed (full speed, slowing down to stop at the goal).
-
-When no arc is admissible (an obstacle will hit the robot whatever it does within the horizon) it
-takes the arc that comes least close (the one that gets out of the way most). Everything is
-vectorised over all arcs and horizon steps. The executed motion is integrated exactly on arcs
-(knots every ``sample_time / SUBSTEPS``), then measured by the same code as the replanning
-strategies, and its static validity is checked exactly (DWA, unlike a planner, can clip a static
-obstacle).
+Everything is vectorised over samples, horizon steps and obstacles (the static checks through
+the :class:`~rrtpso_ompl.model.world.World`'s spatial index). :func:`simulate_dwa` runs it in
+:func:`~rrtpso_ompl.dynamic.local.simulate_local`, the harness of every local controller.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass, fields
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
+from ..model.geometry import cumulative_length, point_segment_distance, wrap_angle
 from ..model.problem import PlannerConfig, Problem
 from ..model.world import World
-from .motion import Motion, ObstacleTrack
-from .simulation import (
-    MAX_STEPS,
+from .dwa_params import DWAParams
+from .local import simulate_local
+from .motion import arc_position
+from .navgrid import NavGrid
+from .options import (
     DynamicOptions,
-    SimulationResult,
-    _check_steps,
-    _measure,
-    _no_static_path,
-    _Robot,
-    _sense,
-    _turn_at_random,
+    Observations,
+    RobotModel,
+    RobotState,
+    default_margin,
+    goal_tolerance,
 )
+from .result import SimulationResult
 
-__all__ = ["CARROT_SAMPLES", "SUBSTEPS", "DWAParams", "guide_path", "simulate_dwa"]
+__all__ = ["DWAController", "DWAParams", "guide_path", "simulate_dwa"]
 
-#: Knots per control period of the executed motion (the arc between knots is replaced by its
-#: chord: at most ``v dt^2 w / 8`` off, 0.003 cm for the paper's robot).
-SUBSTEPS = 5
-
-#: Points of the guide path tried as the carrot, every control period.
-CARROT_SAMPLES = 16
-
-
-@dataclass(frozen=True)
-class DWAParams:
-    """The DWA's parameters (units of the problem, seconds, radians).
-
-    Attributes
-    ----------
-    horizon : float
-        Roll-out time of each arc, s.
-    v_samples, w_samples : int
-        Linear and angular velocities sampled across the dynamic window.
-    accel_time : float
-        Time to reach full speed (or full turn rate) from rest, s: sets the acceleration limits
-        ``v_max / accel_time`` and ``w_max / accel_time``.
-    lookahead : float
-        Carrot distance along the guide path beyond the robot's progress, in robot radii beyond
-        the longest arc (``v_max * horizon``).
-    weight_path, weight_clearance, weight_speed : float
-        Weights of the three terms (each normalised to [0, 1]).
-    clearance_cap : float
-        Clearance beyond which it no longer scores, in robot radii.
-    """
-
-    horizon: float = 4.0
-    v_samples: int = 7
-    w_samples: int = 15
-    accel_time: float = 0.3
-    lookahead: float = 1.0
-    weight_path: float = 1.0
-    weight_clearance: float = 0.4
-    weight_speed: float = 0.3
-    clearance_cap: float = 1.0
-
-    def __post_init__(self) -> None:
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if not (math.isfinite(value) and value >= 0):
-                raise ValueError(f"DWAParams.{f.name} must be a finite number >= 0, got {value}")
-        if self.v_samples < 2 or self.w_samples < 2 or self.v_samples * self.w_samples > 10_000:
-            raise ValueError("DWAParams: 2 to 10,000 samples per axis product are needed")
-        if not (self.horizon > 0 and self.accel_time > 0):
-            raise ValueError("DWAParams.horizon and accel_time must be > 0")
+#: Least cost of an inadmissible-by-prediction drive, as a multiple of the obstacle weight:
+#: the exponential obstacle cost is capped there.
+_MAX_OBSTACLE_COST = 20.0
 
 
 def simulate_dwa(
@@ -107,6 +89,7 @@ def simulate_dwa(
     params: DWAParams | None = None,
     options: DynamicOptions | None = None,
     seed: int | None = None,
+    progress: Callable[[float, float], None] | None = None,
 ) -> SimulationResult:
     """Drive the robot with the DWA along ``guide_path`` among the problem's moving obstacles.
 
@@ -116,48 +99,30 @@ def simulate_dwa(
         As for :func:`~rrtpso_ompl.dynamic.simulate` (``robot.speed``, ``sample_time``,
         ``sensor_range``; the turn rate from ``track_width``).
     guide_path : (n, 2) array
-        The static path to follow (units).
+        The path to follow (units), e.g. from :func:`guide_path`.
     params : DWAParams, optional
     options : DynamicOptions, optional
-        Only ``margin``, ``max_time``, ``heading_changes`` and ``heading_change_deg`` are used
-        (the same obstacles, the same random turns as :func:`simulate` with the same seed).
+        ``margin``, ``max_time``, ``heading_changes`` and ``heading_change_deg`` are used (the
+        same obstacles, the same random turns as :func:`~rrtpso_ompl.dynamic.simulate` with
+        the same seed).
     seed : int, optional
-        Seeds the obstacles' random heading changes exactly as :func:`simulate` does.
+        Seeds the obstacles' random heading changes as :func:`~rrtpso_ompl.dynamic.simulate`
+        does.
+    progress : callable, optional
+        Called as ``progress(t, t_max)`` after every step.
 
     Returns
     -------
     SimulationResult
-        ``strategy="dwa"``; ``status`` says when the robot clipped a static obstacle.
+        ``strategy="dwa"``, ``planner="DWA"``; ``status`` says when the robot clipped a static
+        obstacle.
     """
-    params = params or DWAParams()
     options = options or DynamicOptions()
-    robot = _Robot.of(problem)
-    options_dwa = dataclasses.replace(options, strategy="none", planner="DWA")
     path = np.asarray(guide_path, dtype=float).reshape(-1, 2)
-    tracks = [ObstacleTrack.from_obstacle(m) for m in problem.moving_obstacles]
-    if len(path) < 2:
-        return _no_static_path(problem, options_dwa, seed, robot, path, tracks)
-    radii = [m.radius for m in problem.moving_obstacles]
-    margin = options.margin
-    if margin is None:
-        margin = 0.1 * (robot.radius + min(radii, default=0.0))
-    _, world_rng = np.random.default_rng(seed).spawn(2)
-    seg = np.hypot(*np.diff(path, axis=0).T)
-    t_max = options.max_time if options.max_time is not None else 4 * seg.sum() / robot.speed + 60
-    _check_steps(t_max, robot.sample_time)
-    world = World.from_problem(problem)
-    dwa = _DWA(problem, robot, params, world, path, margin)
-    motion, reached = dwa.drive(tracks, options, t_max, world_rng)
-    # The driven motion is the only "plan" a local planner has (the animation draws it ahead).
-    plans = [(0.0, motion)]
-    result = _measure(problem, options_dwa, seed, robot, motion, reached, path, tracks, [], plans)
-    result.strategy = "dwa"
-    result.planner = "DWA"
-    # Unlike a planned path, DWA's arcs are not checked exactly before they are driven.
-    free = world.segments_free(motion.xy[:-1], motion.xy[1:])
-    if not (free.all() and world.points_in_bounds(motion.xy).all()):
-        result.status = "clipped a static obstacle or left the bounds"
-    return result
+    controller = None
+    if len(path) >= 2:
+        controller = DWAController(problem, path, params, options.margin)
+    return simulate_local(problem, controller or _NoController(), path, options, seed, progress)
 
 
 def guide_path(
@@ -171,9 +136,9 @@ def guide_path(
     ``time_limit`` s) for a robot larger by 10 % of SR plus half a control period's travel
     (``v_max * sample_time / 2``); ``static_path`` when that problem has no solution.
 
-    A shortest path touches obstacles (zero clearance): a DWA, whose sampled arcs and clearance
-    term keep it off the obstacles, cannot follow it there and crawls. OMPL is not reseeded here
-    (give ``params={"seed": ...}``).
+    A shortest path touches obstacles (zero clearance), and a local planner that keeps off the
+    obstacles cannot follow it there; the inflation is Nav2's inflated costmap under the global
+    planner. OMPL is not reseeded here (give ``params={"seed": ...}``).
     """
     from ..planners import solve
 
@@ -187,197 +152,485 @@ def guide_path(
     return res.path if res.solved else np.asarray(static_path, dtype=float)
 
 
-class _DWA:
-    """The controller's state: the robot's velocities and its progress along the guide path."""
+class _NoController:
+    """Stands in when there is no guide path: the harness reports "no static path"."""
 
-    def __init__(self, problem, robot, params: DWAParams, world, path, margin) -> None:
-        self.p = params
-        self.robot = robot
-        self.world = world
-        self.path = path
+    name = "DWA"
+
+    def reset(self, xy, theta) -> None:  # pragma: no cover - never driven
+        pass
+
+    def step(self, state, obstacles, t) -> tuple[float, float]:  # pragma: no cover
+        return 0.0, 0.0
+
+
+@dataclass
+class _Trend:
+    """The sign history of one velocity (DWB's oscillation critic): after a flip, the other
+    sign is refused until the robot has moved or turned enough."""
+
+    sign: int = 0
+    refused: int = 0  # the sign refused since the last flip (0: none)
+
+    def update(self, value: float) -> bool:
+        s = int(np.sign(value))
+        flipped = s != 0 and self.sign != 0 and s != self.sign
+        if flipped:
+            self.refused = self.sign
+        if s != 0:
+            self.sign = s
+        return flipped
+
+    def refuses(self, values: np.ndarray) -> np.ndarray:
+        return np.sign(values) == self.refused if self.refused else np.zeros(len(values), bool)
+
+
+@dataclass
+class Evaluation:
+    """The scored samples of one control period (kept for tests and diagnostics).
+
+    ``v``, ``w``: the sampled commands; ``admissible``: a stop after the period keeps off the
+    static world; ``safe``: admissible and not heading into a predicted moving obstacle;
+    ``cost``: the critics' total (``inf`` where not scored); ``d_go``, ``d_stop``: the least
+    margin to the predicted moving obstacles driving on and stopping; ``chosen``: the index taken;
+    ``mode``: ``"critics"``, ``"rotate"``, ``"backup"`` or ``"unavoidable"``.
+    """
+
+    v: np.ndarray
+    w: np.ndarray
+    admissible: np.ndarray
+    safe: np.ndarray
+    cost: np.ndarray
+    d_go: np.ndarray
+    d_stop: np.ndarray
+    chosen: int
+    mode: str
+
+
+class _StaticCheck(NamedTuple):
+    """The static world's verdict on the sampled commands (see :meth:`DWAController.
+    _static_check`)."""
+
+    admissible: np.ndarray  # (m,) a stop after the period keeps off the static world
+    k_s: np.ndarray  # (m,) index of the first roll-out step that meets it (n: none)
+    go: np.ndarray  # (m, n, 2) the roll-outs, held at their last free point
+    reached: np.ndarray  # (m,) how long each roll-out drives, s
+    clear_static: np.ndarray  # (m,) least clearance to the static world, units
+
+
+class DWAController:
+    """The DWB-like controller (see the module doc); a :class:`~rrtpso_ompl.dynamic.local.
+    LocalController`.
+
+    Parameters
+    ----------
+    problem : Problem
+        The robot's limits, the static world, the goal.
+    guide : (n, 2) array
+        The guide path (units), from the start to the goal.
+    params : DWAParams, optional
+    margin : float or None
+        Extra separation kept from moving obstacles beyond ``SR + SO`` (half of it is the
+        prediction's threshold, as for the replanning strategies); default 10 % of ``SR + SO``
+        of the smallest obstacle.
+    """
+
+    name = "DWA"
+
+    def __init__(
+        self,
+        problem: Problem,
+        guide: np.ndarray,
+        params: DWAParams | None = None,
+        margin: float | None = None,
+    ) -> None:
+        self.p = p = params or DWAParams()
+        self.robot = robot = RobotModel.of(problem)
+        self.world = World.from_problem(problem)
         self.goal = np.asarray(problem.goal, dtype=float)
-        self.margin = margin
+        self.margin = default_margin(problem, margin)
+        sr = robot.radius
+        self.sr = sr
+        self.dt = dt = robot.sample_time
+        self.v_max = robot.speed
+        self.w_max = robot.turn_rate if robot.turn_rate else 4.0 * math.pi
+        self.half_track = 0.5 * (robot.track_width or 0.0)
+        self.acc = self.v_max / p.accel_time
+        self.alpha = self.w_max / p.accel_time
+        self.v_min = -p.reverse * self.v_max
+        # Every braking arc (one period, then at most accel_time ramping down) lies within the
+        # roll-out, so admissibility is decided on it.
+        horizon = max(p.sim_time, dt + 0.5 * p.accel_time)
+        self.t_roll = dt * np.arange(1, math.ceil(horizon / dt - 1e-9) + 1)
+        ahead = max(horizon, p.obstacle_time)
+        self.t_pred = dt * np.arange(1, math.ceil(ahead / dt - 1e-9) + 1)
+        self.forward = p.forward_point * sr
+        self.goal_tolerance = goal_tolerance(robot)
+        self.grid = NavGrid(self.world, sr, p.resolution * sr)
+        reach = self.v_max * self.t_roll[-1] + self.forward
+        #: How far beyond the local plan the distance fields are computed.
+        self.path_limit = reach + 4.0 * sr
+        self.goal_limit = p.prune_distance * sr + reach + 4.0 * sr
+        self.recoveries: list[tuple[float, str]] = []
+        self.last: Evaluation | None = None
+        self._set_guide(np.asarray(guide, dtype=float).reshape(-1, 2))
+        self.reset(self.guide[0], 0.0)
+
+    # -- LocalController ------------------------------------------------------------------------
+    def reset(self, xy: np.ndarray, theta: float) -> None:
+        """Start a run at ``xy``: progress, oscillation, progress checker and recoveries."""
+        self.progress = 0.0
+        self._v_trend, self._w_trend = _Trend(), _Trend()
+        self._flip_pose = (np.asarray(xy, dtype=float).copy(), float(theta))
+        self._checkpoint: tuple[float, np.ndarray] | None = None
+        self._backup_until = -math.inf
+        self._track(np.asarray(xy, dtype=float))
+
+    def step(self, state: RobotState, obstacles: Observations, t: float) -> tuple[float, float]:
+        """The command for the period from ``t`` (see the module doc)."""
+        x = np.asarray(state.xy, dtype=float)
+        self._track(x)
+        self._check_progress(x, t)
+        pd, gd = self._fields(obstacles)
+        if self._off_plan(x) and self._recover(t, x, "left the plan"):
+            pd, gd = self._fields(obstacles)
+        ev = self._evaluate(x, state.theta, state.v, state.w, obstacles, pd, gd, t)
+        self.last = ev
+        v, w = float(ev.v[ev.chosen]), float(ev.w[ev.chosen])
+        self._debrief(v, w, x, state.theta)
+        return v, w
+
+    # -- the plan -------------------------------------------------------------------------------
+    def _set_guide(self, path: np.ndarray) -> None:
+        self.guide = path
         seg = np.diff(path, axis=0)
         self.seg = seg
         self.seg_len = np.hypot(*seg.T)
-        self.s_at = np.concatenate([[0.0], np.cumsum(self.seg_len)])
-        self.v_max = robot.speed
-        self.w_max = robot.turn_rate if robot.turn_rate else 4.0 * math.pi
-        self.wheel = problem.robot.max_wheel_speed or problem.robot.speed
-        self.half_track = 0.5 * (problem.robot.track_width or 0.0)
+        self.s_at = cumulative_length(path)
         self.progress = 0.0
-        # The carrot lies beyond the longest arc, so that the heading term never asks a fast
-        # arc to turn back to a carrot it has already passed.
-        self.carrot_distance = self.v_max * params.horizon + params.lookahead * robot.radius
-        dt = robot.sample_time
-        self.n_steps = max(1, math.ceil(params.horizon / dt))
-        self.t_roll = dt * np.arange(1, self.n_steps + 1)
-        # Samples are h = v dt apart along an arc: passing a convex obstacle of radius >= SR
-        # between two of them, the disc can go deeper than at either by at most the sagitta
-        # (h/2)^2 / (2 SR). (Relative to a moving obstacle the relative motion is what counts:
-        # half of both speeds times dt, see _dynamic_clearance.)
-        self.static_pad = (0.5 * self.v_max * dt) ** 2 / (2.0 * robot.radius)
+        self._guide_version = getattr(self, "_guide_version", -1) + 1
+        self._field_key: tuple | None = None
 
-    # -- the control loop --------------------------------------------------------------------------
-    def drive(self, tracks, options, t_max, world_rng) -> tuple[Motion, bool]:
-        dt = self.robot.sample_time
-        x = self.path[0].copy()
-        th = math.atan2(*self.seg[0][::-1])
-        v = w = 0.0
-        ts, xs, ths = [0.0], [x.copy()], [th]
-        change_p = options.heading_changes * dt
-        tol = max(self.v_max * dt, 0.1 * self.robot.radius)
-        reached = False
-        k = 0
-        while k * dt <= t_max and k < MAX_STEPS:
-            t = k * dt
-            if math.dist(x, self.goal) <= tol and self._straight_free(x, self.goal):
-                # Within one control period (or SR/10) of the goal: drive the last chord in.
-                d = math.dist(x, self.goal)
-                ts.append(t + d / self.v_max)
-                xs.append(self.goal.copy())
-                ths.append(th)
-                reached = True
-                break
-            obs = _sense(x, tracks, t, self.robot.sensor_range)
-            v, w = self.choose(x, th, v, w, obs)
-            for j in range(1, SUBSTEPS + 1):
-                tau = dt * j / SUBSTEPS
-                xs.append(_arc(x, th, v, w, tau))
-                ths.append(th + w * tau)
-                ts.append(t + tau)
-            x, th = xs[-1].copy(), ths[-1]
-            self._advance(x)
-            k += 1
-            if change_p > 0:
-                _turn_at_random(tracks, k * dt, change_p, options.heading_change_deg, world_rng)
-        return Motion(np.array(ts), np.array(xs), np.array(ths)), reached
+    def _point_at(self, s: np.ndarray) -> np.ndarray:
+        return np.column_stack([np.interp(s, self.s_at, self.guide[:, 0]),
+                                np.interp(s, self.s_at, self.guide[:, 1])])  # fmt: skip
 
-    def choose(self, x, th, v, w, obs) -> tuple[float, float]:
-        """The best admissible ``(v, w)`` of the dynamic window (see the module doc)."""
-        p = self.p
-        dt = self.robot.sample_time
-        dv = self.v_max / p.accel_time * dt
-        dw = self.w_max / p.accel_time * dt
-        vs = np.linspace(max(0.0, v - dv), min(self.v_max, v + dv), p.v_samples)
-        ws = np.linspace(max(-self.w_max, w - dw), min(self.w_max, w + dw), p.w_samples)
+    def _track(self, x: np.ndarray) -> None:
+        """Progress along the guide: its point nearest the robot, never back and never more than
+        a little beyond one period's travel ahead at once (a point of the path behind a wall
+        must not pull the progress through it)."""
+        rel = x[None, :] - self.guide[:-1]
+        u = np.clip(np.einsum("ij,ij->i", rel, self.seg) / np.maximum(self.seg_len**2, 1e-300),
+                    0.0, 1.0)  # fmt: skip
+        ahead = 2.0 * self.v_max * self.dt + 2.0 * self.sr
+        # Each segment's nearest point, moved into the window where the window cuts the
+        # segment (along a segment the distance is convex, so that is the window's nearest).
+        s = np.clip(self.s_at[:-1] + u * self.seg_len, self.progress, self.progress + ahead)
+        d = np.hypot(*(self._point_at(s) - x).T)
+        self.progress = max(self.progress, float(s[np.argmin(d)]))
+
+    def _fields(self, obstacles: Observations) -> tuple[np.ndarray, np.ndarray]:
+        """The distance fields of the local plan (PathDist) and of its end (GoalDist), round
+        the static world and the sensed obstacles where they are now (Nav2's costmap with its
+        obstacle layer)."""
+        # Recomputed once the progress has moved on by SR (every few periods), or when
+        # obstacles are sensed: the local plan starts up to 3 SR behind the progress and ends
+        # up to SR short of prune_distance.
+        sr = self.sr
+        q = math.floor(self.progress / sr)
+        discs = None
+        if obstacles:
+            discs = np.array([(*o[0], sr + o[2] + 0.5 * self.margin) for o in obstacles.values()])
+        key = (q, self._guide_version, None if discs is None else discs.tobytes())
+        if key != self._field_key:
+            lo = max(0.0, (q - 2) * sr)
+            hi = min(self.s_at[-1], (q + self.p.prune_distance) * sr)
+            s = np.linspace(lo, hi, max(2, math.ceil((hi - lo) / (0.5 * self.grid.h)) + 1))
+            local = self._point_at(s)
+            self._pd = self.grid.field(local, self.path_limit, discs)
+            self._gd = self.grid.field(local[-1:], self.goal_limit, discs)
+            inner = (self.s_at > lo) & (self.s_at < hi)
+            self._local = np.vstack([local[:1], self.guide[inner], local[-1:]])
+            self._local_end = hi
+            self._field_key = key
+        return self._pd, self._gd
+
+    def _off_plan(self, x: np.ndarray) -> bool:
+        """Whether the robot is beyond the reach of the PathDist field."""
+        a, b = self._local[:-1], self._local[1:]
+        near = float(point_segment_distance(x[None], a, b).min())
+        return near > self.path_limit - self.v_max * self.t_roll[-1] - self.forward
+
+    def _path_distance(self, pd: np.ndarray, pts: np.ndarray) -> np.ndarray:
+        """PathDist at ``pts``: distance to the local plan through free space, units."""
+        a, b = self._local[:-1], self._local[1:]
+        direct = point_segment_distance(pts[:, None], a[None], b[None]).min(axis=1)
+        return self.grid.value(pd, pts, direct)
+
+    def _goal_distance(self, gd: np.ndarray, pts: np.ndarray) -> np.ndarray:
+        """GoalDist at ``pts``: distance to the local plan's end through free space, units."""
+        return self.grid.value(gd, pts, np.hypot(*(pts - self._local[-1]).T))
+
+    # -- scoring --------------------------------------------------------------------------------
+    def _window(self, v0: float, w0: float) -> tuple[np.ndarray, np.ndarray]:
+        """The sampled commands: a grid over the dynamic window plus zero, the current
+        velocities and the command that brakes along the current arc."""
+        p, dt = self.p, self.dt
+        vlo, vhi = max(self.v_min, v0 - self.acc * dt), min(self.v_max, v0 + self.acc * dt)
+        wlo, whi = max(-self.w_max, w0 - self.alpha * dt), min(self.w_max, w0 + self.alpha * dt)
+        vs = np.linspace(vlo, vhi, p.v_samples)
+        ws = np.linspace(wlo, whi, p.w_samples)
+        vs = np.unique(np.concatenate([vs, [min(max(0.0, vlo), vhi), min(max(v0, vlo), vhi)]]))
+        ws = np.unique(np.concatenate([ws, [min(max(0.0, wlo), whi), min(max(w0, wlo), whi)]]))
         V, W = (a.ravel() for a in np.meshgrid(vs, ws))
-        ok = np.abs(V) + np.abs(W) * self.half_track <= self.wheel * (1 + 1e-9)
-        if not ok.any():  # the window lies beyond the wheel limit: slow down
-            ok = np.isclose(V, V.min())
+        ok = np.abs(V) + np.abs(W) * self.half_track <= self.robot.wheel_speed * (1 + 1e-9)
         V, W = V[ok], W[ok]
-        n = self.n_steps
-        pts = _arc(x, th, V[:, None], W[:, None], self.t_roll[None, :])  # (m, n, 2)
-        static = self._static_clearance(pts)  # (m, n): distance beyond contact, units
-        s_hit = static < 0
-        k_s = np.where(s_hit.any(axis=1), s_hit.argmax(axis=1), n)
-        # Classic DWA admissibility towards static obstacles: the robot can still brake to a
-        # stop before the first contact after one more control period (t_free >= V/2a + dt),
-        # and then stays at the last free roll-out point, where a moving obstacle may still
-        # reach it.
-        a = self.v_max / p.accel_time
-        t_free = np.where(k_s == n, np.inf, np.where(k_s > 0, self.t_roll[k_s - 1], 0.0))
-        static_ok = (k_s == n) | (t_free >= V / (2.0 * a) + dt - 1e-12)
-        idx = np.minimum(np.arange(n)[None, :], k_s[:, None] - 1)
-        held = np.take_along_axis(pts, np.maximum(idx, 0)[..., None], axis=1)
-        pts = np.where((idx >= 0)[..., None], held, x)
-        static = np.where(idx >= 0, np.take_along_axis(static, np.maximum(idx, 0), axis=1),
-                          self._static_clearance(x[None, None])[0, 0])  # fmt: skip
-        dyn = self._dynamic_clearance(pts, obs)
-        clear = np.minimum(static, dyn)
-        hit = dyn < 0
-        safe = static_ok & ~hit.any(axis=1)
-        first_hit = np.where(hit.any(axis=1), hit.argmax(axis=1), n)
-        cap = p.clearance_cap * self.robot.radius
-        carrot = self._carrot(x)
-        # How near the arc comes to the carrot (not where it ends: an arc through the goal at
-        # full speed is as good as one that stops on it).
-        reach = self.v_max * p.horizon + 1e-9
-        near = np.hypot(*(pts - carrot).transpose(2, 0, 1)).min(axis=1)
-        # ... and whether it ends facing the carrot (the classic DWA heading term), which is
-        # what turns the robot back after it has dodged away.
-        end = pts[:, -1]
-        bearing = np.arctan2(carrot[1] - end[:, 1], carrot[0] - end[:, 0])
-        heading = th + W * np.minimum(t_free, p.horizon)
-        off = np.abs(np.angle(np.exp(1j * (bearing - heading))))
-        off = np.where(np.hypot(*(carrot - end).T) < self.robot.radius, 0.0, off)
-        path_term = 0.5 * (1.0 - np.minimum(near / reach, 1.0)) + 0.5 * (1.0 - off / math.pi)
-        clear_term = np.minimum(clear.min(axis=1), cap) / cap
-        d_goal = math.dist(x, self.goal)
-        # Slow down over the last second to the goal (arriving at full speed, the robot orbits it).
-        v_want = min(self.v_max, d_goal / 1.0)
-        speed_term = 1.0 - np.abs(V - v_want) / self.v_max
-        score = p.weight_path * path_term + p.weight_clearance * clear_term
-        score = score + p.weight_speed * speed_term
-        if safe.any():
-            i = int(np.argmax(np.where(safe, score, -np.inf)))
-        else:
-            # Every arc meets something within the horizon: the one that comes least close (the
-            # one that moves out of the way most), on a tie the one whose contact comes latest.
-            least = np.round(clear.min(axis=1), 6)
-            i = int(np.lexsort((-first_hit, -least, ~static_ok))[0])
-        return float(V[i]), float(W[i])
+        t_b = max(abs(v0) / self.acc, abs(w0) / self.alpha)
+        keep = max(0.0, 1.0 - dt / t_b) if t_b > 0 else 0.0
+        return np.append(V, v0 * keep), np.append(W, w0 * keep)
 
-    # -- pieces ------------------------------------------------------------------------------------
-    def _static_clearance(self, pts) -> np.ndarray:
-        """Margin left to the static obstacles and the bounds at each point (negative: too
-        close), units; ``pts`` is ``(..., 2)``."""
-        sr = self.robot.radius
-        flat = pts.reshape(-1, 2)
-        static = self.world.point_clearance(flat, cap=sr + self.static_pad + 1.0)
-        clear = static - sr - self.static_pad
+    def _evaluate(self, x, th, v0, w0, obstacles, pd, gd, t) -> Evaluation:
+        """Roll out the dynamic window's commands, check them against the static world and the
+        predicted moving obstacles, score the safe ones and choose (see the module doc)."""
+        V, W = self._window(v0, w0)
+        go, stop, tau_stop = self._rollouts(x, th, V, W)
+        static = self._static_check(x, V, W, go, tau_stop)
+        # Moving obstacles, predicted at constant velocity: the first predicted contact and the
+        # least margin, driving on (straight on after the roll-out, unless it met the static
+        # world) and stopping.
+        heading = th + W * static.reached
+        drive = self._drive_on(static.go, heading, V, static.k_s)
+        (ttc_go, d_go), (ttc_stop, d_stop) = (
+            self._dynamic_clearance(x, traj, V, obstacles) for traj in (drive, stop)
+        )
+        safe = static.admissible & (np.isinf(ttc_go) | np.isinf(ttc_stop))
+        cost = self._critics(x, V, static, heading, d_go, pd, gd)
+        choice, mode = self._choose(x, th, v0, t, V, W, safe, cost, static, (ttc_go, ttc_stop),
+                                    (d_go, d_stop))  # fmt: skip
+        return Evaluation(V, W, static.admissible, safe, np.where(safe, cost, np.inf), d_go,
+                          d_stop, choice, mode)  # fmt: skip
+
+    def _rollouts(self, x, th, V, W) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(go, stop, tau_stop)``: driving on, the arc for the whole roll-out (``(m, n, 2)``);
+        stopping, the period then both velocities ramped down together in ``t_b`` (the same
+        arc, at the position reached by then), over the prediction's horizon; and the time
+        from now to the stop, s."""
+        dt = self.dt
+        go = arc_position(x, th, V[:, None], W[:, None], self.t_roll[None, :])
+        t_b = np.maximum(np.abs(V) / self.acc, np.abs(W) / self.alpha)
+        tb = t_b[:, None]
+        after = np.clip(self.t_pred[None, :] - dt, 0.0, tb)
+        ramp = np.where(tb > 0, after - after**2 / (2.0 * np.where(tb > 0, tb, 1.0)), 0.0)
+        tau = np.minimum(self.t_pred[None, :], dt) + ramp
+        stop = arc_position(x, th, V[:, None], W[:, None], tau)
+        return go, stop, dt + 0.5 * t_b
+
+    def _static_check(self, x, V, W, go, tau_stop) -> _StaticCheck:
+        """Admissibility (a stop keeps off the static world and in the bounds), each roll-out
+        cut at its last free point, and the least clearance to the static world."""
+        p, dt, sr, t_roll = self.p, self.dt, self.sr, self.t_roll
+        m, n = len(V), len(t_roll)
+        # Static world: exact distance of each chord of the roll-out, less the arc's sagitta
+        # (once for the chord of the roll-out, once for the executed motion's own chords).
+        pad = 0.25 * np.abs(V) * np.abs(W) * dt**2 + self.world.tol
+        start = np.concatenate([np.broadcast_to(x, (m, 1, 2)), go[:, :-1]], axis=1)
+        # One query for the chords and the robot's own position (beyond the cap the obstacle
+        # cost is below exp(-3)).
+        cap = sr + 3.0 * p.inflation * sr
+        a = np.concatenate([start.reshape(-1, 2), x[None]])
+        b = np.concatenate([go.reshape(-1, 2), x[None]])
+        d_all = self.world.segment_distance(a, b, cap=cap)
+        d_static, here = d_all[:-1].reshape(m, n), d_all[-1] - sr
+        # The centre's bounds, shrunk by the pad: between two samples an arc bulges out.
         (xmin, ymin), (xmax, ymax) = self.world.bounds
-        out = (flat[:, 0] < xmin) | (flat[:, 0] > xmax) | (flat[:, 1] < ymin)
-        out |= flat[:, 1] > ymax
-        return np.where(out, -1.0, clear).reshape(pts.shape[:-1])
+        lo, hi = np.array([xmin, ymin]), np.array([xmax, ymax])
+        inside = ((go >= lo + pad[:, None, None]) & (go <= hi - pad[:, None, None])).all(axis=2)
+        clear_s = np.where(inside, d_static - sr - pad[:, None], -1.0)
+        hit = clear_s < 0
+        k_s = np.where(hit.any(axis=1), hit.argmax(axis=1), n)
+        t_free = np.where(k_s == n, np.inf, np.where(k_s > 0, t_roll[np.maximum(k_s - 1, 0)], 0))
+        still = (V == 0) & (W == 0)
+        admissible = (tau_stop <= t_free + 1e-12) | still
+        if not admissible.any():  # round-off at a contact: braking is what is left
+            admissible[-1] = True
+        # Driving on ends at the last free point before a static contact.
+        idx = np.minimum(np.arange(n)[None, :], k_s[:, None] - 1)
+        held = np.take_along_axis(go, np.maximum(idx, 0)[..., None], axis=1)
+        go = np.where((idx >= 0)[..., None], held, x)
+        clear_static = np.where(np.arange(n)[None, :] < k_s[:, None], clear_s, np.inf).min(axis=1)
+        return _StaticCheck(admissible, k_s, go, np.minimum(t_free, t_roll[-1]),
+                            np.minimum(clear_static, here))  # fmt: skip
 
-    def _dynamic_clearance(self, pts, obs) -> np.ndarray:
-        """Margin left to the sensed obstacles' constant-velocity predictions at each roll-out
-        point ``(m, n, 2)`` (inf when none is sensed), units."""
-        clear = np.full(pts.shape[:-1], np.inf)
-        sr = self.robot.radius
-        for pos, vel, radius in obs.values():
-            o = pos[None, :] + self.t_roll[:, None] * vel[None, :]  # (n, 2)
-            pad = 0.5 * (self.v_max + float(np.hypot(*vel))) * self.robot.sample_time
-            d = np.hypot(*(pts - o[None]).transpose(2, 0, 1))
-            clear = np.minimum(clear, d - (sr + radius + 0.5 * self.margin + pad))
-        return clear
+    def _drive_on(self, go, heading, V, k_s) -> np.ndarray:
+        """The roll-outs continued over the prediction's horizon: straight on at full speed
+        (a turn in place is how the robot starts to get out of the way), or standing where a
+        roll-out met the static world."""
+        n = len(self.t_roll)
+        extra = self.t_pred[n:] - self.t_roll[-1]
+        onward = np.where(V < 0, -self.v_max, self.v_max)
+        onward = np.where(k_s == n, onward, 0.0)[:, None, None] * extra[None, :, None]
+        direction = np.column_stack([np.cos(heading), np.sin(heading)])
+        return np.concatenate([go, go[:, -1:] + onward * direction[:, None, :]], axis=1)
 
-    def _advance(self, x) -> None:
-        """Progress along the guide path: the nearest point ahead of the last progress (never
-        back, never more than a look-ahead at once)."""
-        rel = x[None, :] - self.path[:-1]
-        L2 = np.maximum(self.seg_len**2, 1e-12)
-        u = np.clip(np.einsum("ij,ij->i", rel, self.seg) / L2, 0.0, 1.0)
-        s = self.s_at[:-1] + u * self.seg_len
-        d = np.hypot(*(self.path[:-1] + u[:, None] * self.seg - x).T)
-        window = (s >= self.progress - 1e-9) & (s <= self.progress + self.carrot_distance)
-        if window.any():
-            self.progress = max(self.progress, float(s[window][np.argmin(d[window])]))
+    def _critics(self, x, V, static, heading, d_go, pd, gd) -> np.ndarray:
+        """The critics' total per command (lower is better; ``inf`` where not finite); the
+        weighted scores, one row per critic, are kept in :attr:`parts`."""
+        p, sr, go = self.p, self.sr, static.go
+        m, t_roll = len(V), self.t_roll
+        end = go[:, -1]
+        front = end + self.forward * np.column_stack([np.cos(heading), np.sin(heading)])
+        path_d = self._path_distance(pd, end) / sr
+        goal_d = self._goal_distance(gd, end) / sr
+        if self._local_end >= self.s_at[-1]:
+            # The local plan ends at the goal, where the run ends: a trajectory that gets there
+            # (within the harness's tolerance, at a control instant) scores the distance it
+            # could still have driven, so that arriving early beats creeping up to the goal.
+            near = np.hypot(*(go - self.goal).transpose(2, 0, 1)) <= self.goal_tolerance
+            arrive = np.where(near.any(axis=1), t_roll[near.argmax(axis=1)], np.inf)
+            goal_d = np.where(np.isfinite(arrive), -self.v_max * (t_roll[-1] - arrive) / sr, goal_d)
+        align_path = align_goal = np.zeros(m)
+        if math.dist(x, self.goal) > self.forward:
+            # A point ahead in a wall or off the field does not veto a trajectory (as in DWB,
+            # the align critics only score): it counts as far as the field reaches.
+            far = self.goal_limit / sr
+            align_path = p.path_align * np.minimum(self._path_distance(pd, front) / sr, far)
+            align_goal = p.goal_align * np.minimum(self._goal_distance(gd, front) / sr, far)
+        lam = p.inflation * sr
+        obstacle = np.exp(-np.maximum(static.clear_static, 0.0) / lam)
+        obstacle += np.minimum(np.exp(-d_go / lam), _MAX_OBSTACLE_COST)
+        #: The critics' weighted scores, one row each (kept for diagnostics).
+        self.parts = np.array([
+            p.path_dist * path_d,
+            p.goal_dist * goal_d,
+            align_path,
+            align_goal,
+            p.obstacle * obstacle,
+            p.prefer_forward * np.maximum(-V, 0.0) / self.v_max,
+        ])  # fmt: skip
+        cost = self.parts.sum(axis=0)
+        return np.where(np.isfinite(cost), cost, np.inf)
 
-    def _carrot(self, x) -> np.ndarray:
-        """The farthest point of the guide path within the carrot distance beyond the robot's
-        progress that the robot sees (the straight line to it is free): a carrot behind a wall
-        pulls a DWA into the wall, the classic local minimum at a door."""
-        s = np.linspace(self.progress, min(self.progress + self.carrot_distance, self.s_at[-1]),
-                        CARROT_SAMPLES)  # fmt: skip
-        pts = np.column_stack([np.interp(s, self.s_at, self.path[:, 0]),
-                               np.interp(s, self.s_at, self.path[:, 1])])  # fmt: skip
-        seen = self.world.segments_free(np.broadcast_to(x, pts.shape), pts)
-        return pts[int(np.flatnonzero(seen)[-1])] if seen.any() else pts[0]
+    def _choose(self, x, th, v0, t, V, W, safe, cost, static, ttc, d) -> tuple[int, str]:
+        """``(index, mode)`` of the command taken: a recovery's back-up, the rotation shim, the
+        cheapest safe command the oscillation critic allows, or when nothing is safe the
+        admissible one that meets the predicted obstacle last (``ttc``, ``d``: driving on and
+        stopping)."""
+        if t < self._backup_until:
+            choice, mode = self._backup(V, W, safe), "backup"
+        else:
+            choice = self._rotate(x, th, v0, V, W, safe)
+            mode = "critics" if choice is None else "rotate"
+        if choice is not None:
+            return choice, mode
+        osc = self._v_trend.refuses(V)
+        osc |= (np.abs(V) <= 0.1 * self.v_max) & self._w_trend.refuses(W)
+        legal = safe & np.isfinite(cost)
+        if legal.any() and (legal & ~osc).any():
+            legal &= ~osc
+        if legal.any():
+            return int(np.argmin(np.where(legal, cost, np.inf))), mode
+        if safe.any():
+            # Off the fields' reach: the safe command nearest the local plan's end.
+            end = static.go[:, -1]
+            near = np.hypot(*(end - self._local[-1]).T)
+            return int(np.argmin(np.where(safe, near, np.inf))), mode
+        # Whatever it does, a predicted obstacle comes too close: the admissible command whose
+        # better continuation meets it last, and of those the one that comes least close.
+        admissible = static.admissible
+        late = np.where(admissible, np.maximum(*ttc), -np.inf)
+        least = np.where(admissible, np.maximum(*d), -np.inf)
+        return int(np.lexsort((-late, -np.round(least, 9)))[0]), "unavoidable"
 
-    def _straight_free(self, a, b) -> bool:
-        return bool(self.world.motion_free(*a, *b))
+    def _dynamic_clearance(self, x, traj, V, obstacles) -> tuple[np.ndarray, np.ndarray]:
+        """First predicted contact (s; ``inf`` when none) and least margin (units) to the sensed
+        obstacles' constant-velocity predictions along ``traj`` (``(m, len(t_pred), 2)``), per
+        sample: exact on each chord of the relative motion (linear in time up to the arc's
+        sagitta, which the margin is padded with)."""
+        m = len(V)
+        if not obstacles:
+            return np.full(m, np.inf), np.full(m, np.inf)
+        pos = np.array([o[0] for o in obstacles.values()], dtype=float)  # (J, 2)
+        vel = np.array([o[1] for o in obstacles.values()], dtype=float)
+        rad = np.array([o[2] for o in obstacles.values()], dtype=float)
+        ts = np.concatenate([[0.0], self.t_pred])
+        pred = pos[:, None, :] + ts[None, :, None] * vel[:, None, :]  # (J, n + 1, 2)
+        contact = self.sr + rad + 0.5 * self.margin  # (J,)
+        pad = 0.25 * np.abs(V) * self.w_max * self.dt**2  # the arc's sagitta, over-estimated
+        full = np.concatenate([np.broadcast_to(x, (m, 1, 2)), traj], axis=1)  # (m, n + 1, 2)
+        rel = full[:, None] - pred[None]  # (m, J, n + 1, 2)
+        a, d = rel[:, :, :-1], np.diff(rel, axis=2)
+        dd = np.einsum("...k,...k->...", d, d)
+        u = np.clip(-np.einsum("...k,...k->...", a, d) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
+        closest = np.hypot(*(a + u[..., None] * d).transpose(3, 0, 1, 2))  # (m, J, n)
+        margin = (closest - contact[None, :, None]).min(axis=1) - pad[:, None]  # (m, n)
+        hit = margin < 0
+        ttc = np.where(hit.any(axis=1), ts[hit.argmax(axis=1)], np.inf)
+        return ttc, margin.min(axis=1)
 
+    # -- behaviours -----------------------------------------------------------------------------
+    def _rotate(self, x, th, v0, V, W, safe) -> int | None:
+        """Nav2's rotation shim: nearly stopped and facing away from the local plan, turn in
+        place towards it (when turning in place is safe)."""
+        if abs(v0) > self.acc * self.dt + 1e-12:
+            return None
+        ahead = self._point_at(np.array([min(self.s_at[-1], self.progress + 2.0 * self.sr)]))[0]
+        if math.dist(ahead, x) < 0.5 * self.sr:
+            return None
+        err = wrap_angle(math.atan2(ahead[1] - x[1], ahead[0] - x[0]) - th)
+        if abs(err) <= math.radians(self.p.rotate_threshold_deg):
+            return None
+        turning = safe & (V == 0)
+        if not turning.any():
+            return None
+        want = math.copysign(min(self.w_max, abs(err) / self.dt), err)
+        return int(np.argmin(np.where(turning, np.abs(W - want), np.inf)))
 
-def _arc(x, th, v, w, tau):
-    """Position after driving ``(v, w)`` for ``tau`` from ``x`` with heading ``th`` (exact arc;
-    broadcasts over arrays of ``v``, ``w``, ``tau``)."""
-    v = np.asarray(v, dtype=float)
-    w = np.asarray(w, dtype=float)
-    small = np.abs(w) < 1e-9
-    ws = np.where(small, 1.0, w)
-    a = th + w * tau
-    dx = np.where(small, v * tau * np.cos(th), v / ws * (np.sin(a) - math.sin(th)))
-    dy = np.where(small, v * tau * np.sin(th), -v / ws * (np.cos(a) - math.cos(th)))
-    return np.stack([x[0] + dx, x[1] + dy], axis=-1)
+    def _backup(self, V, W, safe) -> int | None:
+        """A recovery's back-up: the safe command nearest half the reverse speed, straight."""
+        if not safe.any() or self.v_min >= 0:
+            return None
+        want = 0.5 * self.v_min
+        return int(np.argmin(np.where(safe, np.abs(V - want) + np.abs(W), np.inf)))
+
+    def _debrief(self, v: float, w: float, x: np.ndarray, th: float) -> None:
+        """The oscillation critic's memory (DWB's debrief): a sign flip starts a refusal that
+        moving or turning enough forgets."""
+        flipped = self._v_trend.update(v)
+        if abs(v) <= 0.1 * self.v_max:
+            flipped |= self._w_trend.update(w)
+        if flipped:
+            self._flip_pose = (x.copy(), th)
+        elif self._v_trend.refused or self._w_trend.refused:
+            fx, fth = self._flip_pose
+            if (math.dist(x, fx) > self.p.oscillation_distance * self.sr
+                    or abs(th - fth) > self.p.oscillation_angle):  # fmt: skip
+                self._v_trend, self._w_trend = (
+                    _Trend(self._v_trend.sign),
+                    _Trend(self._w_trend.sign),
+                )
+
+    def _check_progress(self, x: np.ndarray, t: float) -> None:
+        """Nav2's progress checker: no progress for ``progress_time`` starts a recovery."""
+        if self._checkpoint is None or math.dist(x, self._checkpoint[1]) >= (
+            self.p.progress_distance * self.sr
+        ):
+            self._checkpoint = (t, x.copy())
+        elif t - self._checkpoint[0] >= self.p.progress_time:
+            self._recover(t, x, "no progress")
+            self._checkpoint = (t, x.copy())
+
+    def _recover(self, t: float, x: np.ndarray, why: str) -> bool:
+        """Re-plan the guide path from ``x`` on the grid and back up a little; False when the
+        recoveries are used up or no route exists."""
+        if len(self.recoveries) >= self.p.max_recoveries:
+            return False
+        self.recoveries.append((t, why))
+        if why == "no progress":
+            self._backup_until = t + self.p.backup_time
+        route = self.grid.route(x, self.goal)
+        if route is None or len(route) < 2:
+            return False
+        self._set_guide(route)
+        self._v_trend, self._w_trend = _Trend(), _Trend()
+        self._track(x)
+        return True

@@ -30,9 +30,9 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -40,65 +40,54 @@ from ..model.geometry import shortcut
 from ..model.problem import Circle, PlannerConfig, Polygon, Problem
 from ..model.world import World
 from .motion import Motion, closest_approach
+from .options import DynamicOptions, Observations
 from .prediction import Threat, capsule, extrapolate, true_runs
+from .result import Replan
 
-if TYPE_CHECKING:
-    from .simulation import DynamicOptions
-
-__all__ = ["BUDGET_RESERVE", "MAX_WAIT_STEPS", "Detour", "Replan", "ReplanningManager"]
+__all__ = [
+    "BUDGET_RESERVE",
+    "FALLBACK_KINDS",
+    "MAX_WAIT_STEPS",
+    "Detour",
+    "Replan",
+    "ReplanPolicy",
+    "ReplanningManager",
+]
 
 #: Least planner budget of one detour, s (below it a solve cannot even set up).
 MIN_DETOUR_TIME = 0.01
 #: Share of the replanning budget kept back for the bookkeeping after the last solve (choosing,
 #: recording) and for the scatter of a solve's overrun around the measured estimate.
 BUDGET_RESERVE = 0.05
+#: The kinds of a :class:`Replan` that planned nothing (the others are the strategy's name).
+FALLBACK_KINDS = ("wait", "evade", "unavoidable")
 #: Most waits one replan verifies (each is an exact check against every sensed obstacle).
 MAX_WAIT_STEPS = 400
 
-#: What the manager knows of an obstacle it senses: index -> (position, velocity, radius).
-Observations = Mapping[int, tuple[np.ndarray, np.ndarray, float]]
 
+@dataclass(frozen=True)
+class ReplanPolicy:
+    """What a replanning strategy asks of the manager (the defaults are the paper's contour).
 
-@dataclass
-class Replan:
-    """One reaction of the manager (JSON-ready through :meth:`to_dict`).
-
-    ``kind`` is ``"contour"``/``"global"`` for a planned reaction (``side`` ``"up"``, ``"down"``,
-    ``"wait"`` or None for global), ``"wait"`` or ``"evade"`` for a fallback, ``"unavoidable"``
-    when nothing verified. ``planning_time`` is the measured wall-clock
-    time of the planners, ``budget`` the simulated time it was charged.
+    Attributes
+    ----------
+    kind : str
+        The :attr:`Replan.kind` of a planned reaction (the strategy's name).
+    sides : tuple of str or None
+        The detours planned per replan: ``"up"`` (left of the direction of travel) and
+        ``"down"``, each behind a wall that closes the other side, or ``(None,)``: one plan
+        with no wall.
+    wait : bool
+        Whether waiting for the obstacles to pass is a candidate too.
+    rejoin_at_goal : bool
+        Whether the detour goes to the goal (the whole remaining path replanned) instead of the
+        first free point of the old plan past the collision zone.
     """
 
-    t: float
-    kind: str
-    side: str | None
-    start: np.ndarray
-    goal: np.ndarray | None
-    planning_time: float
-    budget: float
-    length: float | None
-    obstacles: list[int]
-    cross_point: np.ndarray
-    t_cross: float
-    candidates: list[dict[str, Any]] = field(default_factory=list)
-    detour: np.ndarray | None = None
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "t": self.t,
-            "kind": self.kind,
-            "side": self.side,
-            "start": self.start.tolist(),
-            "goal": None if self.goal is None else self.goal.tolist(),
-            "planning_time": self.planning_time,
-            "budget": self.budget,
-            "length": self.length,
-            "obstacles": self.obstacles,
-            "cross_point": self.cross_point.tolist(),
-            "t_cross": self.t_cross,
-            "candidates": self.candidates,
-            "detour": None if self.detour is None else self.detour.tolist(),
-        }
+    kind: str = "contour"
+    sides: tuple[str | None, ...] = ("up", "down")
+    wait: bool = True
+    rejoin_at_goal: bool = False
 
 
 @dataclass
@@ -153,6 +142,8 @@ class ReplanningManager:
         Seeds the planners.
     solve_fn : callable
         ``solve``-compatible function (injectable for tests).
+    policy : ReplanPolicy, optional
+        What the strategy asks of a replan (default: the paper's contour detours).
     """
 
     def __init__(
@@ -164,11 +155,14 @@ class ReplanningManager:
         margin: float,
         rng: np.random.Generator,
         solve_fn: Callable[..., Any] | None = None,
+        *,
+        policy: ReplanPolicy | None = None,
     ) -> None:
         from ..planners import default_registry, solve
 
         self.problem = problem
         self.options = options
+        self.policy = policy or ReplanPolicy()
         self.speed = speed
         self.turn_rate = turn_rate
         self.margin = margin
@@ -193,34 +187,12 @@ class ReplanningManager:
         """A new plan for the predicted ``threats`` (verified when at all possible)."""
         budget = self.options.replan_time
         t_s = t_now + budget
-        first = threats[0]
-        if first.t_enter <= t_s + 1e-9:
+        if threats[0].t_enter <= t_s + 1e-9:
             # No time to plan: fall back at once (no planning, so nothing is charged).
             return self.fallback(t_now, plan, obs, threats, t_now)
-        p_s = plan.position(t_s)
-        th_s = float(plan.heading(t_s))
-        t_exit = max(th.t_exit for th in threats)
-        if self.options.strategy == "contour":
-            tangent = _direction(plan, first.t_enter)
-            sides: tuple[str | None, ...] = ("up", "down")
-        else:
-            sides, tangent = (None,), None
         clock = time.perf_counter()
         deadline = clock + (1.0 - BUDGET_RESERVE) * budget
-        detours = []
-        if self.options.strategy == "contour":
-            # Waiting is a contour option too: let the obstacle pass, then drive on (cheap: exact
-            # checks of the old plan delayed, no planning).
-            detours.append(self._wait(t_now, plan, obs, t_s, t_exit))
-        for i, side in enumerate(sides):
-            # Wall-clock budgeting: what is left, shared among the detours still to plan, less the
-            # set-up and verification a solve costs beyond its own budget (measured as we go).
-            share = (deadline - time.perf_counter()) / (len(sides) - i) - self._overrun
-            share = max(share, MIN_DETOUR_TIME)
-            started = time.perf_counter()
-            d = self._detour(t_now, plan, obs, p_s, th_s, t_s, t_exit, side, share, first, tangent)
-            self._overrun = max(0.75 * self._overrun, time.perf_counter() - started - share)
-            detours.append(d)
+        detours = self._candidates(t_now, plan, obs, threats, t_s, deadline)
         elapsed = time.perf_counter() - clock
         candidates = [d.record for d in detours]
         usable = [d for d in detours if d.motion is not None]
@@ -234,16 +206,16 @@ class ReplanningManager:
         best = min(usable, key=lambda d: (round(d.motion.t_end, 6), d.length or 0.0))
         rec = Replan(
             t=t_now,
-            kind=self.options.strategy,
+            kind=self.policy.kind,
             side=best.side,
-            start=p_s,
+            start=plan.position(t_s),
             goal=best.goal,
             planning_time=elapsed,
             budget=budget,
             length=best.length,
             obstacles=[th.obstacle for th in threats],
-            cross_point=first.cross_point,
-            t_cross=first.t_enter,
+            cross_point=threats[0].cross_point,
+            t_cross=threats[0].t_enter,
             candidates=candidates,
             detour=best.path,
         )
@@ -318,6 +290,32 @@ class ReplanningManager:
         return new
 
     # -- pieces ------------------------------------------------------------------------------------
+    def _candidates(self, t_now, plan, obs, threats, t_s, deadline) -> list[Detour]:
+        """The policy's candidates from ``t_s``: the wait (when it is one) and a detour per side,
+        planned until the wall-clock ``deadline`` (``time.perf_counter`` s)."""
+        p_s = plan.position(t_s)
+        th_s = float(plan.heading(t_s))
+        t_exit = max(th.t_exit for th in threats)
+        sides = self.policy.sides
+        # The wall of a side is set along the direction of travel at the first threat.
+        tangent = _direction(plan, threats[0].t_enter) if sides != (None,) else None
+        detours = []
+        if self.policy.wait:
+            # Waiting: let the obstacle pass, then drive on (cheap: exact checks of the old plan
+            # delayed, no planning).
+            detours.append(self._wait(t_now, plan, obs, t_s, t_exit))
+        for i, side in enumerate(sides):
+            # Wall-clock budgeting: what is left, shared among the detours still to plan, less the
+            # set-up and verification a solve costs beyond its own budget (measured as we go).
+            share = (deadline - time.perf_counter()) / (len(sides) - i) - self._overrun
+            share = max(share, MIN_DETOUR_TIME)
+            started = time.perf_counter()
+            d = self._detour(t_now, plan, obs, p_s, th_s, t_s, t_exit, side, share, threats[0],
+                             tangent)  # fmt: skip
+            self._overrun = max(0.75 * self._overrun, time.perf_counter() - started - share)
+            detours.append(d)
+        return detours
+
     def _wait(self, t_now, plan, obs, t_s, t_exit) -> Detour:
         """The least wait at ``p_s`` (a multiple of the control period) after which driving on
         along ``plan`` passes every sensed obstacle, verified exactly.
@@ -419,9 +417,9 @@ class ReplanningManager:
         """The first point of the old plan past the collision zone that is free among the
         relevant sweeps: ``(t_g, goal, obstacles, world)``, or None.
 
-        With ``strategy="global"`` the only candidate is the plan's end (the goal).
+        With ``policy.rejoin_at_goal`` the only candidate is the plan's end (the goal).
         """
-        if self.options.strategy == "global":
+        if self.policy.rejoin_at_goal:
             goal_times = np.array([plan.t_end])
         else:
             step = max(self.sr, 1e-6) / self.speed

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..model.geometry import dedupe, wrap_angle
 
-__all__ = ["Motion", "ObstacleTrack", "closest_approach", "first_entry"]
+__all__ = ["Motion", "ObstacleTrack", "arc_position", "closest_approach", "first_entry"]
 
 
 @dataclass(frozen=True)
@@ -229,6 +229,33 @@ class ObstacleTrack:
     def breakpoints(self) -> np.ndarray:
         """Times at which the velocity changes."""
         return np.array([k[0] for k in self.knots])
+
+
+def arc_position(x, theta, v, w, tau) -> np.ndarray:
+    """Position after driving at linear speed ``v`` and turn rate ``w`` for ``tau`` from ``x``
+    with heading ``theta`` (a differential drive at constant wheel speeds: an exact circular arc,
+    or a straight line when ``w = 0``).
+
+    Parameters
+    ----------
+    x : (2,) array
+        Start position, units.
+    theta : float or array
+        Start heading, rad.
+    v, w, tau : float or array
+        Linear speed (units/s, negative backwards), turn rate (rad/s) and time (s); broadcast
+        together with ``theta``.
+
+    Returns
+    -------
+    ndarray of shape ``broadcast(theta, v, w, tau).shape + (2,)``
+    """
+    half = 0.5 * np.asarray(w, dtype=float) * tau
+    # The chord of the arc: length v tau sinc(w tau / 2), direction theta + w tau / 2 (exact, and
+    # stable as w -> 0, where it becomes the straight line).
+    chord = np.asarray(v, dtype=float) * tau * np.sinc(half / math.pi)
+    mid = np.asarray(theta, dtype=float) + half
+    return np.stack([x[0] + chord * np.cos(mid), x[1] + chord * np.sin(mid)], axis=-1)
 
 
 def _relative(

@@ -390,33 +390,56 @@ def run_batch(
         ``overwrite`` is given, or is not a results file of this package.
     """
     tasks = list(tasks)
+    results_of = _executor(executor, jobs, scheduler)  # checked before the file is touched
+    with ResultsFile(out, resume=resume, overwrite=overwrite) as results:
+        kept = [r for r in results.kept if not r.is_error]
+        todo = _still_to_run(tasks, kept)
+        if on_start is not None:
+            on_start(len(todo), len(tasks) - len(todo))
+        new = _record(results_of(todo), results, _Optima() if optimum else None, progress)
+    return latest_rows([*kept, *new])
+
+
+def _executor(
+    executor: str, jobs: int, scheduler: Any
+) -> Callable[[list[Task]], Iterator[RunRecord]]:
+    """The function that runs a list of tasks on ``executor`` and yields their rows as they
+    finish (``ValueError`` for an unknown executor or a Dask one without its scheduler)."""
     if executor not in ("local", "dask"):
         raise ValueError(f"unknown executor {executor!r} (local or dask)")
     if executor == "dask" and scheduler is None:
         raise ValueError("the dask executor needs a scheduler address")
-    with ResultsFile(out, resume=resume, overwrite=overwrite) as results:
-        kept = [r for r in results.kept if not r.is_error]
-        done = {r.key: r.inputs_sha256 for r in kept}
-        todo = [t for t in tasks if not _done(t, done)]
-        if on_start is not None:
-            on_start(len(todo), len(tasks) - len(todo))
-        rows = list(kept)
-        if executor == "local":
-            stream = _local_results(todo, max(1, jobs))
-        else:
-            stream = _dask_results(todo, scheduler)
-        optima = _Optima() if optimum else None
-        try:
-            for row in stream:
-                if optima is not None:
-                    row = optima.annotate(row)
-                results.append(row)
-                rows.append(row)
-                if progress is not None:
-                    progress(row)
-        finally:
-            stream.close()  # on Ctrl-C: stop the workers before the file is released
-    return latest_rows(rows)
+    if executor == "local":
+        return lambda todo: _local_results(todo, max(1, jobs))
+    return lambda todo: _dask_results(todo, scheduler)
+
+
+def _still_to_run(tasks: list[Task], kept: list[RunRecord]) -> list[Task]:
+    """The tasks whose run none of the ``kept`` rows (a resumed file's) already is."""
+    done = {r.key: r.inputs_sha256 for r in kept}
+    return [t for t in tasks if not _done(t, done)]
+
+
+def _record(
+    stream: Iterator[RunRecord],
+    results: ResultsFile,
+    optima: _Optima | None,
+    progress: Callable[[RunRecord], None] | None,
+) -> list[RunRecord]:
+    """Append each row of ``stream`` to ``results`` as it arrives (with its optimum and ratio
+    when ``optima`` is given), report it to ``progress``, and return the rows."""
+    rows = []
+    try:
+        for row in stream:
+            if optima is not None:
+                row = optima.annotate(row)
+            results.append(row)
+            rows.append(row)
+            if progress is not None:
+                progress(row)
+    finally:
+        stream.close()  # on Ctrl-C: stop the workers before the file is released
+    return rows
 
 
 def _done(task: Task, done: Mapping[RunKey, str | None]) -> bool:

@@ -188,17 +188,15 @@ def run_bench(
         Runs per problem, budget and planner.
     times : sequence of float
         Time budgets, seconds; one experiment per problem and budget.
-    seed, params, jobs, executor, scheduler, resume, progress, on_start
+    seed, params, jobs, executor, scheduler, resume, overwrite, progress, on_start
         As for :func:`~rrtpso_ompl.harness.run_batch` and
-        :func:`~rrtpso_ompl.harness.make_tasks`.
+        :func:`~rrtpso_ompl.harness.make_tasks` (``resume`` and ``overwrite`` apply to the
+        folder: without either, one that holds an earlier bench is refused).
     command : str, optional
         The command line that ran the benchmark, quoted at the top of ``report.md``.
     simplify : bool, optional
         Follow every planner with OMPL's simplifier (True), none (False, e.g. the paper's
         Table 3 of raw paths), or as its registry entry says (None).
-    overwrite : bool
-        Start afresh in a folder that holds an earlier bench (without it, or ``resume``, such a
-        folder is refused).
 
     Returns
     -------
@@ -212,15 +210,33 @@ def run_bench(
     """
     tasks = bench_tasks(items, planners, runs, times, seed, params, simplify)  # checked first
     out = Path(out_dir)
+    batch = dict(jobs=jobs, resume=resume, overwrite=overwrite, executor=executor,
+                 scheduler=scheduler, progress=progress, on_start=on_start)  # fmt: skip
+    return _write_outputs(_run_in_folder(tasks, out, batch), out, planners, runs, seed, command)
+
+
+def _run_in_folder(tasks: list[Task], out: Path, batch: dict[str, Any]) -> list[RunRecord]:
+    """Run ``tasks`` into ``out/runs.jsonl`` (``batch``: :func:`run_batch`'s keywords) after
+    checking the folder; a folder made for a bench that wrote nothing is removed again."""
     _check_out_dir(out)
     made = make_folders(out)
     try:
-        rows = run_batch(tasks, out / "runs.jsonl", jobs=jobs, resume=resume,
-                         overwrite=overwrite, executor=executor, scheduler=scheduler,
-                         progress=progress, on_start=on_start)  # fmt: skip
+        return run_batch(tasks, out / "runs.jsonl", **batch)
     except BaseException:
-        remove_folders(made)  # a folder made for a bench that wrote nothing
+        remove_folders(made)
         raise
+
+
+def _write_outputs(
+    rows: list[RunRecord],
+    out: Path,
+    planners: Sequence[str],
+    runs: int,
+    seed: int,
+    command: str | None,
+) -> BenchResult:
+    """Write the bench's logs (replacing an earlier bench's), database and report from its
+    rows."""
     errors = sorted({r.error for r in rows if r.error})
     good = [r for r in rows if not r.is_error]
     experiments = to_experiments(good, planners, runs, seed)

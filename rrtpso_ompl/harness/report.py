@@ -8,8 +8,9 @@ a table is escaped and aligned the same way everywhere.
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
+from pathlib import Path
 
-__all__ = ["markdown_table"]
+__all__ = ["markdown_table", "write_markdown"]
 
 #: The rule under a column's header for each alignment character of :func:`markdown_table`.
 _RULES = {"-": "---", "l": ":---", "r": "---:", "c": ":---:"}
@@ -71,3 +72,12 @@ def _line(cells: Sequence[object]) -> str:
 def _cell(value: object) -> str:
     text = str(value)
     return text.replace("|", r"\|").replace("\r\n", " ").replace("\n", " ").replace("\r", " ")
+
+
+def write_markdown(lines: Iterable[str], out: str | Path) -> None:
+    """Join ``lines`` into one markdown document (ending in a newline), write it to ``out``
+    unless ``out`` is ``"-"``, and print it: how a benchmark script publishes its report."""
+    text = "\n".join(lines) + "\n"
+    if str(out) != "-":
+        Path(out).write_text(text)
+    print(text)

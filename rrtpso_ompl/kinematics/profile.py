@@ -139,18 +139,10 @@ def time_parametrize(curve: ReferenceCurve, robot: Robot, profile: str = "auto")
     profile = _resolve_profile(robot, profile)
     L, ts = robot.track_width, robot.sample_time
     v, v_top = _speeds(curve, robot, profile)
-    # Time along the curve: exact for constant acceleration between samples.
-    ds = np.diff(curve.s)
-    dv = v[:-1] + v[1:]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        dt = np.where(dv > 0, 2.0 * ds / dv, 0.0)
     # Turns in place: as fast as the wheels allow (w = 2 v_wheel / L), else at the speed the
     # robot would drive.
     w_turn = 2.0 * (robot.max_wheel_speed or v_top) / L
-    turn_dt = np.abs(curve.turns) / w_turn
-
-    # Event list: (time, s index, in-place turn progress).
-    t_nodes = np.concatenate([[0.0], np.cumsum(turn_dt[:-1] + dt)])
+    dt, turn_dt, t_nodes = _node_times(curve, v, w_turn)
     t_end = t_nodes[-1] + turn_dt[-1]
     check_samples(t_end, ts)
     n = max(1, math.ceil(t_end / ts - 1e-9))
@@ -208,6 +200,30 @@ def _speeds(curve: ReferenceCurve, robot: Robot, profile: str) -> tuple[np.ndarr
     elif stops.any():
         v[stops] = 0.0  # the polyline fallback must stop to turn, whatever the profile
     return v, float(v_top)
+
+
+def _node_times(
+    curve: ReferenceCurve, v: np.ndarray, w_turn: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Time along the curve at speeds ``v`` (units/s) with turns in place at ``w_turn`` (rad/s).
+
+    Returns
+    -------
+    dt : ndarray
+        Seconds from each curve sample to the next (exact for constant acceleration between
+        samples); one fewer than the samples.
+    turn_dt : ndarray
+        Seconds of each sample's turn in place (0 where there is none).
+    t_nodes : ndarray
+        When each sample is reached, before its turn (s).
+    """
+    ds = np.diff(curve.s)
+    dv = v[:-1] + v[1:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dt = np.where(dv > 0, 2.0 * ds / dv, 0.0)
+    turn_dt = np.abs(curve.turns) / w_turn
+    t_nodes = np.concatenate([[0.0], np.cumsum(turn_dt[:-1] + dt)])
+    return dt, turn_dt, t_nodes
 
 
 def _limit_acceleration(v: np.ndarray, ds: np.ndarray, a: float) -> None:

@@ -438,8 +438,29 @@ def read_pgm(path: str | Path) -> tuple[np.ndarray, int]:
     magic = data[:2]
     if magic not in (b"P2", b"P5"):
         raise ValueError("not a PGM image (P2 or P5)")
+    (width, height, maxval), pos = _pgm_header(data)
+    if width <= 0 or height <= 0 or not 0 < maxval < 65536:
+        raise ValueError(f"bad PGM header: width {width}, height {height}, maxval {maxval}")
+    if width * height > MAX_CELLS:
+        raise ValueError(f"{width} x {height} pixels, more than the {MAX_CELLS:,} allowed")
+    values = _pgm_pixels(data, pos, width * height, maxval).astype(np.int64)
+    if values.max(initial=0) > maxval:
+        raise ValueError(f"a pixel value exceeds maxval {maxval}")
+    if values.min(initial=0) < 0:
+        # P2 text can hold "-1"; read as an unsigned byte it would be 255, free space.
+        k = int(np.argmax(values < 0))
+        raise ValueError(
+            f"pixel {k} (row {k // width}, column {k % width}) is {values[k]}: pixel values "
+            f"run from 0 to maxval {maxval}"
+        )
+    return values.reshape(height, width).astype(np.uint16 if maxval > 255 else np.uint8), maxval
+
+
+def _pgm_header(data: bytes) -> tuple[list[int], int]:
+    """Width, height and maxval of a PGM file's bytes (``# comments`` between the tokens
+    skipped), and the position just after the last of them."""
     pos, values = 2, []
-    while len(values) < 3:  # width, height, maxval, with # comments between tokens
+    while len(values) < 3:
         while pos < len(data) and data[pos : pos + 1].isspace():
             pos += 1
         if data[pos : pos + 1] == b"#":
@@ -452,43 +473,30 @@ def read_pgm(path: str | Path) -> tuple[np.ndarray, int]:
         if start == pos:
             raise ValueError("malformed PGM header (width, height and maxval expected)")
         values.append(int(data[start:pos]))
-    width, height, maxval = values
-    if width <= 0 or height <= 0 or not 0 < maxval < 65536:
-        raise ValueError(f"bad PGM header: width {width}, height {height}, maxval {maxval}")
-    if width * height > MAX_CELLS:
-        raise ValueError(f"{width} x {height} pixels, more than the {MAX_CELLS:,} allowed")
-    n = width * height
-    if magic == b"P5":
+    return values, pos
+
+
+def _pgm_pixels(data: bytes, pos: int, n: int, maxval: int) -> np.ndarray:
+    """The ``n`` pixel values after the header (which ends at ``pos``): binary for P5 (two bytes
+    a value, big-endian, when ``maxval`` > 255), whitespace-separated text for P2; not checked
+    against ``maxval``."""
+    if data[:2] == b"P5":
         pos += 1  # exactly one whitespace character ends the header
         dtype = np.dtype(">u2") if maxval > 255 else np.dtype("u1")
         need = n * dtype.itemsize
         if len(data) - pos < need:
             raise ValueError(f"truncated: {n} pixels need {need} bytes, {len(data) - pos} left")
-        raw = np.frombuffer(data[pos : pos + need], dtype=dtype)
-    else:
-        text = data[pos:].decode("ascii", errors="replace")
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")  # numpy warns, then stops, at a non-number
-            try:
-                raw = np.fromstring(text, dtype=np.int64, sep=" ")
-            except (ValueError, DeprecationWarning):
-                raise ValueError("P2 pixel values must be whitespace-separated integers") from None
-        if len(raw) < n:
-            raise ValueError(
-                f"truncated or not numbers: {n} pixel values expected, {len(raw)} read"
-            )
-        raw = raw[:n]
-    values_ = raw.astype(np.int64)
-    if values_.max(initial=0) > maxval:
-        raise ValueError(f"a pixel value exceeds maxval {maxval}")
-    if values_.min(initial=0) < 0:
-        # P2 text can hold "-1"; read as an unsigned byte it would be 255, free space.
-        k = int(np.argmax(values_ < 0))
-        raise ValueError(
-            f"pixel {k} (row {k // width}, column {k % width}) is {values_[k]}: pixel values "
-            f"run from 0 to maxval {maxval}"
-        )
-    return values_.reshape(height, width).astype(np.uint16 if maxval > 255 else np.uint8), maxval
+        return np.frombuffer(data[pos : pos + need], dtype=dtype)
+    text = data[pos:].decode("ascii", errors="replace")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy warns, then stops, at a non-number
+        try:
+            raw = np.fromstring(text, dtype=np.int64, sep=" ")
+        except (ValueError, DeprecationWarning):
+            raise ValueError("P2 pixel values must be whitespace-separated integers") from None
+    if len(raw) < n:
+        raise ValueError(f"truncated or not numbers: {n} pixel values expected, {len(raw)} read")
+    return raw[:n]
 
 
 def _read_with_pillow(source: str, path: Path) -> tuple[np.ndarray, np.ndarray | None, int]:

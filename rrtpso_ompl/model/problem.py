@@ -13,11 +13,11 @@ from __future__ import annotations
 import math
 import numbers
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import shapely
@@ -57,6 +57,7 @@ __all__ = [
 ]
 
 Point = tuple[float, float]
+_T = TypeVar("_T")
 
 
 @dataclass(frozen=True)
@@ -280,35 +281,13 @@ def problem_from_dict(
     if name is not None and not isinstance(name, str):
         raise ArgumentError(f"problem_from_dict: name must be a str, got {describe(name)}")
     v = _Validator(source)
-    if data is None:
-        raise v.error("", "the file is empty; a problem needs at least bounds, start, goal, robot")
-    if isinstance(data, Mapping) and {"image", "resolution"} <= set(data) and "start" not in data:
-        raise v.error(
-            "",
-            "this is an occupancy-grid map (map_server YAML), not a problem; "
-            "name it in a problem's map key",
-        )
-    doc = v.mapping(data, "", _TOP_KEYS, required=_REQUIRED)
+    doc = v.document(data)
     if base is None:  # a map path is relative to the problem file, when there is one
         base = Path.cwd() if source.startswith("<") else Path(source).parent
-    occupancy = v.map(doc.get("map"), "map", Path(base))
-    if doc.get("bounds") is None and occupancy is None:
-        raise v.error("bounds", "required key is missing (or give a map, whose extent it is)")
-    bounds = v.bounds(doc["bounds"], "bounds") if doc.get("bounds") is not None else None
-    if bounds is None:
-        bounds = occupancy.extent
-        small = _too_small(bounds)
-        if small:
-            raise v.error("map", f"its extent (image size x resolution) is {small}; give bounds "
-                          "or a map of larger cells")  # fmt: skip
+    occupancy, bounds = v.region(doc, Path(base))
     robot = v.robot(doc["robot"], "robot")
-    obstacles = tuple(
-        v.obstacle(o, f"obstacles[{i}]") for i, o in enumerate(v.sequence(doc, "obstacles"))
-    )
-    moving = tuple(
-        v.moving(o, f"moving_obstacles[{i}]")
-        for i, o in enumerate(v.sequence(doc, "moving_obstacles"))
-    )
+    obstacles = v.each(doc, "obstacles", v.obstacle)
+    moving = v.each(doc, "moving_obstacles", v.moving)
     problem = Problem(
         name=v.string(_get(doc, "name", name or "problem"), "name"),
         description=v.string(_get(doc, "description", ""), "description", empty=True),
@@ -352,6 +331,42 @@ class _Validator:
     def error(self, key: str, message: str) -> ProblemError:
         return ProblemError(self.source, key, message)
 
+    # -- the document ----------------------------------------------------------------------------
+    def document(self, data: Any) -> Mapping[str, Any]:
+        """The top-level mapping, or an error that says what the file is instead (empty, a map)."""
+        if data is None:
+            raise self.error(
+                "", "the file is empty; a problem needs at least bounds, start, goal, robot"
+            )
+        if (
+            isinstance(data, Mapping)
+            and {"image", "resolution"} <= set(data)
+            and "start" not in data
+        ):
+            raise self.error(
+                "",
+                "this is an occupancy-grid map (map_server YAML), not a problem; "
+                "name it in a problem's map key",
+            )
+        return self.mapping(data, "", _TOP_KEYS, required=_REQUIRED)
+
+    def region(
+        self, doc: Mapping[str, Any], base: Path
+    ) -> tuple[OccupancyMap | None, tuple[Point, Point]]:
+        """The map (read, or None) and the bounds: the ``bounds`` key, else the map's extent."""
+        occupancy = self.map(doc.get("map"), "map", base)
+        if doc.get("bounds") is not None:
+            return occupancy, self.bounds(doc["bounds"], "bounds")
+        if occupancy is None:
+            raise self.error(
+                "bounds", "required key is missing (or give a map, whose extent it is)"
+            )
+        small = _too_small(occupancy.extent)
+        if small:
+            raise self.error("map", f"its extent (image size x resolution) is {small}; give bounds "
+                             "or a map of larger cells")  # fmt: skip
+        return occupancy, occupancy.extent
+
     # -- containers ------------------------------------------------------------------------------
     def mapping(
         self,
@@ -384,6 +399,12 @@ class _Validator:
         if not isinstance(value, list | tuple):
             raise self.error(key, f"must be a list, got {describe(value)}")
         return value
+
+    def each(
+        self, doc: Mapping[str, Any], key: str, check: Callable[[Any, str], _T]
+    ) -> tuple[_T, ...]:
+        """The list under ``key`` (default empty), each item checked as ``key[i]``."""
+        return tuple(check(item, f"{key}[{i}]") for i, item in enumerate(self.sequence(doc, key)))
 
     # -- scalars -----------------------------------------------------------------------------------
     def number(self, value: Any, key: str, low: float | None = None, strict: bool = False) -> float:

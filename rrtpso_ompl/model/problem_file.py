@@ -26,6 +26,7 @@ from .problem import (
     _PLANNER_KEYS,
     _ROBOT_KEYS,
     _TOP_KEYS,
+    Problem,
     problem_from_dict,
 )
 
@@ -73,14 +74,30 @@ def write_problem(
     """
     path = Path(path)
     problem = problem_from_dict(data, source=str(path))
+    rounded = _rounded_valid(data, path, _decimals(problem, decimals))
+    text = _format_problem(rounded, header)
+    # The text must read back as exactly the validated dictionary: a formatting slip (a string
+    # that YAML would read as a number, say) must not reach the file.
+    if yaml.safe_load(text) != _plain(rounded):
+        raise AssertionError("internal error: the formatted YAML does not read back as written")
+
+    return write_text_atomic(text, path)
+
+
+def _decimals(problem: Problem, decimals: int | None) -> int:
+    """``decimals`` checked (0..12), or :func:`default_decimals` of the problem's bounds."""
     if decimals is None:
         (xmin, ymin), (xmax, ymax) = problem.bounds
-        decimals = default_decimals(max(xmax - xmin, ymax - ymin))
-    else:
-        try:
-            decimals = check_integer(decimals, low=0, high=12)
-        except ValueError as exc:
-            raise ValueError(f"decimals {exc}") from None
+        return default_decimals(max(xmax - xmin, ymax - ymin))
+    try:
+        return check_integer(decimals, low=0, high=12)
+    except ValueError as exc:
+        raise ValueError(f"decimals {exc}") from None
+
+
+def _rounded_valid(data: Mapping[str, Any], path: Path, decimals: int) -> dict[str, Any]:
+    """``data`` with every float rounded to ``decimals`` places, validated again: rounding may
+    move an obstacle onto the start or make a thin polygon degenerate (a ValueError then)."""
     rounded = round_floats(data, decimals)
     try:
         problem_from_dict(rounded, source=str(path))
@@ -89,14 +106,7 @@ def write_problem(
             f"{path}: after rounding to {decimals} decimals the problem is no longer valid: "
             f"{exc.key + ': ' if exc.key else ''}{exc.message}; write more decimals"
         ) from None
-
-    text = _format_problem(rounded, header)
-    # The text must read back as exactly the validated dictionary: a formatting slip (a string
-    # that YAML would read as a number, say) must not reach the file.
-    if yaml.safe_load(text) != _plain(rounded):
-        raise AssertionError("internal error: the formatted YAML does not read back as written")
-
-    return write_text_atomic(text, path)
+    return rounded
 
 
 def default_decimals(size: float) -> int:

@@ -150,6 +150,12 @@ class ParamSpec:
         return number
 
     def _convert(self, v: Any) -> Any:
+        if self.type is dict:
+            # A mapping of named values handed on as they are (a planner's parameters, which
+            # the planner's own table validates).
+            if not isinstance(v, Mapping) or not all(isinstance(k, str) for k in v):
+                raise ValueError(f"must be a mapping of names to values, got {describe(v)}")
+            return v
         if self.type is bool:
             if isinstance(v, bool):
                 return v
@@ -173,6 +179,8 @@ class ParamSpec:
             return "{" + ", ".join(map(str, self.choices)) + "}"
         if self.type is str:
             return "any text"
+        if self.type is dict:
+            return "names to values"
         if self.type is bool:
             return "{false, true}"
 
@@ -351,6 +359,9 @@ def param(
     """Declare one field of an option set (see :func:`declared`): its default, what it does,
     its unit and its range. The name and type come from the field itself."""
     spec = {"doc": doc, "unit": unit, "low": low, "high": high, "choices": choices}
+    if isinstance(default, dict):
+        # A mapping field (such as a planner's parameters): each instance gets its own copy.
+        return dataclasses.field(default_factory=lambda: dict(default), metadata={_PARAM_KEY: spec})
     return dataclasses.field(default=default, metadata={_PARAM_KEY: spec})
 
 
@@ -369,13 +380,16 @@ def _field_type(hint: Any, where: str) -> tuple[type, bool, int | None]:
         if not items or Ellipsis in items or len(set(items)) != 1:
             raise TypeError(f"{where}: a tuple field holds values of one type, a fixed number")
         hint, length = items[0], len(items)
+    if typing.get_origin(hint) in (dict, Mapping) or hint in (dict, Mapping):
+        return dict, optional, None
     return (_TYPES.get(hint, hint) if isinstance(hint, str) else hint), optional, length
 
 
 def _validate_fields(self: Any) -> None:
     """``__post_init__`` of every option set: its values against its table."""
     klass = type(self)
-    klass.PARAMS.validate(dataclasses.asdict(self), owner=klass.__name__)
+    values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}  # not copied
+    klass.PARAMS.validate(values, owner=klass.__name__)
 
 
 def _dataclass_transform(**kwargs: Any) -> Callable[[_T], _T]:
@@ -421,7 +435,8 @@ def declared(cls: type[_T] | None = None, *, rules: Iterable[Rule] = ()) -> Any:
             if meta is None:
                 raise TypeError(f"{klass.__name__}.{f.name}: declare it with param(...)")
             kind, optional, length = _field_type(hints[f.name], f"{klass.__name__}.{f.name}")
-            specs.append(ParamSpec(f.name, kind, f.default, **meta, optional=optional,
+            default = f.default_factory() if f.default is dataclasses.MISSING else f.default
+            specs.append(ParamSpec(f.name, kind, default, **meta, optional=optional,
                                    length=length))  # fmt: skip
         table = ParamTable(*specs, rules=(*dict.fromkeys(inherited), *rules))
 

@@ -355,37 +355,40 @@ def _planner(
         raise UnknownPlannerError(exc.name, exc.known, exc.reason, origin) from None
 
 
+def _origin(name: str, given, from_file, src: str, sources: Sources, default):
+    """The value of ``name`` and where it came from: the caller's (``sources`` labels it), the
+    problem file's ``planner`` section, else ``default``."""
+    if given is not None:
+        return given, sources.label(name)
+    if from_file is not None:
+        return from_file, f"{src}: planner.{name}"
+    return default, DEFAULT
+
+
 def _time_limit(
     given: float | None, cfg: PlannerConfig, src: str, sources: Sources, origins: dict[str, str]
 ) -> float:
-    if given is not None:
-        value, origin = given, sources.label("time_limit")
-    elif cfg.time_limit is not None:
-        value, origin = cfg.time_limit, f"{src}: planner.time_limit"
-    else:
-        value, origin = DEFAULT_TIME_LIMIT, DEFAULT
-    origins["time_limit"] = origin
+    value, origins["time_limit"] = _origin(
+        "time_limit", given, cfg.time_limit, src, sources, DEFAULT_TIME_LIMIT
+    )
     try:
         return check_seconds(value)
     except ValueError as exc:
-        raise ParameterError(f"a time in seconds {exc}", "time_limit", origin) from None
+        raise ParameterError(
+            f"a time in seconds {exc}", "time_limit", origins["time_limit"]
+        ) from None
 
 
 def _seed(
     given: int | None, cfg: PlannerConfig, src: str, sources: Sources, origins: dict[str, str]
 ) -> int | None:
-    if given is not None:
-        value, origin = given, sources.label("seed")
-    elif cfg.seed is not None:
-        value, origin = cfg.seed, f"{src}: planner.seed"
-    else:
-        origins["seed"] = DEFAULT
+    value, origins["seed"] = _origin("seed", given, cfg.seed, src, sources, None)
+    if value is None:
         return None
-    origins["seed"] = origin
     try:
         return check_seed(value)
     except ValueError as exc:
-        raise ParameterError(f"the seed {exc}", "seed", origin) from None
+        raise ParameterError(f"the seed {exc}", "seed", origins["seed"]) from None
 
 
 def _params(

@@ -20,6 +20,8 @@ from pathlib import Path
 import pytest
 from helpers import PROBLEMS, rrtpso_exe
 
+pytestmark = pytest.mark.slow
+
 #: Address space of every child (bytes): a run that tries to expand a bomb hits it.
 MEMORY_LIMIT = 2 << 30
 CIRCLE = (PROBLEMS / "static" / "single_circle.yaml").read_text()

@@ -203,10 +203,14 @@ def test_fallback_when_the_collision_is_too_close_to_plan():
 
 
 def test_options_are_checked():
-    with pytest.raises(ValueError, match="strategy"):
-        DynamicOptions(strategy="teleport")
+    with pytest.raises(ValueError, match=r"no strategy 'teleport'.*known: contour, global"):
+        simulate(corridor([]), DynamicOptions(strategy="teleport"))
     with pytest.raises(ValueError, match="replan_time"):
         DynamicOptions(replan_time=0)
+    with pytest.raises(ValueError, match="stretch"):
+        DynamicOptions(stretch=0.5)
+    with pytest.raises(ValueError, match="params"):
+        DynamicOptions(params=[1, 2])
 
 
 # ----------------------------------------------------------------------------------------------

@@ -3,8 +3,7 @@
 The generator's promise is a *certificate*: every generated problem comes with a grid path whose
 every segment passed the world's exact test. The tests check that promise against the world
 itself (``path_valid``) and against a real planner (OMPL's RRTConnect), and that the same seed
-gives the same bytes.
-"""
+gives the same bytes."""
 
 from __future__ import annotations
 
@@ -14,7 +13,7 @@ from typing import ClassVar
 import numpy as np
 import pytest
 import yaml
-from helpers import PROBLEMS
+from helpers import PROBLEMS, _generate_parser
 
 from rrtpso_ompl.groundtruth.generate import (
     GENERATORS,
@@ -27,15 +26,8 @@ from rrtpso_ompl.groundtruth.generate import (
     generate_to_file,
     grid_path,
     is_solvable,
-    write_problem,
 )
-from rrtpso_ompl.model.problem import (
-    _TOP_KEYS,
-    Circle,
-    ProblemError,
-    load_problem,
-    problem_from_dict,
-)
+from rrtpso_ompl.model.problem import _TOP_KEYS, load_problem, problem_from_dict
 from rrtpso_ompl.model.world import World
 from rrtpso_ompl.planners.solve import solve
 
@@ -106,36 +98,6 @@ def test_generated_problems_are_solvable(kind, seed):
     assert is_solvable(problem)
     result = solve(problem, "RRTConnect", time_limit=0.5, seed=1)
     assert result.solved and World.from_problem(problem).path_valid(result.path)
-
-
-def test_grid_path_finds_no_route_into_a_closed_box():
-    box = [
-        {"type": "rectangle", "min": [6, 6], "max": [9, 6.5]},
-        {"type": "rectangle", "min": [6, 8.5], "max": [9, 9]},
-        {"type": "rectangle", "min": [6, 6], "max": [6.5, 9]},
-        {"type": "rectangle", "min": [8.5, 6], "max": [9, 9]},
-    ]
-    data = {
-        "bounds": [[0, 0], [10, 10]],
-        "start": [1, 1],
-        "goal": [7.5, 7.5],
-        "robot": {"radius": 0.2},
-        "obstacles": box,
-    }
-    problem = problem_from_dict(data)
-    assert grid_path(problem) is None and not is_solvable(problem)
-    # With a goal tolerance that reaches outside the box, a grid point near the goal will do.
-    reachable = problem_from_dict({**data, "goal_tolerance": 2.0})
-    path = grid_path(reachable)
-    assert path is not None and World.from_problem(reachable).path_valid(path)
-    assert np.hypot(*(path[-1] - reachable.goal)) <= 2.0
-
-
-def test_grid_path_straight_line_when_free():
-    problem = problem_from_dict(
-        {"bounds": [[0, 0], [10, 10]], "start": [1, 1], "goal": [9, 2], "robot": {"radius": 0}}
-    )
-    np.testing.assert_array_equal(grid_path(problem), [[1, 1], [9, 2]])
 
 
 # ----------------------------------------------------------------------------------------------
@@ -236,46 +198,6 @@ def test_generate_to_file_refuses_unknown_options(tmp_path):
 
 
 # ----------------------------------------------------------------------------------------------
-# write_problem
-# ----------------------------------------------------------------------------------------------
-def test_write_problem_orders_keys_and_keeps_the_header(tmp_path):
-    data = {
-        "planner": {"seed": 1, "type": "RRTstarPSO"},
-        "obstacles": [{"radius": 1.0, "center": [5.0, 5.0], "type": "circle"}],
-        "robot": {"track_width": 0.4, "radius": 0.25},
-        "goal": [9, 9],
-        "start": [1, 1],
-        "bounds": [[0, 0], [10, 10]],
-        "units": "m",
-        "name": "ordered",
-    }
-    path = write_problem(data, tmp_path / "o.yaml", header="first line\nsecond line")
-    text = path.read_text()
-    assert text.startswith("# first line\n# second line\nname: ordered\nunits: m\nbounds:")
-    assert "robot:\n  radius: 0.25\n  track_width: 0.4\n" in text
-    assert "  - {type: circle, center: [5.0, 5.0], radius: 1.0}\n" in text
-    assert "planner:\n  type: RRTstarPSO\n  seed: 1\n" in text
-    assert load_problem(path).obstacles == (Circle((5.0, 5.0), 1.0),)
-
-
-def test_write_problem_rechecks_validity_after_rounding(tmp_path):
-    data = {
-        "bounds": [[0, 0], [10, 10]],
-        "start": [1, 1],
-        "goal": [9, 9],
-        "robot": {"radius": 0},
-        # Valid as written; rounded to 3 decimals its apex lands on the base: zero area.
-        "obstacles": [{"type": "polygon", "points": [[4, 5], [5, 5.0004], [6, 5]]}],
-    }
-    write_problem(data, tmp_path / "fine.yaml")  # default decimals for a side of 10: 4
-    with pytest.raises(ValueError, match=r"after rounding to 3 decimals .*obstacles\[0\]"):
-        write_problem(data, tmp_path / "bad.yaml", decimals=3)
-    assert not (tmp_path / "bad.yaml").exists()
-    with pytest.raises(ProblemError, match=r"robot\.radius"):
-        write_problem({**data, "robot": {"radius": -1}}, tmp_path / "bad.yaml")
-
-
-# ----------------------------------------------------------------------------------------------
 # The static problem library
 # ----------------------------------------------------------------------------------------------
 def test_static_library_is_complete():
@@ -346,35 +268,6 @@ def test_generated_static_problems_regenerate_from_their_header_command(name, ki
         assert fresh[key] == shipped[key], key
 
 
-def test_generate_command_is_deterministic_and_checks_options(tmp_path):
-    import subprocess
-
-    from helpers import rrtpso_exe
-
-    a, b = tmp_path / "a.yaml", tmp_path / "b.yaml"
-    for out in (a, b):
-        proc = subprocess.run(
-            [*rrtpso_exe(), "generate", "polygons", "--seed", "4", "--n", "6", "--out", str(out)],
-            capture_output=True, text=True, timeout=120,
-        )  # fmt: skip
-        assert proc.returncode == 0, proc.stderr
-    assert a.read_bytes() == b.read_bytes()
-    assert load_problem(a).obstacles
-    bad = subprocess.run(
-        [*rrtpso_exe(), "generate", "maze", "--seed", "1", "--cells", "1", "--out",
-         str(tmp_path / "c.yaml")], capture_output=True, text=True, timeout=60,
-    )  # fmt: skip
-    assert bad.returncode == 2 and "cells" in bad.stderr and not (tmp_path / "c.yaml").exists()
-    # A generation that fails says so once, naming the kind once.
-    failed = subprocess.run(
-        [*rrtpso_exe(), "generate", "circles", "--seed", "1", "--n", "60", "--robot-radius", "4.5",
-         "--max-attempts", "2", "--out", str(tmp_path / "d.yaml")],
-        capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-    assert failed.returncode == 2 and "no certified-solvable problem" in failed.stderr
-    assert failed.stderr.count("generate circles:") == 1 and not (tmp_path / "d.yaml").exists()
-
-
 def test_thousands_of_obstacles_stay_feasible():
     """Beyond 100 obstacles the default radii and robot shrink as 1 / sqrt(n): the world covers
     the share of the workspace the default count does, and is certified solvable (by the grid,
@@ -390,57 +283,6 @@ def test_thousands_of_obstacles_stay_feasible():
     assert "A collision-free path of length" in data["description"]
     world = World.from_problem(problem)
     assert world.point_free(*problem.start) and world.point_free(*problem.goal)
-
-
-# ----------------------------------------------------------------------------------------------
-# Options declared once: the flags, the header's command and the docs derive from them
-# ----------------------------------------------------------------------------------------------
-def _generate_parser():
-    import argparse
-
-    from rrtpso_ompl.cli.main import build_parser
-
-    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
-    return sub.choices["generate"]
-
-
-def test_every_option_of_every_kind_is_one_flag_of_rrtpso_generate():
-    flags = {a.dest: a for a in _generate_parser()._actions}
-    kinds = next(a for a in _generate_parser()._actions if a.dest == "kind").choices
-    assert list(kinds) == list(GENERATORS) == list(KINDS)
-    for cls in GENERATORS.values():
-        for spec in cls.PARAMS:
-            flag = flags[spec.name]
-            assert flag.option_strings == [f"--{spec.name.replace('_', '-')}"]
-            assert flag.type is spec.type and spec.doc in flag.help
-            assert flag.nargs == spec.length  # a range is two numbers
-            assert flag.choices == spec.choices and flag.default is None
-    # Nothing but the options, the seed, the output and --overwrite.
-    options = {n for cls in GENERATORS.values() for n in cls.PARAMS.names()}
-    assert set(flags) - options == {"help", "verbose", "quiet", "kind", "seed", "out", "overwrite"}
-
-
-def test_the_header_command_regenerates_the_file_through_the_command_line(tmp_path):
-    """Every option the header names is a flag: the header's command run as written gives the
-    same bytes (before the flags were derived, --resolution, --max-attempts and --decimals were
-    written into the header but were no flags of rrtpso generate)."""
-    import shlex
-    import subprocess
-
-    from helpers import rrtpso_exe
-
-    options = {"cells": 5, "resolution": 1.0, "max_attempts": 7, "decimals": 2, "name": "m5",
-               "algorithm": "kruskal"}  # fmt: skip
-    first = generate_to_file("maze", 3, tmp_path / "a.yaml", **options)
-    command = first.read_text().splitlines()[0].removeprefix("# Generated by: ")
-    assert command == (
-        "rrtpso generate maze --seed 3 --resolution 1.0 --max-attempts 7 "
-        "--decimals 2 --name m5 --cells 5 --algorithm kruskal --out FILE"
-    )
-    args = [*shlex.split(command)[1:-1], str(tmp_path / "b.yaml")]
-    proc = subprocess.run([*rrtpso_exe(), *args], capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 0, proc.stderr
-    assert (tmp_path / "b.yaml").read_bytes() == first.read_bytes()
 
 
 def test_the_header_names_the_options_that_differ_from_their_defaults(tmp_path):

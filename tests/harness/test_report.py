@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from rrtpso_ompl.harness.report import markdown_table
+from rrtpso_ompl.harness.report import markdown_table, write_markdown
 
 
 def test_a_table_is_header_rule_and_rows():
@@ -32,3 +32,12 @@ def test_a_cell_cannot_break_the_table():
 def test_a_ragged_table_is_refused(rows, align, message):
     with pytest.raises(ValueError, match=message):
         markdown_table(["a", "b"], rows, align=align)
+
+
+def test_a_report_is_written_and_printed_or_only_printed(tmp_path, capsys):
+    out = tmp_path / "r.md"
+    write_markdown(["# Title", "| a |"], out)
+    assert out.read_text() == "# Title\n| a |\n"
+    assert capsys.readouterr().out == "# Title\n| a |\n\n"  # print() adds its own newline
+    write_markdown(["only printed"], "-")
+    assert capsys.readouterr().out == "only printed\n\n" and not (tmp_path / "-").exists()

@@ -18,12 +18,7 @@ import pytest
 from helpers import PROBLEMS
 
 from rrtpso_ompl.harness.batch import Task, error_row, make_tasks, run_batch
-from rrtpso_ompl.harness.workers import (
-    ChildFailure,
-    _ParentGone,
-    run_local,
-    run_once_in_child,
-)
+from rrtpso_ompl.harness.workers import ChildFailure, _ParentGone, run_local, run_once_in_child
 
 ABORT = "__import__('os').abort()"
 KILL_WORKER = "__import__('os').kill(__import__('os').getppid(), 9)"

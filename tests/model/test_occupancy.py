@@ -2,14 +2,10 @@
 
 from __future__ import annotations
 
-import json
-import math
-import subprocess
-
 import numpy as np
 import pytest
 import shapely
-from helpers import PROBLEMS, rrtpso_exe
+from helpers import PROBLEMS, _corridor, _map, _pgm
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from PIL import Image
@@ -19,28 +15,6 @@ from rrtpso_ompl.model import World, load_problem, problem_from_dict
 from rrtpso_ompl.model.occupancy import OCCUPIED, UNKNOWN, load_map, merge_cells, read_pgm
 
 FREE_STATE = 0
-
-
-def _pgm(path, img: np.ndarray, binary: bool = True, maxval: int = 255) -> None:
-    h, w = img.shape
-    if binary:
-        dtype = ">u2" if maxval > 255 else "u1"
-        path.write_bytes(f"P5\n# c\n{w} {h}\n{maxval}\n".encode() + img.astype(dtype).tobytes())
-    else:
-        rows = "\n".join(" ".join(str(int(v)) for v in row) for row in img)
-        path.write_text(f"P2\n# comment\n{w} {h}\n# another\n{maxval}\n{rows}\n")
-
-
-def _map(tmp_path, img, name="m", image=None, **keys) -> str:
-    """A map YAML next to its image (a PGM unless ``image`` names one already written)."""
-    if image is None:
-        image = f"{name}.pgm"
-        _pgm(tmp_path / image, img)
-    doc = {"image": image, "resolution": 0.5, "origin": [0.0, 0.0, 0.0], "negate": 0,
-           "occupied_thresh": 0.65, "free_thresh": 0.196, **keys}  # fmt: skip
-    path = tmp_path / f"{name}.yaml"
-    path.write_text(json.dumps(doc))  # JSON is YAML
-    return str(path)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -161,22 +135,6 @@ def test_segment_checks_agree_with_shapely_on_the_blocked_squares(tmp_path, radi
 # ----------------------------------------------------------------------------------------------
 # Problems on maps: loader, bad input, every command
 # ----------------------------------------------------------------------------------------------
-def _corridor(tmp_path, **problem) -> str:
-    """A 20 x 10-cell map at 0.5 m: walls around, a wall with a gap in the middle, an unknown
-    patch."""
-    img = np.full((10, 20), 254, dtype=np.uint8)
-    img[[0, -1], :] = 0
-    img[:, [0, -1]] = 0
-    img[0:7, 10] = 0  # wall from the top, gap at the bottom
-    img[1:3, 14:17] = 205  # unknown
-    _map(tmp_path, img, name="corridor")
-    doc = {"map": "corridor.yaml", "start": [2.0, 3.0], "goal": [8.0, 2.5],
-           "robot": {"radius": 0.3}, **problem}  # fmt: skip
-    path = tmp_path / "prob.yaml"
-    path.write_text(json.dumps(doc))
-    return str(path)
-
-
 def test_a_map_problem_takes_bounds_and_units_from_the_map(tmp_path):
     p = load_problem(_corridor(tmp_path))
     assert p.bounds == ((0.0, 0.0), (10.0, 5.0)) and p.units == "m"
@@ -205,32 +163,6 @@ def test_bad_map_problems_name_the_file_key_and_cell(tmp_path, change, key, word
 
 
 @pytest.mark.parametrize(
-    ("keys", "key", "words"),
-    [
-        ({"origin": [0, 0, 0.5]}, "origin[2]", "rotated map"),
-        ({"free_thresh": 0.7}, "free_thresh", "below occupied_thresh"),
-        ({"occupied_thresh": 1.5}, "occupied_thresh", "between 0 and 1"),
-        ({"negate": 2}, "negate", "0 or 1"),
-        ({"mode": "fancy"}, "mode", "trinary, scale, raw"),
-        ({"resolution": 0}, "resolution", "> 0"),
-        ({"image": "missing.pgm"}, "image", "no such image file"),
-    ],
-)
-def test_bad_map_files_exit_2_naming_the_map_and_key(tmp_path, keys, key, words):
-    img = np.full((4, 4), 254, dtype=np.uint8)
-    _pgm(tmp_path / "m.pgm", img)
-    _map(tmp_path, img, **{"image": "m.pgm", **keys})
-    prob = tmp_path / "p.yaml"
-    prob.write_text("map: m.yaml\nstart: [0.5, 0.5]\ngoal: [1.5, 1.5]\nrobot: {radius: 0.1}\n")
-    out = tmp_path / "out.json"
-    proc = subprocess.run([*rrtpso_exe(), "solve", str(prob), "--json", str(out)],
-                          capture_output=True, text=True)  # fmt: skip
-    assert proc.returncode == 2, proc.stderr
-    assert "m.yaml" in proc.stderr and key in proc.stderr and words in proc.stderr
-    assert "Traceback" not in proc.stderr and not out.exists()
-
-
-@pytest.mark.parametrize(
     ("content", "words"),
     [
         (b"P5\n4 4\n255\n\x00", "truncated"),
@@ -247,39 +179,6 @@ def test_unreadable_images_are_clear_errors(tmp_path, content, words):
     assert "image" in str(exc.value) and words in str(exc.value)
 
 
-def test_solve_optimum_and_batch_on_a_map_problem(tmp_path):
-    prob = _corridor(tmp_path)
-    exe = rrtpso_exe()
-    sol, opt, nav = tmp_path / "s.json", tmp_path / "o.json", tmp_path / "path.yaml"
-    run = subprocess.run([*exe, "solve", prob, "--time", "0.5", "--seed", "3", "--json", str(sol),
-                          "--path-out", str(nav), "--plot", str(tmp_path / "s.png")],
-                         capture_output=True, text=True)  # fmt: skip
-    assert run.returncode == 0, run.stderr
-    run = subprocess.run([*exe, "optimum", prob, "--json", str(opt)],
-                         capture_output=True, text=True)  # fmt: skip
-    assert run.returncode == 0, run.stderr
-    s, o = json.loads(sol.read_text()), json.loads(opt.read_text())
-    world = World.from_problem(load_problem(prob))
-    assert world.path_valid(np.array(s["path"])) and world.path_valid(np.array(o["path"]))
-    assert o["length"] <= s["length"] + 1e-9
-    # The way round the wall's end: longer than straight, as long as the bend demands.
-    assert o["length"] > math.dist((2.0, 3.0), (8.0, 2.5)) + 0.5
-    import yaml
-
-    doc = yaml.safe_load(nav.read_text())
-    assert doc["header"]["frame_id"] == "map" and len(doc["poses"]) == len(s["path"])
-    q = doc["poses"][0]["pose"]["orientation"]
-    heading = math.atan2(s["path"][1][1] - s["path"][0][1], s["path"][1][0] - s["path"][0][0])
-    assert 2 * math.atan2(q["z"], q["w"]) == pytest.approx(heading)
-    rows = tmp_path / "b.jsonl"
-    run = subprocess.run([*exe, "batch", prob, str(PROBLEMS / "maps" / "lab_clutter.yaml"),
-                          "--time", "0.3", "--out", str(rows), "--jobs", "1"],
-                         capture_output=True, text=True)  # fmt: skip
-    assert run.returncode == 0, run.stderr
-    got = [json.loads(line) for line in rows.read_text().splitlines()]
-    assert len(got) == 2 and all(r["solved"] for r in got)
-
-
 def test_the_library_maps_load_and_the_big_one_stays_small():
     p = load_problem(PROBLEMS / "maps" / "warehouse_aisles.yaml")
     assert p.map.shape == (1700, 1000)
@@ -288,32 +187,6 @@ def test_the_library_maps_load_and_the_big_one_stays_small():
     assert counts["boxes"] < counts["blocked"] / 50  # merged
     for name in ("office_corridor", "lab_clutter"):
         assert load_problem(PROBLEMS / "maps" / f"{name}.yaml").map.counts()["unknown"] > 0
-
-
-def test_simulate_and_bench_accept_map_problems(tmp_path):
-    prob = _corridor(
-        tmp_path,
-        robot={"radius": 0.2, "wheel_radius": 0.05, "track_width": 0.3, "speed": 0.5,
-               "sample_time": 0.1, "sensor_range": 2.0},
-        moving_obstacles=[{"radius": 0.2, "start": [4.0, 3.5], "speed": 0.0, "heading_deg": 0}],
-    )  # fmt: skip
-    exe = rrtpso_exe()
-    out = tmp_path / "sim.json"
-    run = subprocess.run([*exe, "simulate", prob, "--json", str(out), "--seed", "1"],
-                         capture_output=True, text=True)  # fmt: skip
-    assert run.returncode == 0, run.stderr
-    doc = json.loads(out.read_text())
-    assert doc["reached_goal"] and doc["collisions"] == 0
-    world = World.from_problem(load_problem(prob))
-    xy = np.array(doc["trajectory"])[:, 1:3]
-    # Every sampled pose keeps the radius (chords between samples may cut a corner the robot
-    # drives round, so they are not checked).
-    assert (world.point_clearance(xy) >= world.threshold).all()
-    run = subprocess.run([*exe, "bench", prob, "--planner", "RRTstarPSO", "--runs", "1",
-                          "--time", "0.2", "--out", str(tmp_path / "b")],
-                         capture_output=True, text=True)  # fmt: skip
-    assert run.returncode == 0, run.stderr
-    assert (tmp_path / "b" / "benchmark.db").exists()
 
 
 @settings(max_examples=60, deadline=None)

@@ -1,4 +1,4 @@
-"""The `rrtpso` command as a user runs it: real processes, real files, exit codes, JSON."""
+"""``rrtpso solve`` as a user runs it: real processes, real files, exit codes, JSON."""
 
 from __future__ import annotations
 
@@ -8,13 +8,11 @@ from pathlib import Path
 
 import pytest
 import yaml
-from helpers import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
+from helpers import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe, run
+
+pytestmark = pytest.mark.slow
 
 CONTRACT_KEYS = {"problem", "planner", "status", "solved", "length", "time", "seed", "path"}
-
-
-def run(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
-    return subprocess.run([*rrtpso_exe(), *args], capture_output=True, text=True, timeout=timeout)
 
 
 @pytest.fixture
@@ -161,31 +159,6 @@ def _without_times(value):
         return {k: _without_times(v) for k, v in value.items()
                 if not (k == "time" or k.endswith("_time") or k == "progress")}  # fmt: skip
     return value
-
-
-def test_planners_lists_everything_with_params():
-    proc = run("planners", "--json")
-    assert proc.returncode == 0
-    rows = {r["name"]: r for r in json.loads(proc.stdout)}
-    for name in ("RRTstarPSO", "PSO", "RRTstar", "BITstar", "RRTConnect", "InformedRRTstar"):
-        assert name in rows
-    assert "geometric::RRTstar" in rows["RRTstar"]["aliases"]
-    params = {p["name"]: p for p in rows["RRTstarPSO"]["params"]}
-    for name in (
-        "range",
-        "goal_bias",
-        "rewire_factor",
-        "rrt_time_fraction",
-        "swarm_size",
-        "iterations",
-        "w",
-        "c1",
-        "c2",
-    ):
-        assert name in params
-    text = run("planners", "RRTstarPSO")
-    assert text.returncode == 0 and "swarm_size" in text.stdout
-    assert run("planners", "Nope").returncode == 2
 
 
 #: The shipped problems with a drive (wheel radius, track width, speed, sample time).

@@ -1,0 +1,14 @@
+"""``none``: the baseline that never replans."""
+
+from __future__ import annotations
+
+from ..replanning import ReplanningStrategy
+
+__all__ = ["Blind"]
+
+
+class Blind(ReplanningStrategy):
+    """Never replan: drive the static path blindly (a baseline)."""
+
+    name = "none"
+    policy = None

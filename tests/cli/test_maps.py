@@ -1,0 +1,100 @@
+"""Map problems through the command line: bad map files, and every subcommand on a map."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+
+import numpy as np
+import pytest
+from helpers import PROBLEMS, _corridor, _map, _pgm, rrtpso_exe
+
+from rrtpso_ompl.model import World, load_problem
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.mark.parametrize(
+    ("keys", "key", "words"),
+    [
+        ({"origin": [0, 0, 0.5]}, "origin[2]", "rotated map"),
+        ({"free_thresh": 0.7}, "free_thresh", "below occupied_thresh"),
+        ({"occupied_thresh": 1.5}, "occupied_thresh", "between 0 and 1"),
+        ({"negate": 2}, "negate", "0 or 1"),
+        ({"mode": "fancy"}, "mode", "trinary, scale, raw"),
+        ({"resolution": 0}, "resolution", "> 0"),
+        ({"image": "missing.pgm"}, "image", "no such image file"),
+    ],
+)
+def test_bad_map_files_exit_2_naming_the_map_and_key(tmp_path, keys, key, words):
+    img = np.full((4, 4), 254, dtype=np.uint8)
+    _pgm(tmp_path / "m.pgm", img)
+    _map(tmp_path, img, **{"image": "m.pgm", **keys})
+    prob = tmp_path / "p.yaml"
+    prob.write_text("map: m.yaml\nstart: [0.5, 0.5]\ngoal: [1.5, 1.5]\nrobot: {radius: 0.1}\n")
+    out = tmp_path / "out.json"
+    proc = subprocess.run([*rrtpso_exe(), "solve", str(prob), "--json", str(out)],
+                          capture_output=True, text=True)  # fmt: skip
+    assert proc.returncode == 2, proc.stderr
+    assert "m.yaml" in proc.stderr and key in proc.stderr and words in proc.stderr
+    assert "Traceback" not in proc.stderr and not out.exists()
+
+
+def test_solve_optimum_and_batch_on_a_map_problem(tmp_path):
+    prob = _corridor(tmp_path)
+    exe = rrtpso_exe()
+    sol, opt, nav = tmp_path / "s.json", tmp_path / "o.json", tmp_path / "path.yaml"
+    run = subprocess.run([*exe, "solve", prob, "--time", "0.5", "--seed", "3", "--json", str(sol),
+                          "--path-out", str(nav), "--plot", str(tmp_path / "s.png")],
+                         capture_output=True, text=True)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    run = subprocess.run([*exe, "optimum", prob, "--json", str(opt)],
+                         capture_output=True, text=True)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    s, o = json.loads(sol.read_text()), json.loads(opt.read_text())
+    world = World.from_problem(load_problem(prob))
+    assert world.path_valid(np.array(s["path"])) and world.path_valid(np.array(o["path"]))
+    assert o["length"] <= s["length"] + 1e-9
+    # The way round the wall's end: longer than straight, as long as the bend demands.
+    assert o["length"] > math.dist((2.0, 3.0), (8.0, 2.5)) + 0.5
+    import yaml
+
+    doc = yaml.safe_load(nav.read_text())
+    assert doc["header"]["frame_id"] == "map" and len(doc["poses"]) == len(s["path"])
+    q = doc["poses"][0]["pose"]["orientation"]
+    heading = math.atan2(s["path"][1][1] - s["path"][0][1], s["path"][1][0] - s["path"][0][0])
+    assert 2 * math.atan2(q["z"], q["w"]) == pytest.approx(heading)
+    rows = tmp_path / "b.jsonl"
+    run = subprocess.run([*exe, "batch", prob, str(PROBLEMS / "maps" / "lab_clutter.yaml"),
+                          "--time", "0.3", "--out", str(rows), "--jobs", "1"],
+                         capture_output=True, text=True)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    got = [json.loads(line) for line in rows.read_text().splitlines()]
+    assert len(got) == 2 and all(r["solved"] for r in got)
+
+
+def test_simulate_and_bench_accept_map_problems(tmp_path):
+    prob = _corridor(
+        tmp_path,
+        robot={"radius": 0.2, "wheel_radius": 0.05, "track_width": 0.3, "speed": 0.5,
+               "sample_time": 0.1, "sensor_range": 2.0},
+        moving_obstacles=[{"radius": 0.2, "start": [4.0, 3.5], "speed": 0.0, "heading_deg": 0}],
+    )  # fmt: skip
+    exe = rrtpso_exe()
+    out = tmp_path / "sim.json"
+    run = subprocess.run([*exe, "simulate", prob, "--json", str(out), "--seed", "1"],
+                         capture_output=True, text=True)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    doc = json.loads(out.read_text())
+    assert doc["reached_goal"] and doc["collisions"] == 0
+    world = World.from_problem(load_problem(prob))
+    xy = np.array(doc["trajectory"])[:, 1:3]
+    # Every sampled pose keeps the radius (chords between samples may cut a corner the robot
+    # drives round, so they are not checked).
+    assert (world.point_clearance(xy) >= world.threshold).all()
+    run = subprocess.run([*exe, "bench", prob, "--planner", "RRTstarPSO", "--runs", "1",
+                          "--time", "0.2", "--out", str(tmp_path / "b")],
+                         capture_output=True, text=True)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert (tmp_path / "b" / "benchmark.db").exists()
