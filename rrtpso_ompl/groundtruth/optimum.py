@@ -13,7 +13,8 @@ LaValle, *Planning Algorithms*, 2006, section 6.2.4; Latombe 1991 for the polygo
    lie on one lattice (a map's merged cells), the corners come straight from the cells: the grid
    points where exactly one of the four cells around is blocked. A vertex's circle carries its
    *cone*: a path wraps it only between the outward normals of its two edges (a quarter circle
-   at a map corner), elsewhere it would enter an edge's offset.
+   at a map corner), elsewhere it would enter an edge's offset. The cone's ends belong to it,
+   with room for round-off: a path along an edge leaves and reaches its vertices exactly there.
 2. **A\* over tangents, built as it goes.** A node is a tangent point on a circle and the sense
    (clockwise or counter-clockwise) in which the path wraps that circle; from it the path follows
    the circle in that sense and leaves along a common tangent (two outer and two inner per pair of
@@ -633,7 +634,7 @@ class _TangentSearch:
             return False
         key = (i, s)
         rho = float(self.circles[i, 2])
-        pos = (self.angle[u] - self.lo[i]) % _TWO_PI
+        pos = float(_cone_pos(self.angle[u], self.lo[i]))
         g = float(self.g[u])
         seen = self._expanded.setdefault(key, [])
         for g_a, pos_a in seen:
@@ -677,12 +678,14 @@ class _TangentSearch:
             idx = np.flatnonzero(cand.sense_i == s)
             if self.width[i] < _TWO_PI:
                 # The arc stays on the circle's free arc: from u's point on, in u's sense.
-                pos_u = (self.angle[u] - self.lo[i]) % _TWO_PI
+                pos_u = _cone_pos(self.angle[u], self.lo[i])
                 ahead = s * (cand.pos_i[idx] - pos_u)
-                idx = idx[ahead >= -1e-9]
+                idx = idx[ahead >= -_ANGLE_TOL]
                 sweep = np.maximum(s * (cand.pos_i[idx] - pos_u), 0.0)
             else:
-                sweep = np.mod(s * (cand.angle_i[idx] - self.angle[u]), _TWO_PI)
+                # Leaving where it arrived is no turn, whichever way round-off goes.
+                turn = s * (cand.angle_i[idx] - self.angle[u]) + _ANGLE_TOL
+                sweep = np.maximum(np.mod(turn, _TWO_PI) - _ANGLE_TOL, 0.0)
         else:
             idx = np.arange(len(cand.j))
             sweep = np.zeros(len(idx))
@@ -779,11 +782,11 @@ class _TangentSearch:
         row, j = self._shadowed(batch, row, j)
         cand = _tangents_from(c, batch[row], j)
         i = cand.i
-        cand.pos_i = np.mod(cand.angle_i - self.lo[i], _TWO_PI)
+        cand.pos_i = _cone_pos(cand.angle_i, self.lo[i])
         wi, wj = self.width[i], self.width[cand.j]
-        pos_j = np.mod(cand.angle_j - self.lo[cand.j], _TWO_PI)
-        cone = ((wi >= _TWO_PI) | (cand.pos_i <= wi + 1e-7)) & (
-            (wj >= _TWO_PI) | (pos_j <= wj + 1e-7))  # fmt: skip
+        pos_j = _cone_pos(cand.angle_j, self.lo[cand.j])
+        cone = ((wi >= _TWO_PI) | (cand.pos_i <= wi + _ANGLE_TOL)) & (
+            (wj >= _TWO_PI) | (pos_j <= wj + _ANGLE_TOL))  # fmt: skip
         cand = cand.take(np.flatnonzero(cone))
         cand.q = self._ends(cand, cand.j == 1)
         cand.seg = np.hypot(*(cand.q - cand.p).T)
@@ -1167,6 +1170,31 @@ def _edges_of(world: World, arc: np.ndarray, ids: np.ndarray, kind: np.ndarray):
 
 
 # ----------------------------------------------------------------------------------------------
+#: Round-off allowed on angles at a cone's ends, radians: a tangent along a polygon's edge leaves
+#: and reaches its end vertices exactly at their cones' ends, and which side of them its computed
+#: angles fall on is chance. (A tangent that far outside a cone comes nearer the edge by
+#: ``rho (1 - cos(1e-7))``, about ``5e-15 rho``: far below the touch tolerance.)
+_ANGLE_TOL = 1e-7
+
+
+def _cone_pos(angle: Any, lo: Any) -> Any:
+    """Angle from the start of a circle's free arc, counter-clockwise.
+
+    Parameters
+    ----------
+    angle, lo : float or ndarray
+        Angles of the points and of the free arc's start, radians.
+
+    Returns
+    -------
+    float or ndarray
+        Radians, in ``[-_ANGLE_TOL, 2 pi - _ANGLE_TOL)``: an angle a hair before the start stays
+        a hair before it (a plain ``mod`` puts it a whole turn ahead, outside every cone, and
+        the search refused the tangents along half of the polygons' edges).
+    """
+    return np.mod(angle - lo + _ANGLE_TOL, _TWO_PI) - _ANGLE_TOL
+
+
 def _in_sweep(phi: Any, a0: np.ndarray, sweep: np.ndarray) -> np.ndarray:
     """Whether angle ``phi`` lies on the counter-clockwise arc from ``a0`` through ``sweep``."""
     return np.mod(phi - a0, _TWO_PI) <= sweep
