@@ -90,7 +90,12 @@ def run(args: argparse.Namespace) -> int:
     check_seed_flag(args.seed)
     options = {k: getattr(args, k) for k in _options() if getattr(args, k) is not None}
     # A map kind writes the map beside the problem (<stem>_map.yaml and .pgm): each is checked.
-    paths = GENERATORS[args.kind].output_paths(args.out) if args.out != "-" else [args.out]
+    kind = GENERATORS[args.kind]
+    try:
+        kind.check_places(args.out)
+    except GenerationError as exc:
+        raise UsageError(f"--out: {exc}") from None
+    paths = kind.output_paths(args.out) if args.out != "-" else [args.out]
     check_outputs([Output("--out", str(p)) for p in paths])
     for p in paths:
         if os.path.lexists(p) and not args.overwrite and not is_stream(p):

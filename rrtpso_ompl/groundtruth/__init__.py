@@ -9,11 +9,14 @@
 
 from .certify import grid_path, is_solvable
 from .generate import generate, generate_to_file
+from .map_kinds import GeneratedMap, generate_map
 from .optimum import OptimumResult, shortest_path
 
 __all__ = [
+    "GeneratedMap",
     "OptimumResult",
     "generate",
+    "generate_map",
     "generate_to_file",
     "grid_path",
     "is_solvable",

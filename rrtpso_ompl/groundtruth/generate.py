@@ -7,12 +7,21 @@ order, so it round-trips through :func:`~rrtpso_ompl.model.problem_from_dict` an
 dictionary as a problem file and :func:`generate_to_file` does both (the ``rrtpso generate``
 command is a thin wrapper around it).
 
-Three kinds (:data:`GENERATORS`, by name):
+The first three kinds (:data:`GENERATORS`, by name):
 
 * ``"circles"``: random non-overlapping circles (:class:`CirclesOptions`);
 * ``"polygons"``: random non-overlapping convex polygons (:class:`PolygonsOptions`);
 * ``"maze"``: a perfect maze (exactly one route between any two cells) on a grid of cells, its walls
   as rectangles, start and goal in opposite corner cells (:class:`MazeOptions`).
+
+More kinds register from their own modules, imported at the end of this one:
+:mod:`.shape_kinds` (``slabs``, ``combs``, ``spiral``, ``rooms``: shapes, certified as these) and
+:mod:`.map_kinds` (``rooms_map``, ``maze_map``, ``city_map``, ``warehouse_map``, ``caves_map``,
+``random_map``: occupancy-grid maps written beside the problem; :func:`generate` returns the
+problem dictionary, whose ``map`` names the map relatively, and
+:func:`~.map_kinds.generate_map` the map too). A kind may override how it is generated and
+written (:meth:`GeneratorOptions.problem_dict`, :meth:`~GeneratorOptions.write`,
+:meth:`~GeneratorOptions.output_paths`, :meth:`~GeneratorOptions.check_places`).
 
 Every random choice comes from one ``numpy.random.default_rng(seed)`` stream, and nothing else
 (no clock, no hash order) enters the output, so the same kind, seed and options give a
@@ -168,6 +177,11 @@ class GeneratorOptions:
     def output_paths(cls, out: str | Path) -> list[Path]:
         """The files :meth:`write` makes for ``out``: ``[out]`` (map kinds add the map's two)."""
         return [Path(out)]
+
+    @classmethod
+    def check_places(cls, out: str | Path) -> None:
+        """Refuse places :meth:`write` cannot use (:class:`GenerationError`); any for one file
+        (the command line's output rules apply), map kinds refuse more."""
 
     def write(self, seed: int, out: str | Path) -> Path:
         """Generate the problem of seed ``seed`` and write it to ``out`` (see
@@ -812,6 +826,7 @@ def _cli_value(value: Any) -> str:
 #: The kinds defined here, in order (:data:`GENERATORS` holds every registered kind).
 KINDS: tuple[str, ...] = tuple(GENERATORS)
 
-# The map kinds (rooms_map, maze_map, ...) register themselves on import; they import this module,
-# so they come last.
+# The shape kinds (slabs, combs, spiral, rooms) and the map kinds (rooms_map, maze_map, ...)
+# register themselves on import; they import this module, so they come last.
 from . import map_kinds as _map_kinds  # noqa: E402, F401
+from . import shape_kinds as _shape_kinds  # noqa: E402, F401

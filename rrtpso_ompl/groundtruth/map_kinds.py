@@ -60,7 +60,6 @@ from scipy.spatial import ConvexHull, QhullError
 
 from ..errors import GenerationError, ProblemError
 from ..model.geometry import path_length
-from ..model.geometry import shortcut as shortcut_path
 from ..model.occupancy import OccupancyMap
 from ..model.problem import problem_from_dict
 from ..model.problem_file import round_floats, write_problem
@@ -196,14 +195,14 @@ class GeneratedMap:
             for p in moved:
                 with contextlib.suppress(OSError):
                     p.unlink()
+            if tmp is not None:
+                shutil.rmtree(tmp, ignore_errors=True)
             remove_folders(made)
             if isinstance(exc, OSError):
                 raise GenerationError(f"cannot write '{out}' and its map: {exc.strerror or exc}"
                                       ) from None  # fmt: skip
             raise
-        finally:
-            if tmp is not None:
-                shutil.rmtree(tmp, ignore_errors=True)
+        shutil.rmtree(tmp, ignore_errors=True)
         return out
 
 
@@ -315,7 +314,14 @@ class MapKindOptions(GeneratorOptions):
     def output_paths(cls, out: str | Path) -> list[Path]:
         return map_output_paths(out)
 
+    @classmethod
+    def check_places(cls, out: str | Path) -> None:
+        """Refuse ``-`` and a link, fifo or folder at any of the three places."""
+        for p in map_output_paths(out) if str(out) != "-" else ["-"]:
+            _check_writable_place(Path(p))
+
     def write(self, seed: int, out: str | Path) -> Path:
+        self.check_places(out)  # before the map is drawn
         return generate_map_from(self.resolved(), seed, generate_command(self, seed)).write(out)
 
 
@@ -517,8 +523,28 @@ def _certify(world: World, lat: Lattice, cells: np.ndarray, start, goal) -> np.n
     step = np.diff(path, axis=0)
     turn = np.any(step[1:] != step[:-1], axis=1)
     path = path[np.concatenate([[True], turn, [True]])] if len(path) > 2 else path
-    path = shortcut_path(path, world.segments_free, window=8)
+    path = _straighten(path, world)
     return path if world.path_valid(path) else None
+
+
+def _straighten(path: np.ndarray, world: World, passes: int = 24) -> np.ndarray:
+    """Drop waypoints whose neighbours see each other, in vectorised passes: each pass tests
+    every ``(p[i], p[i + 2])`` at once (exact segment test) and drops ``p[i + 1]`` where it is
+    free, for ``i`` of one parity only (two dropped waypoints are never neighbours, so every
+    new segment was tested). A long maze route of thousands of turns takes a few calls, where
+    the greedy shortcut would take one per kept waypoint."""
+    for k in range(passes):
+        if len(path) < 3:
+            break
+        free = world.segments_free(path[:-2], path[2:])
+        i = np.arange(len(free))
+        drop = free & (i % 2 == k % 2)
+        if not drop.any() and not (free & (i % 2 != k % 2)).any():
+            break
+        keep = np.ones(len(path), dtype=bool)
+        keep[1:-1][drop] = False
+        path = path[keep]
+    return path
 
 
 # ----------------------------------------------------------------------------------------------
@@ -548,7 +574,7 @@ class RoomsMapOptions(MapKindOptions):
         high=1.0,
     )
     clutter: float = param(
-        0.5, "Furniture against the walls: pieces per room (never in front of a door).",
+        2.0, "Furniture against the walls: pieces per room (never in front of a door).",
         low=0.0, high=10.0,
     )  # fmt: skip
 
