@@ -669,11 +669,10 @@ def _round_corners(path: np.ndarray, corners, r: float) -> np.ndarray | None:
     """The taut string from ``path[0]`` to ``path[-1]`` round circles of radius ``r`` at the
     ``corners`` (one per interior vertex: a point passed on the side the path turns to there,
     a ``(point, side)`` pair, side +1 for a corner on the left, or None for a vertex kept as a
-    point); every arc replaced by the polygon circumscribed about it
-    (vertices at ``r / cos(delta / 2)``, ``delta`` at most 45 degrees), so no segment comes
-    closer than ``r`` to a corner. Also returns, for every vertex, the index of the path vertex
-    whose circle it lies on. None when two circles on opposite sides overlap or an arc would
-    turn back (the corners do not make a taut string)."""
+    point); every arc replaced by the polygon circumscribed about it (:func:`_arc_polygon`), so
+    no segment comes closer than ``r`` to a corner. Also returns, for every vertex, the index
+    of the path vertex whose circle it lies on. None when two circles on opposite sides overlap
+    or an arc would turn back (the corners do not make a taut string)."""
     centres, side = [path[0]], [0.0]
     for k, corner in enumerate(corners, start=1):
         d_in, d_out = path[k] - path[k - 1], path[k + 1] - path[k]
@@ -712,28 +711,38 @@ def _round_corners(path: np.ndarray, corners, r: float) -> np.ndarray | None:
             out.append(c[k])
             owner.append(k)
             continue
-        a_in = math.atan2(arrive[k - 1][1] - c[k][1], arrive[k - 1][0] - c[k][0])
-        a_out = math.atan2(leave[k][1] - c[k][1], leave[k][0] - c[k][0])
-        sweep = (a_out - a_in) % (2.0 * math.pi)
-        if s[k] < 0:
-            sweep -= 2.0 * math.pi
-        if abs(sweep) > math.pi:
+        arc = _arc_polygon(c[k], r, arrive[k - 1], leave[k], s[k])
+        if arc is None:
             return None
-        pieces = max(1, math.ceil(abs(sweep) / (0.25 * math.pi)))
-        delta = sweep / pieces
-        ang = a_in + (np.arange(pieces) + 0.5) * delta
-        out.extend(c[k] + (r / math.cos(0.5 * delta)) * np.column_stack([np.cos(ang), np.sin(ang)]))
-        owner.extend([k] * pieces)
+        out.extend(arc)
+        owner.extend([k] * len(arc))
     out.append(c[-1])
     owner.append(len(c) - 1)
     return np.asarray(out), np.asarray(owner)
 
 
+def _arc_polygon(centre, r: float, enter, leave, side: float) -> np.ndarray | None:
+    """The polygon circumscribed about the arc of radius ``r`` round ``centre`` from ``enter``
+    to ``leave`` (counter-clockwise for ``side`` +1), in pieces of at most 45 degrees, vertices
+    at ``r / cos(delta / 2)``: its edges are tangent to the circle. None for an arc of more
+    than half a turn (the string would turn back)."""
+    a_in = math.atan2(enter[1] - centre[1], enter[0] - centre[0])
+    a_out = math.atan2(leave[1] - centre[1], leave[0] - centre[0])
+    sweep = (a_out - a_in) % (2.0 * math.pi)
+    if side < 0:
+        sweep -= 2.0 * math.pi
+    if abs(sweep) > math.pi:
+        return None
+    pieces = max(1, math.ceil(abs(sweep) / (0.25 * math.pi)))
+    delta = sweep / pieces
+    ang = a_in + (np.arange(pieces) + 0.5) * delta
+    return centre + (r / math.cos(0.5 * delta)) * np.column_stack([np.cos(ang), np.sin(ang)])
+
+
 def centre_route(model: Any, start, goal, max_cells: int = 65_536, terminate=None,
                  lattice: Lattice | None = None, within=None):  # fmt: skip
     """A path through the centres of lattice cells whose centre is free, every segment checked:
-    for a free space too thin for any wholly free cell (a disc robot in a corridor barely wider
-    than it), where :func:`corridor_path` finds no route.
+    for free space too thin for any wholly free cell, where :func:`corridor_path` finds none.
 
     Dijkstra's algorithm over the cells with a free centre (16-connected, as
     :func:`corridor_path`), then every segment of the route through the model's exact check; a
@@ -787,14 +796,20 @@ def centre_route(model: Any, start, goal, max_cells: int = 65_536, terminate=Non
                 path = taut
             return CorridorResult(path, path_length(path), lat, int(free.sum()), len(nodes),
                                   time.perf_counter() - t0, "", {}, 1, 0)  # fmt: skip
-        for a, b in zip(nodes[:-1][~ok], nodes[1:][~ok], strict=True):
-            for u, v in ((a, b), (b, a)):  # the edge is stored once, in either direction
-                lo, hi = graph.indptr[u], graph.indptr[u + 1]
-                at = lo + np.searchsorted(graph.indices[lo:hi], v)
-                if at < hi and graph.indices[at] == v:
-                    graph.data[at] = _CUT  # as good as gone
+        _cut_edges(graph, nodes[:-1][~ok], nodes[1:][~ok])
     return CorridorResult(None, lattice=lat, cells=int(free.sum()), time=time.perf_counter() - t0,
                           reason="no checked route through free cell centres")  # fmt: skip
+
+
+def _cut_edges(graph, tails, heads) -> None:
+    """Give the edges ``tails[i] - heads[i]`` of the sorted CSR ``graph`` the weight
+    :data:`_CUT`: no route uses them while another exists."""
+    for a, b in zip(tails, heads, strict=True):
+        for u, v in ((a, b), (b, a)):  # the edge is stored once, in either direction
+            lo, hi = graph.indptr[u], graph.indptr[u + 1]
+            at = lo + np.searchsorted(graph.indices[lo:hi], v)
+            if at < hi and graph.indices[at] == v:
+                graph.data[at] = _CUT  # as good as gone
 
 
 def _thin_funnel(model, lat: Lattice, free: np.ndarray, route, path, s_hop: bool, g_hop: bool):
@@ -868,63 +883,42 @@ def search(
     alternatives: int = 3,
     no_route_seconds: float | None = None,
 ) -> CorridorResult:
-    """The corridor stage within ``seconds``: corridors chosen on a coarse lattice, each searched
-    again on a fine lattice within a band round it.
+    """The corridor stage within ``seconds`` (None: no limit but ``max_cells``).
 
-    1. **Coarse routes.** A lattice small enough to route on in a third of the time (at
-       :data:`CELLS_PER_SECOND`) whose cells are open generously: for a map, a coarse cell is
-       open when any of the fine cells it pools is wholly free (marking a map's cells is cheap:
-       :data:`MARK_CELLS_PER_SECOND`); among shapes, when its centre is free. No passage the
-       fine cells keep is closed at the coarse level. The shortest route and ``alternatives``
-       through other corridors (:func:`alternative_routes`).
-    2. **Fine route in each corridor.** For each coarse route, best first, the fine cells within
-       :data:`BAND_CELLS` coarse cells of it, marked wholly free or not (a box of the lattice
-       round the band, so the work follows the band, not the whole map), the route over them
-       (a coarse passage whose fine cells do not connect has none) and its funnel path. The
-       shortest valid path wins.
+    A map whose fine lattice fits the time (:data:`DIRECT_CELLS_PER_SECOND`) is searched whole
+    (:func:`_route_and_funnel`). Otherwise:
 
-    With no route yet, the search may go on until ``no_route_seconds`` (there is nothing for
-    the later stages to refine meanwhile): a map's whole fine lattice if it fits, then, free
-    space too thin for any wholly free fine cell, :func:`centre_route`. ``seconds`` None: no
-    limit but ``max_cells``.
+    1. **Coarse routes** on a lattice small enough to route on in a third of the time
+       (:data:`CELLS_PER_SECOND`), its cells open generously (a map's when any fine cell they
+       pool is wholly free; among shapes when their centre is free): no passage the fine cells
+       keep is closed. The shortest route and ``alternatives`` through other corridors.
+    2. **A fine route in each corridor**, best first: the fine cells within :data:`BAND_CELLS`
+       coarse cells of it (marked in a box round the band: the work follows the band), the route
+       over them and its funnel path. The shortest valid path wins.
+
+    With no route yet, the search may go on until ``no_route_seconds`` (nothing is left for the
+    later stages to refine meanwhile): a map's whole fine lattice if it fits, then, for free
+    space too thin for any wholly free fine cell, :func:`centre_route`.
     """
     t0 = time.perf_counter()
     end = None if seconds is None else t0 + seconds
-    start = np.asarray(start, dtype=float)
-    goal = np.asarray(goal, dtype=float)
+    start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
     stages: dict[str, float] = {}
-
     out_of_time = _Deadline(end, terminate)
     if end is not None and no_route_seconds is not None:
         out_of_time.grace_end = max(end, t0 + no_route_seconds)
 
-    def left() -> float:
-        return math.inf if end is None else max(end - time.perf_counter(), 0.0)
-
-    route_cells = int(min(max_cells, max(CELLS_PER_SECOND * left() / 3.0, 1024)))
+    left = out_of_time.left
     on_map = getattr(model, "raster", None) is not None
     # Among shapes the wholly free cells may miss gaps narrower than a cell (a dense field of
     # circles): time is kept for the route through free cell centres.
     first = (out_of_time if on_map or end is None
              else _Deadline(t0 + SHAPE_BAND_SHARE * seconds, terminate))  # fmt: skip
-    while True:
-        t1 = time.perf_counter()
-        if on_map:
-            fine_cells = int(min(max_cells, max(0.4 * MARK_CELLS_PER_SECOND * left(), 4096)))
-            result = _map_corridors(model, fine_cells, route_cells, start, goal, alternatives,
-                                    out_of_time, t0, stages, left)  # fmt: skip
-        else:
-            result = _shape_corridors(model, route_cells, max_cells, start, goal, alternatives,
-                                      first, t0, stages)  # fmt: skip
-        # No corridor held a route at the fine level: the coarse lattice joined cells that do
-        # not join. Twice the coarse cells, while a try as long again fits twice over.
-        took = time.perf_counter() - t1
-        if result.path is not None or route_cells >= max_cells or first() or left() < 4.0 * took:
-            break
-        route_cells = min(2 * route_cells, max_cells)
+    result, fine_cells, route_cells = _coarse_tries(model, start, goal, max_cells, alternatives,
+                                                    out_of_time, first, t0, stages)  # fmt: skip
     if result.path is None and end is not None and no_route_seconds is not None:
-        end = out_of_time.end = max(end, t0 + no_route_seconds)
-        if on_map and not out_of_time():
+        out_of_time.end = max(end, t0 + no_route_seconds)
+        if on_map and not out_of_time():  # the whole fine lattice, if it now fits
             result = _map_corridors(model, fine_cells, route_cells, start, goal, 0, out_of_time,
                                     t0, stages, left)  # fmt: skip
     if result.path is None and not out_of_time():
@@ -933,6 +927,30 @@ def search(
         if thin.path is not None:
             result = thin
     return dataclasses.replace(result, time=time.perf_counter() - t0, stages=stages)
+
+
+def _coarse_tries(model, start, goal, max_cells, alternatives, out_of_time, first, t0, stages):
+    """:func:`search`'s tries until a path, ``first()`` or too little time: when no corridor
+    held a route at the fine level (the coarse lattice joined cells that do not join), twice the
+    coarse cells, while a try as long again fits twice over. The last result, the fine and the
+    coarse lattice's cells."""
+    left = out_of_time.left
+    on_map = getattr(model, "raster", None) is not None
+    route_cells = int(min(max_cells, max(CELLS_PER_SECOND * left() / 3.0, 1024)))
+    fine_cells = 0
+    while True:  # at most log2(max_cells) rounds: the coarse cells double each time
+        t1 = time.perf_counter()
+        if on_map:
+            fine_cells = int(min(max_cells, max(0.4 * MARK_CELLS_PER_SECOND * left(), 4096)))
+            result = _map_corridors(model, fine_cells, route_cells, start, goal, alternatives,
+                                    out_of_time, t0, stages, left)  # fmt: skip
+        else:
+            result = _shape_corridors(model, route_cells, max_cells, start, goal, alternatives,
+                                      first, t0, stages)  # fmt: skip
+        took = time.perf_counter() - t1
+        if result.path is not None or route_cells >= max_cells or first() or left() < 4.0 * took:
+            return result, fine_cells, route_cells
+        route_cells = min(2 * route_cells, max_cells)
 
 
 def _map_corridors(model, fine_cells, route_cells, start, goal, alternatives, terminate, t0,
@@ -1052,6 +1070,10 @@ class _Deadline:
     def __init__(self, end: float | None, terminate=None) -> None:
         self.end, self.terminate = end, terminate
         self.grace_end = end
+
+    def left(self) -> float:
+        """Seconds until ``end`` (infinite without one)."""
+        return math.inf if self.end is None else max(self.end - time.perf_counter(), 0.0)
 
     def grace(self) -> bool:
         return bool(self.terminate is not None and self.terminate()) or (
