@@ -843,6 +843,14 @@ def _rooms(rng, size: int, room, door, wall: int, extra: float, clutter: float):
             c = cols[j + 1]
             g[off : off + w, c : c + wall] = False
             keep[max(off - 1, 0) : off + w + 1, max(c - reach, 0) : c + wall + reach] = True
+    _furnish(rng, g, keep, rows, cols, wall, clutter)
+    return g
+
+
+def _furnish(rng, g: np.ndarray, keep: np.ndarray, rows, cols, wall: int, clutter: float):
+    """Pieces of furniture (``clutter`` per room on average) against a wall of a random room,
+    each kept out of the ``keep`` cells in front of the doors."""
+    nr, nc = len(rows) - 1, len(cols) - 1
     pieces = int(rng.poisson(clutter * nr * nc)) if clutter > 0 else 0
     for _ in range(min(pieces, 10 * nr * nc)):  # furniture against a wall of a random room
         i, j = int(rng.integers(nr)), int(rng.integers(nc))
@@ -865,7 +873,6 @@ def _rooms(rng, size: int, room, door, wall: int, extra: float, clutter: float):
         a0, a1, b0, b1 = box
         if not keep[a0:a1, b0:b1].any():
             g[a0:a1, b0:b1] = True
-    return g
 
 
 def _city(rng, size: int, street, block, avenue: float, plazas: float):

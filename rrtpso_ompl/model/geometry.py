@@ -149,9 +149,8 @@ def shortcut(
 
     Notes
     -----
-    The look-ahead window starts at ``window`` vertices and doubles while its far end is in
-    sight, so a long winding route (a grid path of thousands of vertices) is not tested against
-    every later vertex; the visibility calls are chunked to bound their memory.
+    The doubling window keeps a long winding route (thousands of vertices) from being tested
+    against every later vertex; the visibility calls are chunked to bound their memory.
     """
     p = np.asarray(path, dtype=float).reshape(-1, 2)
     if len(p) <= 2:
