@@ -88,10 +88,6 @@ RRTSTAR_PSO_PARAMS = (
         ParamSpec("rrt_time_fraction", float, 0.9,
                   "Share of the budget (after the corridor stage) given to RRT*; the PSO gets "
                   "the rest.", low=1e-3, high=1.0),
-        ParamSpec("rrt_time_fraction_with_corridor", float, 0.9,
-                  "RRT*'s share, as rrt_time_fraction, when the corridor stage found a path: "
-                  "RRT* then only competes with a path already in the best corridor found, and "
-                  "the swarm may need the time more.", low=1e-3, high=1.0),
         ParamSpec("stall_fraction", float, 0.25,
                   "Hand over to the swarm before RRT*'s share is used up once RRT*'s best cost "
                   "has fallen by less than 0.1 % over this share of the budget (0 = never).",
@@ -553,7 +549,7 @@ class RRTstarPSO(PythonPlanner):
         budget = values["budget"]
         t_begin = time.perf_counter()
         # RRT*'s share of what the corridor stage left.
-        share = values["rrt_time_fraction" if fallback else "rrt_time_fraction_with_corridor"]
+        share = values["rrt_time_fraction"]
         rrt_end = t_begin + share * max(t0 + budget - t_begin, 0.0) if budget > 0 else None
         if resume:  # grown on after a swarm run: until a stall again, or 70 % of what is left
             rrt_end = t_begin + 0.7 * max(t0 + budget - t_begin, 0.0)
