@@ -58,6 +58,8 @@ DIRECT_CELLS_PER_SECOND = 1_200_000
 #: Lattice cells per second :func:`centre_route` builds and routes over among shapes, on the
 #: safe side (measured 0.6-1 million among 10,000 circles).
 CENTRE_CELLS_PER_SECOND = 600_000
+#: Cells of the small lattice on which the cost of marking cells among shapes is measured.
+MARKING_PROBE_CELLS = 1_600
 #: Among shapes, the share of the stage's time for the bands of wholly free cells; the rest is
 #: kept for :func:`centre_route` in case they hold no route.
 SHAPE_BAND_SHARE = 0.5
@@ -914,29 +916,44 @@ def search(
     # circles): time is kept for the route through free cell centres.
     first = (out_of_time if on_map or end is None
              else _Deadline(t0 + SHAPE_BAND_SHARE * seconds, terminate))  # fmt: skip
-    result, fine_cells, route_cells = _coarse_tries(model, start, goal, max_cells, alternatives,
-                                                    out_of_time, first, t0, stages)  # fmt: skip
+    # Among shapes the cost of marking a cell grows with the obstacles' detail (a polygon of
+    # 10,000 vertices marks 100,000 cells a second, a few circles millions): measured first.
+    rate = CELLS_PER_SECOND if on_map or end is None else _marking_rate(model)
+    result, fine_cells, route_cells = _coarse_tries(
+        model, start, goal, max_cells, alternatives, out_of_time, first, t0, stages, rate
+    )
     if result.path is None and end is not None and no_route_seconds is not None:
         out_of_time.end = max(end, t0 + no_route_seconds)
         if on_map and not out_of_time():  # the whole fine lattice, if it now fits
             result = _map_corridors(model, fine_cells, route_cells, start, goal, 0, out_of_time,
                                     t0, stages, left)  # fmt: skip
     if result.path is None and not out_of_time():
-        cells = min(max_cells, int(CENTRE_CELLS_PER_SECOND * left())) if end else 1 << 18
+        per_second = min(CENTRE_CELLS_PER_SECOND, 0.5 * rate)
+        cells = min(max_cells, int(per_second * left())) if end else 1 << 18
         thin = centre_route(model, start, goal, max(cells, 4096), out_of_time)
         if thin.path is not None:
             result = thin
     return dataclasses.replace(result, time=time.perf_counter() - t0, stages=stages)
 
 
-def _coarse_tries(model, start, goal, max_cells, alternatives, out_of_time, first, t0, stages):
+def _marking_rate(model) -> float:
+    """Lattice cells per second ``model`` marks (its free cell centres), measured on a small
+    lattice; at most :data:`CELLS_PER_SECOND`."""
+    probe = model.lattice(MARKING_PROBE_CELLS)
+    t = time.perf_counter()
+    model.centres_free(probe)
+    return min(CELLS_PER_SECOND, probe.n_cells / max(time.perf_counter() - t, 1e-6))
+
+
+def _coarse_tries(model, start, goal, max_cells, alternatives, out_of_time, first, t0, stages,
+                  rate=CELLS_PER_SECOND):  # fmt: skip
     """:func:`search`'s tries until a path, ``first()`` or too little time: when no corridor
     held a route at the fine level (the coarse lattice joined cells that do not join), twice the
     coarse cells, while a try as long again fits twice over. The last result, the fine and the
     coarse lattice's cells."""
     left = out_of_time.left
     on_map = getattr(model, "raster", None) is not None
-    route_cells = int(min(max_cells, max(CELLS_PER_SECOND * left() / 3.0, 1024)))
+    route_cells = int(min(max_cells, max(min(CELLS_PER_SECOND, rate) * left() / 3.0, 1024)))
     fine_cells = 0
     while True:  # at most log2(max_cells) rounds: the coarse cells double each time
         t1 = time.perf_counter()
@@ -946,7 +963,7 @@ def _coarse_tries(model, start, goal, max_cells, alternatives, out_of_time, firs
                                     out_of_time, t0, stages, left)  # fmt: skip
         else:
             result = _shape_corridors(model, route_cells, max_cells, start, goal, alternatives,
-                                      first, t0, stages)  # fmt: skip
+                                      first, t0, stages, rate)  # fmt: skip
         took = time.perf_counter() - t1
         if result.path is not None or route_cells >= max_cells or first() or left() < 4.0 * took:
             return result, fine_cells, route_cells
@@ -995,7 +1012,7 @@ def _pooled_corridors(model, fine, free, k, start, goal, alternatives, terminate
 
 
 def _shape_corridors(model, route_cells, max_cells, start, goal, alternatives, terminate, t0,
-                     stages) -> CorridorResult:  # fmt: skip
+                     stages, rate=CELLS_PER_SECOND) -> CorridorResult:  # fmt: skip
     """:func:`search` among shapes: coarse cells open when their centre is free, fine cells
     (:data:`SHAPE_SPLIT` per coarse side) marked in each band's box only."""
     coarse = model.lattice(route_cells)
@@ -1009,7 +1026,7 @@ def _shape_corridors(model, route_cells, max_cells, start, goal, alternatives, t
         # As fine as the time left affords: the band's cells are routed and funnelled too.
         afford = max_cells
         if terminate.end is not None:
-            afford = min(afford, CELLS_PER_SECOND * max(terminate.end - time.perf_counter(), 0.0))
+            afford = min(afford, rate * max(terminate.end - time.perf_counter(), 0.0))
         k = SHAPE_SPLIT
         while k > 1 and cells * k * k > afford:
             k -= 1
