@@ -23,7 +23,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 __all__ = ["Lattice", "MapRaster"]
 
@@ -215,6 +214,8 @@ class MapRaster:
                 off_map_x[:, None] | off_map_y[None, :]
             )
             blocked = blocked & ~clear
+        from scipy import ndimage  # here: the model stage loads without SciPy
+
         grown = ndimage.binary_dilation(blocked, structure=np.ones((3, 3), dtype=bool))
         if not grown.any():
             return np.ones((lat.nx, lat.ny), dtype=bool)

@@ -188,6 +188,9 @@ class RRTstarPSOStats(PlannerStats):
 #: shortcuts, collapsing), for sizing it to a user's slow checker: an estimate on the safe side.
 SIMPLIFIER_PASS_LENGTHS = 20
 
+#: The corridor stage's lattice in an iteration-bounded run (no time limit: the same lattice on
+#: any machine).
+REPRODUCIBLE_CORRIDOR_CELLS = 65_536
 #: With no route through the lattice yet, a finer lattice may be tried until this share of the
 #: budget (there is nothing for the other stages to refine meanwhile).
 _CORRIDOR_NO_ROUTE_SHARE = 0.5
@@ -315,6 +318,10 @@ class RRTstarPSO(PythonPlanner):
         budget = v["budget"]
         cells = v["corridor_cells"]
         seconds = v["corridor_fraction"] * budget if budget > 0 else None
+        if v["rrt_max_iterations"] > 0:
+            # Iteration-bounded (reproducible) runs: a lattice sized by the clock would differ
+            # from run to run; a fixed one does not.
+            seconds, cells = None, min(cells, REPRODUCIBLE_CORRIDOR_CELLS)
         if isinstance(self._model, SpaceInformationCollisionModel):
             # The user's checker answers the lattice one state at a time: size it to its cost.
             per_check = self._model.probe(np.asarray(start)) * self._model.step
