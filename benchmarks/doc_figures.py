@@ -5,6 +5,9 @@
 - ``docs/img/paper_dynamic.png`` and ``.gif``: docs/dynamic.md's ``rrtpso simulate
   problems/dynamic/paper_dynamic.yaml --plot ... --gif ...``;
 - ``docs/img/optimum_maze.png``: ``rrtpso optimum problems/static/maze.yaml --plot ...``;
+- ``docs/img/corridor_choice.png``: RRTstarPSO and BIT* with OMPL's simplifier at 0.25 s on
+  report-set maps of ``benchmarks/families.py`` (``rrtpso generate rooms_map`` and ``maze_map``,
+  seed 101), each run a ``rrtpso solve`` of its own, with the exact optimum;
 - ``docs/img/bench_ratio.png`` and ``bench_success.png``: the figures ``rrtpso bench`` draws,
   from the committed summary of the measured benchmark (``docs/bench/report.csv``; its runs are
   not committed, docs/benchmarking.md "Reproduce" reruns them).
@@ -73,9 +76,57 @@ def bench_figures() -> None:
         print("  ->", f"docs/img/bench_{what}.png")
 
 
+#: The corridor figure's maps: kind, options (as benchmarks/families.py poses them), title.
+CORRIDOR_MAPS = (
+    ("rooms_map", {"cells": 128}, "rooms_map (robot: a quarter cell)"),
+    ("maze_map", {"cells": 128, "corridor": 2, "loops": 0.1, "robot_radius": 0},
+     "maze_map, 2-cell corridors (point robot)"),
+)  # fmt: skip
+
+
+def corridor_figure(budget: float = 0.25, seed: int = 101) -> None:
+    """RRTstarPSO and BITstar+simplify on report-set maps, the exact optimum dashed."""
+    import json
+
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from rrtpso_ompl.groundtruth import shortest_path
+    from rrtpso_ompl.groundtruth.generate import generate_to_file
+    from rrtpso_ompl.model import World, load_problem
+    from rrtpso_ompl.plotting import draw_world, save_figure, world_legend
+
+    fig, axes = plt.subplots(1, len(CORRIDOR_MAPS), figsize=(6.5 * len(CORRIDOR_MAPS), 5.6))
+    with tempfile.TemporaryDirectory() as tmp:
+        for ax, (kind, options, title) in zip(axes, CORRIDOR_MAPS, strict=True):
+            path = generate_to_file(kind, seed, Path(tmp) / f"{kind}.yaml", **options)
+            problem = load_problem(path)
+            best = shortest_path(problem, World.from_problem(problem))
+            key = draw_world(ax, problem, safety_zones=False)
+            for planner, colour in (("BITstar+simplify", "tab:blue"), ("RRTstarPSO", "tab:red")):
+                out = Path(tmp) / f"{kind}_{planner}.json"
+                subprocess.run([*rrtpso(), "solve", str(path), "--planner", planner, "--time",
+                                str(budget), "--seed", "1", "--json", str(out), "-q"],
+                               check=True)  # fmt: skip
+                row = json.loads(out.read_text())
+                xy = np.asarray(row["path"] or [[np.nan, np.nan]])
+                ratio = f"{row['length'] / best.length:.4f}" if row["solved"] else "no path"
+                (line,) = ax.plot(xy[:, 0], xy[:, 1], color=colour, lw=1.6,
+                                  label=f"{planner}: {ratio} x optimum")  # fmt: skip
+                key.append(line)
+            ax.set_title(f"{title}, seed {seed}, {budget:g} s", fontsize=10)
+            ax.set_xlabel("x [m]")
+            ax.set_ylabel("y [m]")
+            ax.set_aspect("equal")
+            world_legend(ax, key)
+    fig.tight_layout()
+    save_figure(fig, IMG / "corridor_choice.png")
+    print("  ->", "docs/img/corridor_choice.png")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    names = [*COMMANDS, "bench"]
+    names = [*COMMANDS, "bench", "corridor"]
     parser.add_argument("which", nargs="*", help=f"figures to redraw: {', '.join(names)} "
                         "(default: all)")  # fmt: skip
     args = parser.parse_args(argv)
@@ -86,6 +137,8 @@ def main(argv: list[str] | None = None) -> int:
     for name in which:
         if name == "bench":
             bench_figures()
+        elif name == "corridor":
+            corridor_figure()
         else:
             command_figure(name)
     return 0
