@@ -7,7 +7,7 @@
 - ``docs/img/optimum_maze.png``: ``rrtpso optimum problems/static/maze.yaml --plot ...``;
 - ``docs/img/corridor_choice.png``: RRTstarPSO and BIT* with OMPL's simplifier at 0.25 s on
   report-set maps of ``benchmarks/families.py`` (``rrtpso generate rooms_map`` and ``maze_map``,
-  seed 101), each run a ``rrtpso solve`` of its own, with the exact optimum;
+  seed 101), each run a ``rrtpso solve`` of its own, lengths over the exact optimum;
 - ``docs/img/bench_ratio.png`` and ``bench_success.png``: the figures ``rrtpso bench`` draws,
   from the committed summary of the measured benchmark (``docs/bench/report.csv``; its runs are
   not committed, docs/benchmarking.md "Reproduce" reruns them).
@@ -85,7 +85,7 @@ CORRIDOR_MAPS = (
 
 
 def corridor_figure(budget: float = 0.25, seed: int = 101) -> None:
-    """RRTstarPSO and BITstar+simplify on report-set maps, the exact optimum dashed."""
+    """RRTstarPSO and BITstar+simplify on report-set maps, each length over the exact optimum."""
     import json
 
     import matplotlib.pyplot as plt
