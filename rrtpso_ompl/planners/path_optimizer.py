@@ -305,21 +305,8 @@ def _pso_round(
                                         n_iterations=0, n_evaluations=1, time=now - t_one,
                                         stopped_by="deadline")  # fmt: skip
 
-    def cost(x: np.ndarray) -> np.ndarray:
-        c, v = round_cost.terms(x)
-        return np.where(v > 0.0, c + offset + options.violation_weight * v, c)
-
-    res = pso.minimize(
-        cost,
-        lo.reshape(-1),
-        hi.reshape(-1),
-        PSOOptions.from_values(asdict(options)),
-        rng,
-        init=init,
-        v_max=options.v_max_fraction * float(seg_len.mean()),
-        terminate=terminate,
-        deadline=deadline,
-    )
+    res = _swarm(round_cost.terms, offset, lo, hi, options, rng, init, seg_len, terminate,
+                 deadline)  # fmt: skip
     best = np.vstack([seed_path[:1], res.position.reshape(k, 2), seed_path[-1:]])
     return best, res
 
@@ -341,6 +328,30 @@ def _windows(n_interior: int, width: int, offset: int) -> np.ndarray:
     out = np.full((group[-1] + 1, width), -1, dtype=np.int64)
     out[group, slot] = moving
     return out
+
+
+def _swarm(terms, offset, lo, hi, options, rng, init, seg_len, terminate, deadline, blocks=1):
+    """The swarm of one round: cost = length (and smoothness) from ``terms``, and where a
+    segment intrudes, ``offset`` (the seed's cost) plus the weighted violation, so no colliding
+    particle ranks before the seed; velocities clamped to ``v_max_fraction`` of the mean seed
+    segment."""
+
+    def cost(x: np.ndarray) -> np.ndarray:
+        c, v = terms(x)
+        return np.where(v > 0.0, c + offset + options.violation_weight * v, c)
+
+    return pso.minimize(
+        cost,
+        lo.reshape(-1),
+        hi.reshape(-1),
+        PSOOptions.from_values(asdict(options)),
+        rng,
+        init=init,
+        v_max=options.v_max_fraction * float(seg_len.mean()),
+        terminate=terminate,
+        blocks=blocks,
+        deadline=deadline,
+    )
 
 
 def _window_boxes(seed_path: np.ndarray, world, options: PathOptimizerOptions, offset: int):
@@ -427,22 +438,8 @@ def _window_round(
     init[0] = x0
     offset_cost = terms(x0[None])[0][0]  # (K,)
 
-    def cost(x: np.ndarray) -> np.ndarray:
-        c, v = terms(x)
-        return np.where(v > 0.0, c + offset_cost + options.violation_weight * v, c)
-
-    res = pso.minimize(
-        cost,
-        lo.reshape(-1),
-        hi.reshape(-1),
-        PSOOptions.from_values(asdict(options)),
-        rng,
-        init=init,
-        v_max=options.v_max_fraction * float(seg_len.mean()),
-        terminate=terminate,
-        blocks=n_win,
-        deadline=deadline,
-    )
+    res = _swarm(terms, offset_cost, lo, hi, options, rng, init, seg_len, terminate, deadline,
+                 blocks=n_win)  # fmt: skip
     best = seed_path.copy()
     pos = res.position.reshape(n_win, width, 2)
     best[win[real]] = pos[real]
