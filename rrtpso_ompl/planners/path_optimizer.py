@@ -298,12 +298,8 @@ def _pso_round(
     init[0] = x0  # the seed path itself is a particle, so G_best starts valid
     t_one = time.perf_counter()
     offset = float(round_cost.terms(x0[None, :])[0][0])
-    now = time.perf_counter()
-    if deadline is not None and now + (now - t_one) > deadline:
-        # The swarm's first evaluation (of n particles) would not end in time either.
-        return seed_path, pso.PSOResult(position=x0, cost=offset, history=np.array([offset]),
-                                        n_iterations=0, n_evaluations=1, time=now - t_one,
-                                        stopped_by="deadline")  # fmt: skip
+    if _no_time_for_a_swarm(t_one, deadline):
+        return seed_path, _unstarted(x0, offset, t_one)
 
     res = _swarm(round_cost.terms, offset, lo, hi, options, rng, init, seg_len, terminate,
                  deadline)  # fmt: skip
@@ -328,6 +324,22 @@ def _windows(n_interior: int, width: int, offset: int) -> np.ndarray:
     out = np.full((group[-1] + 1, width), -1, dtype=np.int64)
     out[group, slot] = moving
     return out
+
+
+def _no_time_for_a_swarm(t_one: float, deadline: float | None) -> bool:
+    """Whether the swarm's first chunk of evaluations (:data:`swarm._FIRST_CHUNK` particles, each
+    about as long as the one evaluation that started at ``t_one`` and ends now) would end after
+    ``deadline``: on a path of hundreds of waypoints that chunk alone can outlast a budget's
+    end, and an evaluation cannot be interrupted."""
+    now = time.perf_counter()
+    return deadline is not None and now + pso._FIRST_CHUNK * (now - t_one) > deadline
+
+
+def _unstarted(x0: np.ndarray, cost: float, t_one: float) -> pso.PSOResult:
+    """The result of a swarm round that did not start (no time): the seed."""
+    return pso.PSOResult(position=x0, cost=cost, history=np.array([cost]), n_iterations=0,
+                         n_evaluations=1, time=time.perf_counter() - t_one,
+                         stopped_by="deadline")  # fmt: skip
 
 
 def _swarm(terms, offset, lo, hi, options, rng, init, seg_len, terminate, deadline, blocks=1):
@@ -436,7 +448,10 @@ def _window_round(
     n = options.swarm_size
     init = x0 + rng.standard_normal((n, n_win * width * 2)) * np.repeat(spread.reshape(-1), 2)
     init[0] = x0
+    t_one = time.perf_counter()
     offset_cost = terms(x0[None])[0][0]  # (K,)
+    if _no_time_for_a_swarm(t_one, deadline):
+        return seed_path, _unstarted(x0, float(offset_cost.sum()), t_one)
 
     res = _swarm(terms, offset_cost, lo, hi, options, rng, init, seg_len, terminate, deadline,
                  blocks=n_win)  # fmt: skip
