@@ -42,6 +42,22 @@ def test_dynamic_guide_quotes_the_dynamic_benchmark():
     assert "\n".join(table) in (DOCS / "dynamic.md").read_text()
 
 
+def test_benchmarking_guide_quotes_the_family_report_verbatim():
+    """docs/benchmarking.md repeats every per-family table of docs/families.md (written by
+    benchmarks/families.py), and the report's rows are the runs it summarises."""
+    import json
+
+    report = (DOCS / "families.md").read_text()
+    guide = (DOCS / "benchmarking.md").read_text()
+    tables = [block for block in report.split("\n\n") if block.startswith("| family |")]
+    assert len(tables) == 3  # 0.25, 1 and 4 s
+    for table in tables:
+        assert table in guide
+    rows = [json.loads(line) for line in (DOCS / "families.jsonl").read_text().splitlines()]
+    assert {r["budget"] for r in rows} == {0.25, 1.0, 4.0}
+    assert not [r for r in rows if r["solved"] and not r["valid"]]
+
+
 def test_the_published_json_schema_is_the_declared_format_and_accepts_the_library():
     import json
 
