@@ -1,7 +1,7 @@
 """Issue 25: one-cell mazes on occupancy maps, solved at real-time budgets with the deadline kept.
 
-The maze is drawn here (a seeded depth-first perfect maze, one route between any two cells) and
-written as a real map_server YAML + PGM, so the test goes through the same loader as users' maps.
+The maze is a `rrtpso generate maze_map` (a seeded perfect maze, one route between any two cells,
+written as a real map_server YAML + PGM), so the test goes through the same loader as users' maps.
 """
 
 from __future__ import annotations
@@ -14,48 +14,14 @@ from rrtpso_ompl.model import World, load_problem
 from rrtpso_ompl.planners import solve
 
 
-def perfect_maze(cells: int, seed: int) -> np.ndarray:
-    """(2 cells + 1)^2 booleans, True = wall: corridors and walls one pixel wide."""
-    rng = np.random.default_rng(seed)
-    side = 2 * cells + 1
-    wall = np.ones((side, side), dtype=bool)
-    seen = np.zeros((cells, cells), dtype=bool)
-    stack = [(0, 0)]
-    seen[0, 0] = True
-    wall[1, 1] = False
-    while stack:  # each cell is pushed once: at most cells^2 rounds
-        i, j = stack[-1]
-        steps = ((i + di, j + dj) for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1)))
-        nxt = [(a, b) for a, b in steps if 0 <= a < cells and 0 <= b < cells and not seen[a, b]]
-        if not nxt:
-            stack.pop()
-            continue
-        a, b = nxt[rng.integers(len(nxt))]
-        seen[a, b] = True
-        wall[2 * a + 1, 2 * b + 1] = False
-        wall[i + a + 1, j + b + 1] = False
-        stack.append((a, b))
-    return wall
-
-
 @pytest.fixture(scope="module")
 def maze_problem(tmp_path_factory):
+    from rrtpso_ompl.groundtruth.generate import generate_to_file
+
     folder = tmp_path_factory.mktemp("maze")
-    wall = perfect_maze(63, seed=5)  # 127 x 127 pixels
-    side = wall.shape[0]
-    pixels = np.where(wall, 0, 254).astype(np.uint8)
-    (folder / "maze.pgm").write_bytes(f"P5\n{side} {side}\n255\n".encode() + pixels.tobytes())
-    (folder / "maze_map.yaml").write_text(
-        "image: maze.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
-        "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
-    )
-    # Start and goal in opposite corners' corridor cells (image rows run downwards).
-    top, bottom = (side - 1.5) * 0.05, 1.5 * 0.05
-    (folder / "maze.yaml").write_text(
-        f"name: maze\nmap: maze_map.yaml\nstart: [{bottom}, {top}]\ngoal: [{top}, {bottom}]\n"
-        "robot: {radius: 0.0}\n"
-    )
-    problem = load_problem(folder / "maze.yaml")
+    path = generate_to_file("maze_map", 5, folder / "maze.yaml", cells=128, corridor=1,
+                            wall_cells=1, robot_radius=0.0)  # fmt: skip
+    problem = load_problem(path)
     world = World.from_problem(problem)
     optimum = shortest_path(problem, world).length
     return problem, world, optimum
