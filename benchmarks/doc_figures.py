@@ -105,14 +105,17 @@ def corridor_figure(budget: float = 0.25, seed: int = 101) -> None:
             key = draw_world(ax, problem, safety_zones=False)
             for planner, colour in (("BITstar+simplify", "tab:blue"), ("RRTstarPSO", "tab:red")):
                 out = Path(tmp) / f"{kind}_{planner}.json"
-                subprocess.run([*rrtpso(), "solve", str(path), "--planner", planner, "--time",
-                                str(budget), "--seed", "1", "--json", str(out), "-q"],
-                               check=True)  # fmt: skip
+                done = subprocess.run([*rrtpso(), "solve", str(path), "--planner", planner,
+                                       "--time", str(budget), "--seed", "1", "--json", str(out),
+                                       "-q"], check=False)  # fmt: skip
+                if done.returncode not in (0, 1):  # 1: no path, which the legend says
+                    raise RuntimeError(f"rrtpso solve failed on {path.name} ({planner})")
                 row = json.loads(out.read_text())
                 xy = np.asarray(row["path"] or [[np.nan, np.nan]])
-                ratio = f"{row['length'] / best.length:.4f}" if row["solved"] else "no path"
+                what = (f"{row['length'] / best.length:.4f} x optimum" if row["solved"]
+                        else "no path")  # fmt: skip
                 (line,) = ax.plot(xy[:, 0], xy[:, 1], color=colour, lw=1.6,
-                                  label=f"{planner}: {ratio} x optimum")  # fmt: skip
+                                  label=f"{planner}: {what}")  # fmt: skip
                 key.append(line)
             ax.set_title(f"{title}, seed {seed}, {budget:g} s", fontsize=10)
             ax.set_xlabel("x [m]")
