@@ -153,3 +153,36 @@ def _corridor(tmp_path, **problem) -> str:
     path = tmp_path / "prob.yaml"
     path.write_text(json.dumps(doc))
     return str(path)
+
+
+#: Runs the command line in a subprocess whose PYTHONPATH holds an installed plugin.
+CLI_CODE = "import sys; from rrtpso_ompl.cli.main import main; sys.exit(main(sys.argv[1:]))"
+
+
+def install_plugin(tmp_path: Path, name: str, source: str, group: str,
+                   entry_points: dict[str, str]) -> dict[str, str]:  # fmt: skip
+    """Build the one-module package ``name`` (``source``, with ``entry_points`` in the entry-point
+    ``group``) and really install it, offline, into a target folder; the environment of a
+    subprocess that sees it (run :data:`CLI_CODE` with it)."""
+    import subprocess
+    import sys
+    import textwrap
+
+    pkg = tmp_path / name
+    (pkg / name).mkdir(parents=True)
+    (pkg / name / "__init__.py").write_text(source)
+    lines = "\n".join(f"{k} = \"{v}\"" for k, v in entry_points.items())
+    (pkg / "pyproject.toml").write_text(textwrap.dedent(f"""
+        [build-system]
+        requires = ["setuptools"]
+        build-backend = "setuptools.build_meta"
+        [project]
+        name = "{name}"
+        version = "0.1"
+        [project.entry-points."{group}"]
+    """) + lines + "\n")  # fmt: skip
+    target = tmp_path / "site"
+    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-deps",
+                    "--no-build-isolation", "--target", str(target), str(pkg)],
+                   check=True, capture_output=True)  # fmt: skip
+    return {"PYTHONPATH": str(target), "PATH": str(Path(sys.executable).parent)}

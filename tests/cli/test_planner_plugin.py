@@ -7,12 +7,10 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
-import textwrap
-from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import SINGLE_CIRCLE
+from helpers import CLI_CODE, SINGLE_CIRCLE, install_plugin
 
 from rrtpso_ompl.model.problem import load_problem
 from rrtpso_ompl.model.world import World
@@ -56,45 +54,14 @@ PLANNERS = [PlannerEntry("TinyStraight", factory=Straight,
 def test_entry_point_plugin_is_selectable_by_name(tmp_path):
     """A real package, really installed (into a target folder), found through the entry-point
     group and selected by name from the command line."""
-    pkg = tmp_path / "tinyplug"
-    (pkg / "tinyplug").mkdir(parents=True)
-    (pkg / "tinyplug" / "__init__.py").write_text(PLUGIN_SRC)
-    (pkg / "pyproject.toml").write_text(
-        textwrap.dedent("""
-        [build-system]
-        requires = ["setuptools"]
-        build-backend = "setuptools.build_meta"
-        [project]
-        name = "tinyplug"
-        version = "0.1"
-        [project.entry-points."rrtpso_ompl.planners"]
-        tiny = "tinyplug:PLANNERS"
-    """)
-    )
-    target = tmp_path / "site"
-    subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "pip",
-            "install",
-            "--quiet",
-            "--no-deps",
-            "--no-build-isolation",
-            "--target",
-            str(target),
-            str(pkg),
-        ],
-        check=True,
-        capture_output=True,
-    )
+    env = install_plugin(tmp_path, "tinyplug", PLUGIN_SRC, "rrtpso_ompl.planners",
+                         {"tiny": "tinyplug:PLANNERS"})  # fmt: skip
     import yaml
 
     empty = dict(SINGLE_CIRCLE, obstacles=[])
     problem = tmp_path / "empty.yaml"
     problem.write_text(yaml.safe_dump(empty))
-    env = {"PYTHONPATH": str(target), "PATH": str(Path(sys.executable).parent)}
-    code = "import sys; from rrtpso_ompl.cli.main import main; sys.exit(main(sys.argv[1:]))"
+    code = CLI_CODE
     listed = subprocess.run(
         [sys.executable, "-c", code, "planners", "TinyStraight"],
         capture_output=True,

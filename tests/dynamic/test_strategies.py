@@ -10,12 +10,10 @@ import json
 import logging
 import subprocess
 import sys
-import textwrap
-from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import PROBLEMS, REPO, corridor
+from helpers import CLI_CODE, PROBLEMS, REPO, corridor, install_plugin
 
 from rrtpso_ompl.dynamic import (
     DynamicOptions,
@@ -260,28 +258,9 @@ class LeftOnly(ReplanningStrategy):
 
 @pytest.mark.slow
 def test_entry_point_strategy_runs_through_the_command_line(tmp_path):
-    pkg = tmp_path / "leftonly"
-    (pkg / "leftonly").mkdir(parents=True)
-    (pkg / "leftonly" / "__init__.py").write_text(PLUGIN_SRC)
-    (pkg / "pyproject.toml").write_text(
-        textwrap.dedent("""
-        [build-system]
-        requires = ["setuptools"]
-        build-backend = "setuptools.build_meta"
-        [project]
-        name = "leftonly"
-        version = "0.1"
-        [project.entry-points."rrtpso_ompl.strategies"]
-        left = "leftonly:LeftOnly"
-        broken = "leftonly:Missing"
-    """)
-    )
-    target = tmp_path / "site"
-    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-deps",
-                    "--no-build-isolation", "--target", str(target), str(pkg)],
-                   check=True, capture_output=True)  # fmt: skip
-    env = {"PYTHONPATH": str(target), "PATH": str(Path(sys.executable).parent)}
-    code = "import sys; from rrtpso_ompl.cli.main import main; sys.exit(main(sys.argv[1:]))"
+    env = install_plugin(tmp_path, "leftonly", PLUGIN_SRC, "rrtpso_ompl.strategies",
+                         {"left": "leftonly:LeftOnly", "broken": "leftonly:Missing"})  # fmt: skip
+    code = CLI_CODE
     listed = subprocess.run([sys.executable, "-c", code, "simulate", "--help"],
                             capture_output=True, text=True, env=env)  # fmt: skip
     assert listed.returncode == 0, listed.stderr
