@@ -1,0 +1,11 @@
+"""The ROS 2 hand-off: plans in metres and seconds, dense poses, ROS 2 bags.
+
+Everything a ROS tool reads leaves through this stage: the problem's lengths converted to metres
+(REP 103) by :mod:`.units`, the path resampled into poses at about the costmap resolution by
+:mod:`.poses`. The algorithms upstream keep the problem's own units.
+"""
+
+from .poses import Poses, dense_poses
+from .units import metres_per_unit
+
+__all__ = ["Poses", "dense_poses", "metres_per_unit"]

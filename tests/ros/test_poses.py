@@ -1,0 +1,33 @@
+import numpy as np
+import pytest
+
+from rrtpso_ompl.ros.poses import dense_poses
+
+
+def test_poses_are_no_farther_apart_than_the_resolution_and_keep_every_waypoint():
+    path = np.array([[0.0, 0.0], [3.0, 0.0], [3.0, 0.0], [3.0, 4.1], [0.2, 4.1]])
+    poses = dense_poses(path, 0.25)
+    gaps = np.hypot(*np.diff(poses.xy, axis=0).T)
+    assert gaps.max() <= 0.25 + 1e-12
+    assert gaps.min() > 0.0
+    for w in path:
+        assert np.hypot(*(poses.xy - w).T).min() < 1e-12
+    # Each pose faces along its segment; the last keeps the last segment's heading.
+    assert poses.yaw[0] == 0.0
+    assert poses.yaw[-1] == pytest.approx(np.pi)
+    on_second = (poses.xy[:, 0] == 3.0) & (poses.xy[:, 1] < 4.1)
+    assert np.allclose(poses.yaw[on_second][1:], np.pi / 2)
+
+
+def test_a_goal_heading_turns_the_last_pose_only():
+    poses = dense_poses([[0, 0], [1, 0]], 0.1, goal_yaw=0.5)
+    assert len(poses) == 11
+    assert poses.yaw[-1] == 0.5
+    assert np.all(poses.yaw[:-1] == 0.0)
+
+
+def test_the_pose_count_is_bounded():
+    with pytest.raises(ValueError, match="exceed the bound"):
+        dense_poses([[0, 0], [1e6, 0]], 1e-3)
+    with pytest.raises(ValueError, match="positive"):
+        dense_poses([[0, 0], [1, 0]], 0.0)
