@@ -15,6 +15,7 @@ from .common import (
     choose_planner,
     note,
 )
+from .ros_flags import add_ros_flags, ros_frame, ros_outputs
 
 __all__ = ["add_parser", "run"]
 
@@ -38,17 +39,7 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     p.add_argument(
         "--plot", metavar="OUT.png", help="draw the world, the paths and the PSO best-cost curve"
     )
-    p.add_argument(
-        "--path-out",
-        metavar="FILE",
-        help="write the path as a ROS nav_msgs/Path document (JSON for .json, else YAML)",
-    )
-    p.add_argument(
-        "--frame-id",
-        default="map",
-        metavar="FRAME",
-        help="header.frame_id of --path-out (default: map)",
-    )
+    add_ros_flags(p)
     p.add_argument(
         "--post",
         metavar="STEPS",
@@ -96,11 +87,12 @@ def run(args: argparse.Namespace) -> int:
     outputs = [
         Output("--json", args.json),
         Output("--plot", args.plot, "image"),
-        Output("--path-out", args.path_out),
         Output("--trajectory", args.trajectory),
         Output("--plot-velocities", args.plot_velocities, "image"),
+        *ros_outputs(args),
     ]
     check_outputs(outputs, inputs=problem.inputs)
+    frame = ros_frame(args, problem)  # the units and the pose spacing, known before planning
     wants_motion = bool(args.trajectory or args.plot_velocities)
     if wants_motion:
         _check_drive_keys(args, problem)
@@ -109,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
 
     result = solve(request)
     motion = _drive(problem, result, args.profile) if wants_motion and result.solved else None
-    _write_outputs(args, problem, result, motion)
+    _write_outputs(args, problem, result, motion, frame)
     length = f"{result.length:.3f}" if result.length is not None else "-"
     note(
         f"{problem.name}: {result.planner} {result.status} length={length} time={result.time:.3f}s",
@@ -150,7 +142,9 @@ def _drive(problem: Any, result: Any, profile: str) -> Any:
         raise ProblemError(problem.source, "", str(exc)) from None
 
 
-def _write_outputs(args: argparse.Namespace, problem: Any, result: Any, motion: Any) -> None:
+def _write_outputs(
+    args: argparse.Namespace, problem: Any, result: Any, motion: Any, frame: Any
+) -> None:
     if args.plot:
         from ..plotting import plot_solution, save_figure
 
@@ -162,9 +156,9 @@ def _write_outputs(args: argparse.Namespace, problem: Any, result: Any, motion: 
     if motion and args.trajectory:
         motion.trajectory.write_csv(args.trajectory)
     if args.path_out and result.solved:
-        from ..kinematics import nav_path, write_nav_path
+        from ..ros import nav_path, write_nav_path
 
-        write_nav_path(nav_path(result.path, args.frame_id), args.path_out)
+        write_nav_path(nav_path(frame.poses(result.path), frame.frame_id), args.path_out)
     if args.json:
         from ..outputs import write_json_atomic
 

@@ -9,15 +9,13 @@ Stages, each a pure function:
 3. :func:`wheel_speeds`: eqs. 9-12, and :func:`integrate_wheels`: the corrected eqs. 1-3
    (:mod:`.diffdrive`);
 4. :func:`track`: Kanayama's kinematic controller on that model (:mod:`.tracking`);
-5. :func:`drive`: all of it for one path (:mod:`.drive`);
-6. :func:`nav_path`: the path as a ROS ``nav_msgs/Path`` document (:mod:`.nav_path`).
+5. :func:`drive`: all of it for one path (:mod:`.drive`).
 
 Printed typos and their corrections are listed in ``docs/kinematics.md``.
 """
 
 from .diffdrive import integrate_wheels, wheel_speeds
 from .drive import REQUIRED_ROBOT_KEYS, DriveResult, drive
-from .nav_path import nav_path, write_nav_path
 from .profile import CSV_HEADER, Trajectory, TrajectoryError, check_samples, time_parametrize
 from .reference import ReferenceCurve, reference_curve, reference_polynomial
 from .tracking import TrackingResult, track
@@ -33,11 +31,9 @@ __all__ = [
     "check_samples",
     "drive",
     "integrate_wheels",
-    "nav_path",
     "reference_curve",
     "reference_polynomial",
     "time_parametrize",
     "track",
     "wheel_speeds",
-    "write_nav_path",
 ]

@@ -5,7 +5,17 @@ Everything a ROS tool reads leaves through this stage: the problem's lengths con
 :mod:`.poses`. The algorithms upstream keep the problem's own units.
 """
 
+from .nav_path import nav_path, write_nav_path
+from .plan import DEFAULT_PATH_RESOLUTION, RosFrame
 from .poses import Poses, dense_poses
 from .units import metres_per_unit
 
-__all__ = ["Poses", "dense_poses", "metres_per_unit"]
+__all__ = [
+    "DEFAULT_PATH_RESOLUTION",
+    "Poses",
+    "RosFrame",
+    "dense_poses",
+    "metres_per_unit",
+    "nav_path",
+    "write_nav_path",
+]

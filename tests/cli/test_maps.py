@@ -61,7 +61,13 @@ def test_solve_optimum_and_batch_on_a_map_problem(tmp_path):
     import yaml
 
     doc = yaml.safe_load(nav.read_text())
-    assert doc["header"]["frame_id"] == "map" and len(doc["poses"]) == len(s["path"])
+    assert doc["header"]["frame_id"] == "map"
+    # Dense poses, about one per map cell (the map's resolution, metres), every waypoint kept.
+    xy = np.array([[q["pose"]["position"]["x"], q["pose"]["position"]["y"]] for q in doc["poses"]])
+    resolution = load_problem(prob).map.resolution
+    assert np.hypot(*np.diff(xy, axis=0).T).max() <= resolution + 1e-9
+    assert len(xy) >= s["length"] / resolution
+    assert all(np.hypot(*(xy - w).T).min() < 1e-9 for w in s["path"])
     q = doc["poses"][0]["pose"]["orientation"]
     heading = math.atan2(s["path"][1][1] - s["path"][0][1], s["path"][1][0] - s["path"][0][0])
     assert 2 * math.atan2(q["z"], q["w"]) == pytest.approx(heading)
