@@ -134,6 +134,9 @@ class Robot:
     max_speed: float | None = None
     max_wheel_speed: float | None = None
     max_accel: float | None = None
+    inflation_radius: float | None = None
+    cost_scaling_factor: float | None = None
+    cost_travel_multiplier: float | None = None
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,8 @@
 * a state validity checker and an *exact* motion validator over the same
   :class:`~rrtpso_ompl.model.World` (no discretisation: a segment is valid only when every point of
   it keeps the robot radius from every obstacle);
-* the path-length objective, the start and the goal (with its tolerance).
+* the problem's objective (path length, plus the inflation cost when the robot has one:
+  :mod:`.objective`), the start and the goal (with its tolerance).
 
 See ``docs/design.md`` for why some OMPL calls are avoided from Python (the bindings notes).
 """
@@ -17,8 +18,10 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
+from ..model.objective import InflationCost
 from ..model.problem import Problem
 from ..model.world import World
+from .objective import objective_for
 
 __all__ = ["ExactMotionValidator", "PlanningContext", "WorldValidityChecker", "make_context"]
 
@@ -112,5 +115,5 @@ def make_context(problem: Problem, world: World | None = None) -> PlanningContex
     # scale, relative as every exact check; a path ending at the sampled goal state has d = 0).
     threshold = max(problem.goal_tolerance, world.tol)
     ss.setStartAndGoalStates(start, goal, threshold)
-    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    ss.setOptimizationObjective(objective_for(si, InflationCost.of(problem.robot), world))
     return PlanningContext(problem, world, ss, si, space, checker, validator)
