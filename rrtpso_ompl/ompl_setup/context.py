@@ -77,6 +77,9 @@ class PlanningContext:
     space: ob.RealVectorStateSpace
     checker: WorldValidityChecker
     motion_validator: ExactMotionValidator
+    #: Held here too: OMPL holds it in C++, and a Python subclass whose Python object is
+    #: collected silently loses its overrides (its motion costs fall back to the length).
+    objective: ob.OptimizationObjective | None = None
 
 
 def make_context(problem: Problem, world: World | None = None) -> PlanningContext:
@@ -115,5 +118,6 @@ def make_context(problem: Problem, world: World | None = None) -> PlanningContex
     # scale, relative as every exact check; a path ending at the sampled goal state has d = 0).
     threshold = max(problem.goal_tolerance, world.tol)
     ss.setStartAndGoalStates(start, goal, threshold)
-    ss.setOptimizationObjective(objective_for(si, InflationCost.of(problem.robot), world))
-    return PlanningContext(problem, world, ss, si, space, checker, validator)
+    objective = objective_for(si, InflationCost.of(problem.robot), world)
+    ss.setOptimizationObjective(objective)
+    return PlanningContext(problem, world, ss, si, space, checker, validator, objective)

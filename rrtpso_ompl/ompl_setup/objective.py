@@ -7,15 +7,22 @@ state-cost integral; OMPL's ``StateCostIntegralObjective`` cannot be subclassed 
 subclasses ``OptimizationObjective`` and gives ``motionCost`` directly, with the admissible
 heuristics informed planners need (``motionCostHeuristic`` and the cost-to-go: the straight-line
 distance, a lower bound since the integrand is at least 1).
+
+The planners measure motions on a :class:`~rrtpso_ompl.model.objective.ClearanceField`
+(interpolated distances, within 0.05 % of the exact integral where it was measured, and about ten
+times faster); every cost the project reports, and every "no post-pass raises it" decision, uses
+the exact distances (:meth:`InflationObjective.exact_cost`).
 """
 
 from __future__ import annotations
 
+import math
+
 from ompl import base as ob
 
-from ..model.objective import InflationCost
+from ..model.objective import ClearanceField, InflationCost
 
-__all__ = ["InflationObjective", "objective_for"]
+__all__ = ["InflationObjective", "objective_for", "path_cost"]
 
 
 class InflationObjective(ob.PathLengthOptimizationObjective):
@@ -41,11 +48,35 @@ class InflationObjective(ob.PathLengthOptimizationObjective):
         self.si_ = si  # keeps the space information alive as long as the objective
         self.inflation = cost
         self.world = world
+        step = cost.step
+        # Measured beyond the inflation radius, so that most motions far from obstacles are
+        # known to cost their length from their end points alone.
+        self.field = ClearanceField(world, step, 2.0 * cost.inflation_radius + 2.0 * step)
 
     def motionCost(self, s1, s2) -> ob.Cost:
-        a = (s1[0], s1[1])
-        b = (s2[0], s2[1])
-        return ob.Cost(self.inflation.path_cost(self.world, [a, b]))
+        ax, ay, bx, by = s1[0], s1[1], s2[0], s2[1]
+        extra = self.inflation.segment_integral(self.field, ax, ay, bx, by)
+        return ob.Cost(math.hypot(bx - ax, by - ay) + self.inflation.weight * extra)
+
+    def exact_cost(self, path) -> float:
+        """``J`` of a path (an ``og.PathGeometric`` or ``(n, 2)`` waypoints) with exact
+        distances."""
+        xy = path if hasattr(path, "shape") else _waypoints(path)
+        return self.inflation.path_cost(self.world, xy)
+
+
+def _waypoints(path):
+    from .convert import path_to_array
+
+    return path_to_array(path)
+
+
+def path_cost(objective: ob.OptimizationObjective, path) -> float:
+    """The cost of an ``og.PathGeometric`` under ``objective``: exact for ours
+    (:meth:`InflationObjective.exact_cost`), OMPL's own for any other."""
+    if isinstance(objective, InflationObjective):
+        return objective.exact_cost(path)
+    return path.cost(objective).value()
 
 
 def objective_for(si: ob.SpaceInformation, cost: InflationCost, world) -> ob.OptimizationObjective:

@@ -52,7 +52,7 @@ from .corridor import search
 from .ompl_planners import RRTSTAR_PARAMS
 from .params import ParamSpec, ParamTable
 from .path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
-from .post import PSOPathOptimizer, simplify_until
+from .post import PSOPathOptimizer, inflation_of, simplify_until
 from .result import BenchmarkRun
 from .swarm import SWARM_PARAMS
 
@@ -115,7 +115,9 @@ RRTSTAR_PSO_PARAMS = (
 class RRTstarPSOStats(PlannerStats):
     """Per-stage figures of one RRTstarPSO solve (the ``stages`` of a solve result).
 
-    Lengths are in problem units, times in seconds. In OMPL's benchmark terms the corridor stage,
+    Lengths are in problem units, times in seconds; ``*_cost`` are the problem's objective (the
+    length plus the inflation cost, :mod:`rrtpso_ompl.model.objective`; the length without
+    one). In OMPL's benchmark terms the corridor stage,
     the RRT* stage and OMPL's simplifier are the planning, the swarm is the simplification.
     ``rrt_path`` is RRT*'s first path, ``seed_path`` the path the returned one was made from
     (``seed_source`` says whose: ``"corridor"``, ``"RRTstar"`` or ``"BITstar"``; a later RRT*
@@ -133,6 +135,7 @@ class RRTstarPSOStats(PlannerStats):
     corridor_reason: str = ""
     seed_source: str = ""
     seed_length: float | None = None
+    seed_cost: float | None = None
     rrt_length: float | None = None
     first_solution: str = "RRTstar"
     rrt_time: float = 0.0
@@ -144,6 +147,7 @@ class RRTstarPSOStats(PlannerStats):
     simplified_length: float | None = None
     simplify_time: float = 0.0
     pso_length: float | None = None
+    pso_cost: float | None = None
     pso_time: float = 0.0
     pso_iterations: int = 0
     pso_evaluations: int = 0
@@ -245,6 +249,7 @@ class RRTstarPSO(PythonPlanner):
         super().__init__(si, name, **params)
         self.inner = og.RRTstar(si)
         self._inner_ready = False
+        self._inflation = None  # the problem's inflation cost, read from the objective in solve
 
     def setup(self) -> None:
         super().setup()
@@ -282,6 +287,10 @@ class RRTstarPSO(PythonPlanner):
         stats = RRTstarPSOStats(range_used=self.inner.getRange())  # the one chosen when 0
         self.last_stats = stats
 
+        # The problem's inflation cost, when it has one (the swarm and the ranking lower it).
+        self._inflation = inflation_of(pdef.getOptimizationObjective())
+        if not isinstance(self._model, World):
+            self._inflation = None  # it needs our world's distances; the length then
         corridor = self._corridor(ptc, t0, stats)  # stage 0
         self._run_rrtstar(ptc, t0, stats, fallback=corridor is None)  # stage 1
         candidates = self._candidates(corridor, ptc, t0, stats)  # stage 2
@@ -289,12 +298,14 @@ class RRTstarPSO(PythonPlanner):
             if pdef.hasSolution():  # RRT*'s tree never reached the goal
                 return ob.PlannerStatus(ob.PlannerStatus.APPROXIMATE_SOLUTION)
             return ob.PlannerStatus(ob.PlannerStatus.TIMEOUT)
-        source, seed, xy = min(candidates, key=lambda c: path_length(c[2]))
+        source, seed, xy = min(candidates, key=lambda c: self._cost(c[2]))
         stats.seed_source, stats.seed_path = source, seed.tolist()
         stats.seed_length = stats.simplified_length = path_length(xy)
+        stats.seed_cost = self._cost(xy)
         best = self._swarm(xy, stats, t0, ptc).path  # stage 3
         best = self._anytime(best, stats, t0, ptc)
         stats.pso_length = path_length(best)
+        stats.pso_cost = self._cost(best)
         stats.pso_waypoints = len(best)
 
         # Replace RRT*'s entry either way, so the solution is reported under this planner's name.
@@ -367,6 +378,13 @@ class RRTstarPSO(PythonPlanner):
             out.append(("corridor", corridor, short))
         return out
 
+    def _cost(self, xy: np.ndarray) -> float:
+        """The problem's objective of waypoints ``xy``: the length, plus the inflation cost when
+        the problem has one."""
+        if self._inflation is None:
+            return path_length(xy)
+        return self._inflation.path_cost(self._model, xy)
+
     def _finish_by(self, t0: float) -> float | None:
         """When the stages must be done (``time.perf_counter()`` s): the end of the budget, less
         :data:`FINISH_RESERVE` of it for handing the path over; None without a budget."""
@@ -396,12 +414,12 @@ class RRTstarPSO(PythonPlanner):
             seed = xy
             if self._values["simplify"] and not ptc():
                 xy = self._simplify(raw, xy, stats, ptc, t0)
-            if path_length(xy) >= stats.seed_length:
+            if self._cost(xy) >= stats.seed_cost:
                 continue  # still no better start than the one the swarm had
             again = self._swarm(xy, stats, t0, ptc)
-            if again.length < path_length(best):
+            if again.cost < self._cost(best):
                 best, stats.seed_path, stats.seed_source = again.path, seed.tolist(), "RRTstar"
-                stats.seed_length = path_length(xy)
+                stats.seed_length, stats.seed_cost = path_length(xy), self._cost(xy)
         return best
 
     def _simplify(self, raw: og.PathGeometric, xy: np.ndarray, stats: RRTstarPSOStats, ptc, t0):
@@ -419,11 +437,12 @@ class RRTstarPSO(PythonPlanner):
         if budget > 0:
             left = max(0.5 * (t0 + budget - t1), 1e-4)
             with refusing_motions_after(self._model, t1 + left):
-                simplify_until(self.getSpaceInformation(), simplified, t1 + left)
+                simplify_until(self.getSpaceInformation(), simplified, t1 + left,
+                               self.getProblemDefinition().getOptimizationObjective())  # fmt: skip
         else:
             og.PathSimplifier(self.getSpaceInformation()).simplifyMax(simplified)
         candidate = path_to_array(simplified)
-        better = path_length(candidate) < path_length(xy) and self._fine_valid(candidate, t0)
+        better = self._cost(candidate) < self._cost(xy) and self._fine_valid(candidate, t0)
         stats.simplify_time += time.perf_counter() - t1
         return candidate if better else xy
 
@@ -479,7 +498,8 @@ class RRTstarPSO(PythonPlanner):
         # The same post-pass any planner gets with "+pso" (one optimiser, not two).
         si = self.getSpaceInformation()
         options = PathOptimizerOptions.from_values(self._values)
-        optimizer = PSOPathOptimizer(si, options=options, world=self._model, rng=self._rng())
+        optimizer = PSOPathOptimizer(si, options=options, world=self._model, rng=self._rng(),
+                                     objective=self._inflation)  # fmt: skip
         result = optimizer.optimize_array(xy, terminate, deadline)
         # Summed over the swarm runs of one solve (one, unless the anytime loop ran more).
         stats.pso_time += result.time
