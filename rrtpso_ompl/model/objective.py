@@ -155,6 +155,8 @@ class InflationCost:
         """``integral c(d(s)) ds`` along one segment on a :class:`ClearanceField`: the cost of
         one motion as an OMPL planner asks for it thousands of times a second, with as few
         numpy calls as the midpoint rule allows (their per-call overhead is most of it)."""
+        if (bx, by) < (ax, ay):  # one order, so that a motion costs the same both ways
+            ax, ay, bx, by = bx, by, ax, ay
         length = math.hypot(bx - ax, by - ay)
         if not self.active or length == 0.0:
             return 0.0

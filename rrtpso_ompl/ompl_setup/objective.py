@@ -2,11 +2,21 @@
 
 Length alone is OMPL's ``PathLengthOptimizationObjective`` (C++, fast). With inflation (see
 :mod:`rrtpso_ompl.model.objective`) the cost of a motion is ``length + w * integral of c``, a
-state-cost integral; OMPL's ``StateCostIntegralObjective`` cannot be subclassed from Python (its
-``stateCost`` override is never called: the bindings notes), so :class:`InflationObjective`
-subclasses ``OptimizationObjective`` and gives ``motionCost`` directly, with the admissible
-heuristics informed planners need (``motionCostHeuristic`` and the cost-to-go: the straight-line
-distance, a lower bound since the integrand is at least 1).
+state-cost integral. What the OMPL 2.0.1 wheel allows from Python shaped this class (measured,
+see docs/design.md):
+
+- ``StateCostIntegralObjective`` cannot be subclassed (its ``stateCost`` override is never
+  called: the bindings notes), so :class:`InflationObjective` subclasses
+  ``OptimizationObjective`` and gives ``motionCost`` directly;
+- ``setCostToGoHeuristic`` cannot take a Python function (no ``std::function`` caster) and a
+  ``costToGo`` override is never called; a subclass of ``PathLengthOptimizationObjective`` (whose
+  C++ cost-to-go and informed sampler would apply) crashed BIT* (a segmentation fault in
+  ``bestPathFromGoalToStart``, 3 of 10 seeds on paper_static). So the cost-to-go is OMPL's
+  default, zero: admissible, uninformed; informed samplers sample the whole space.
+- ``motionCostHeuristic`` overrides are called (BIT* orders its edges with them): the
+  straight-line distance, a lower bound since the integrand is at least 1; and the motion cost
+  adds to exactly that distance (``si.distance``), so it is never below its heuristic by a
+  rounding step.
 
 The planners measure motions on a :class:`~rrtpso_ompl.model.objective.ClearanceField`
 (interpolated distances, within 0.05 % of the exact integral where it was measured, and about ten
@@ -16,8 +26,6 @@ the exact distances (:meth:`InflationObjective.exact_cost`).
 
 from __future__ import annotations
 
-import math
-
 from ompl import base as ob
 
 from ..model.objective import ClearanceField, InflationCost
@@ -25,7 +33,7 @@ from ..model.objective import ClearanceField, InflationCost
 __all__ = ["InflationObjective", "objective_for", "path_cost"]
 
 
-class InflationObjective(ob.PathLengthOptimizationObjective):
+class InflationObjective(ob.OptimizationObjective):
     """``J = length + w * integral of the inflation cost`` of motions, in problem units.
 
     Parameters
@@ -56,7 +64,11 @@ class InflationObjective(ob.PathLengthOptimizationObjective):
     def motionCost(self, s1, s2) -> ob.Cost:
         ax, ay, bx, by = s1[0], s1[1], s2[0], s2[1]
         extra = self.inflation.segment_integral(self.field, ax, ay, bx, by)
-        return ob.Cost(math.hypot(bx - ax, by - ay) + self.inflation.weight * extra)
+        # The length exactly as the heuristic measures it: never below it by a rounding step.
+        return ob.Cost(self.si_.distance(s1, s2) + self.inflation.weight * extra)
+
+    def motionCostHeuristic(self, s1, s2) -> ob.Cost:
+        return ob.Cost(self.si_.distance(s1, s2))
 
     def exact_cost(self, path) -> float:
         """``J`` of a path (an ``og.PathGeometric`` or ``(n, 2)`` waypoints) with exact

@@ -70,7 +70,7 @@ def test_no_post_pass_raises_the_objective(door, hugging, steps):
     problem, world, cost = door
     ctx = make_context(problem, world)
     path = array_to_path(ctx.si, hugging)
-    done = run_post(ctx.si, path, steps, time.perf_counter() + 0.3,
+    done = run_post(ctx.si, path, steps, time.perf_counter() + 1.0,
                     world=world, rng=np.random.default_rng(2), objective=ctx.objective)  # fmt: skip
     for s in done:
         assert s.cost_after <= s.cost_before + 1e-12
@@ -99,3 +99,22 @@ def test_rrtstarpso_lowers_the_objective_below_the_shortest_paths(door, hugging)
     assert result.solved
     assert result.cost < cost.path_cost(world, hugging)
     assert result.stages["pso_cost"] <= result.stages["seed_cost"]
+
+
+def test_bitstar_survives_the_objective(tmp_path):
+    """OMPL 2.0.1's BIT* crashed (a segmentation fault) under a PathLengthOptimizationObjective
+    subclass with this cost (paper_static, seed 1): the objective derives from
+    OptimizationObjective now. Run in a process of its own, so that a crash fails the test."""
+    import subprocess
+
+    import yaml
+    from helpers import PROBLEMS, rrtpso_exe
+
+    doc = yaml.safe_load((PROBLEMS / "static" / "paper_static.yaml").read_text())
+    doc["robot"] |= {"inflation_radius": 114.0, "cost_scaling_factor": 0.0175}
+    path = tmp_path / "inflated.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    command = [*rrtpso_exe(), "solve", str(path), "--planner", "BITstar", "--time", "1",
+               "--seed", "1"]  # fmt: skip
+    run = subprocess.run(command, capture_output=True, text=True, timeout=60)
+    assert run.returncode in (0, 1), run.stderr[-2000:]
