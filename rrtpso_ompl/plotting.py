@@ -410,7 +410,8 @@ def _plain_number(x: float, pos: int | None = None) -> str:
 
 def plot_velocities(traj: Any, units: str = "") -> Figure:
     """The paper's Figs. 17-18: v_ref and omega_ref, then the wheels' linear and angular speeds,
-    against time (``traj`` is a :class:`~rrtpso_ompl.kinematics.Trajectory`)."""
+    against time (``traj`` is a :class:`~rrtpso_ompl.kinematics.Trajectory`); the in-place turn
+    to a goal heading, if any, shaded."""
     u = units or "units"
     fig, axes = plt.subplots(2, 2, figsize=(12, 7), sharex=True)
     panels = [
@@ -426,6 +427,8 @@ def plot_velocities(traj: Any, units: str = "") -> Figure:
     for ax, series, label in panels:
         for name, legend in series:
             ax.plot(traj.t, getattr(traj, name), label=legend, lw=1.3)
+        if traj.goal_turn_times is not None:
+            ax.axvspan(*traj.goal_turn_times, color="0.85", zorder=0, label="turn to goal_yaw")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
         ax.legend(loc="best", fontsize=8)

@@ -8,7 +8,7 @@ Everything a ROS tool reads leaves through this stage: the problem's lengths con
 from .nav_path import nav_path, write_nav_path
 from .plan import DEFAULT_PATH_RESOLUTION, RosFrame
 from .poses import Poses, dense_poses
-from .units import metres_per_unit
+from .units import metres_per_unit, units_fields
 
 __all__ = [
     "DEFAULT_PATH_RESOLUTION",
@@ -17,5 +17,6 @@ __all__ = [
     "dense_poses",
     "metres_per_unit",
     "nav_path",
+    "units_fields",
     "write_nav_path",
 ]
