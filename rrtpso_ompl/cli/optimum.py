@@ -6,6 +6,7 @@ import argparse
 from typing import Any
 
 from .common import EXIT_OK, EXIT_UNSOLVED, Output, check_outputs, note
+from .ros_flags import add_ros_flags, ros_frame, ros_outputs
 
 __all__ = ["add_parser", "run"]
 
@@ -23,6 +24,7 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     o.add_argument("problem", help="problem file (YAML)")
     o.add_argument("--json", metavar="OUT", help='write {"length": ..., "path": [...], ...}')
     o.add_argument("--plot", metavar="OUT.png", help="draw the world and the shortest path")
+    add_ros_flags(o)
     o.set_defaults(func=run)
 
 
@@ -31,18 +33,31 @@ def run(args: argparse.Namespace) -> int:
     from ..model import load_problem
 
     problem = load_problem(args.problem)
-    check_outputs([Output("--json", args.json), Output("--plot", args.plot, "image")],
-                  inputs=problem.inputs)  # fmt: skip
+    outputs = [
+        Output("--json", args.json),
+        Output("--plot", args.plot, "image"),
+        *ros_outputs(args),
+    ]
+    check_outputs(outputs, inputs=problem.inputs)
+    frame = ros_frame(args, problem)
     result = shortest_path(problem)
     if args.plot:
         from ..plotting import plot_optimum, save_figure
 
         save_figure(plot_optimum(problem, result), args.plot)
-    if args.json:
+    if args.json or args.bag:
         from ..model import World
-        from ..outputs import write_json_atomic
 
-        write_json_atomic(result.to_dict(World.from_problem(problem)), args.json)
+        data = result.to_dict(World.from_problem(problem))  # the path the exact check accepts
+        if args.bag:
+            from ..ros.bag import write_plan_bag
+
+            path = data["path"] if result.found else None
+            write_plan_bag(problem, frame, path, args.bag, command="optimum")
+        if args.json:
+            from ..outputs import write_json_atomic
+
+            write_json_atomic(data, args.json)
     if result.found:
         note(f"{problem.name}: optimum length={result.length:.6f}")
         return EXIT_OK

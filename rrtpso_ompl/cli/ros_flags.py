@@ -54,8 +54,27 @@ def ros_frame(args: argparse.Namespace, problem: Any) -> Any:
     if not args.frame_id.strip():
         raise UsageError(f"{args.problem}: --frame-id: must not be empty")
     try:
-        return RosFrame.for_problem(problem, args.path_resolution, args.frame_id)
+        frame = RosFrame.for_problem(problem, args.path_resolution, args.frame_id)
     except ValueError as exc:
         if getattr(exc, "key", None):  # a ProblemError: the file's own key
             raise
         raise UsageError(f"{args.problem}: --path-resolution: {exc}") from None
+    if args.bag:
+        _check_bag(args, problem, frame)
+    return frame
+
+
+def _check_bag(args: argparse.Namespace, problem: Any, frame: Any) -> None:
+    """What a bag can hold, known before planning: the obstacles' markers, and the poses of
+    even the straight line to the goal."""
+    import math
+
+    from ..ros.bag import check_pose_count
+    from ..ros.markers import check_marker_count
+
+    try:
+        check_marker_count(problem)
+        shortest = max(0.0, math.dist(problem.start, problem.goal) - problem.goal_tolerance)
+        check_pose_count(frame, shortest * frame.scale, "even the straight line to the goal")
+    except ValueError as exc:
+        raise UsageError(f"{args.problem}: --bag: {exc}") from None

@@ -21,6 +21,7 @@ from .common import (
     note,
     progress_bar,
 )
+from .ros_flags import add_ros_flags, ros_frame, ros_outputs
 
 __all__ = ["OPTION_FLAGS", "add_parser", "run"]
 
@@ -80,6 +81,7 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     m.add_argument("--heading-changes", type=float, metavar="RATE",
                    default=DynamicOptions.PARAMS["heading_changes"].default,
                    help=_help("heading_changes"))  # fmt: skip
+    add_ros_flags(m)
     m.set_defaults(func=run)
 
 
@@ -102,8 +104,10 @@ def run(args: argparse.Namespace) -> int:
         Output("--json", args.json),
         Output("--plot", args.plot, "image"),
         Output("--gif", args.gif, "gif"),
+        *ros_outputs(args),
     ]
     check_outputs(outputs, inputs=problem.inputs)
+    frame = ros_frame(args, problem)
 
     from ..dynamic import simulate
 
@@ -126,7 +130,7 @@ def run(args: argparse.Namespace) -> int:
             bar.refresh()
 
         sim = simulate(problem, options, seed=seed, progress=progress)
-    _write_outputs(args, problem, sim)
+    _write_outputs(args, problem, sim, frame)
     verdict = "reached the goal" if sim.reached_goal else f"did not reach the goal ({sim.status})"
     note(
         f"{problem.name}: {verdict}, {sim.collisions} collisions, {len(sim.replans)} replans, "
@@ -135,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_OK if sim.success else EXIT_UNSOLVED
 
 
-def _write_outputs(args: argparse.Namespace, problem: Any, sim: Any) -> None:
+def _write_outputs(args: argparse.Namespace, problem: Any, sim: Any, frame: Any) -> None:
     if args.plot:
         from ..plotting import plot_simulation, save_figure
 
@@ -144,6 +148,10 @@ def _write_outputs(args: argparse.Namespace, problem: Any, sim: Any) -> None:
         from ..plotting import animate_simulation
 
         animate_simulation(problem, sim, args.gif)
+    if args.bag:
+        from ..ros.bag import write_simulation_bag
+
+        write_simulation_bag(problem, frame, sim, args.bag)
     if args.json:
         from ..outputs import write_json_atomic
 

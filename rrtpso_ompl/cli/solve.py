@@ -159,6 +159,10 @@ def _write_outputs(
         from ..ros import nav_path, write_nav_path
 
         write_nav_path(nav_path(frame.poses(result.path), frame.frame_id), args.path_out)
+    if args.bag:
+        from ..ros.bag import write_plan_bag
+
+        write_plan_bag(problem, frame, result.path if result.solved else None, args.bag)
     if args.json:
         from ..outputs import write_json_atomic
 
