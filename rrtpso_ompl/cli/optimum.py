@@ -55,6 +55,11 @@ def run(args: argparse.Namespace) -> int:
         from ..ros import units_fields
 
         write_json_atomic({**data, **units_fields(problem.units)}, args.json)
+    if args.bag:
+        from ..ros.bag import write_plan_bag
+
+        path = data["path"] if result.found else None
+        write_plan_bag(problem, frame, path, args.bag, command="optimum")
     if result.found:
         note(f"{problem.name}: optimum length={result.length:.6f}")
         return EXIT_OK

@@ -78,6 +78,8 @@ def ros_frame(args: argparse.Namespace, problem: Any) -> Any:
             f"({shortest * frame.scale:.6g} m) needs {poses:.3g} poses at {frame.resolution:g} m; "
             f"at most {MAX_POSES:,}: give a coarser --path-resolution"
         )
+    if args.bag:
+        _check_bag(args, problem, frame)
     return frame
 
 
@@ -93,6 +95,11 @@ def ros_poses(args: argparse.Namespace, frame: Any, path: Any) -> Any:
     if frame is None or path is None or len(path) == 0:
         return None
     try:
+        if args.bag:  # a bag's /plan holds fewer poses than a path document
+            from ..model.geometry import path_length
+            from ..ros.bag import check_pose_count
+
+            check_pose_count(frame, path_length(path) * frame.scale)
         return frame.poses(path)
     except ValueError as exc:
         raise UsageError(f"{args.problem}: --path-resolution: {exc}") from None
@@ -105,3 +112,19 @@ def write_path_out(args: argparse.Namespace, frame: Any, poses: Any) -> None:
     from ..ros import nav_path, write_nav_path
 
     write_nav_path(nav_path(poses, frame.frame_id), args.path_out)
+
+
+def _check_bag(args: argparse.Namespace, problem: Any, frame: Any) -> None:
+    """What a bag can hold, known before planning: the obstacles' markers, and the poses of
+    even the straight line to the goal."""
+    import math
+
+    from ..ros.bag import check_pose_count
+    from ..ros.markers import check_marker_count
+
+    try:
+        check_marker_count(problem)
+        shortest = max(0.0, math.dist(problem.start, problem.goal) - problem.goal_tolerance)
+        check_pose_count(frame, shortest * frame.scale, "even the straight line to the goal")
+    except ValueError as exc:
+        raise UsageError(f"{args.problem}: --bag: {exc}") from None

@@ -152,6 +152,10 @@ def _write_outputs(args: argparse.Namespace, problem: Any, sim: Any, frame: Any)
 
         animate_simulation(problem, sim, args.gif)
     write_path_out(args, frame, poses)  # nothing when no static plan was found
+    if args.bag:
+        from ..ros.bag import write_simulation_bag
+
+        write_simulation_bag(problem, frame, sim, args.bag)
     if args.json:
         from ..outputs import write_json_atomic
         from ..ros import units_fields

@@ -165,6 +165,10 @@ def _write_outputs(
     if motion and args.trajectory:
         motion.trajectory.write_csv(args.trajectory)
     write_path_out(args, frame, poses)
+    if args.bag:
+        from ..ros.bag import write_plan_bag
+
+        write_plan_bag(problem, frame, result.path if result.solved else None, args.bag)
     if args.json:
         from ..outputs import write_json_atomic
         from ..ros import units_fields
