@@ -182,7 +182,7 @@ def test_an_unknown_unit_is_refused_for_a_bag_before_planning(tmp_path):
 def test_a_path_resolution_too_fine_for_a_bag_is_refused_before_planning(tmp_path):
     js = tmp_path / "r.json"
     proc = run("solve", str(PROBLEMS / "static" / "paper_static.yaml"), "--bag",
-               str(tmp_path / "b.mcap"), "--path-resolution", "1e-7", "--json", str(js),
+               str(tmp_path / "b.mcap"), "--path-resolution", "1e-5", "--json", str(js),
                "--time", "5")  # fmt: skip
     assert proc.returncode == 2, proc.stderr
     assert "--bag: even the straight line to the goal" in proc.stderr
