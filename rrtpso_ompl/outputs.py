@@ -10,7 +10,9 @@ Where a result goes decides how it is written (:func:`publish`):
   them would replace the fifo (its reader would get nothing) or the device node.
 
 Everything that writes a file goes through :func:`atomic_path` (for writers that need a file
-name: matplotlib, SQLite) or :func:`write_text_atomic`.
+name: matplotlib, SQLite) or :func:`write_text_atomic`; a writer that makes a folder of its own
+(a ROS 2 bag) writes inside :func:`atomic_folder`, which renames the finished folder into place
+(over nothing, or an empty folder: a folder with anything in it is never replaced).
 
 A write that fails (the disk is full, the pipe or standard output is closed, the name is too
 long) raises one :class:`~rrtpso_ompl.errors.OutputError` naming the output and the reason, after
@@ -29,7 +31,7 @@ import shutil
 import stat
 import sys
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -40,6 +42,7 @@ from .errors import OutputError
 
 __all__ = [
     "STDOUT",
+    "atomic_folder",
     "atomic_path",
     "finite",
     "guard_standard_streams",
@@ -230,6 +233,63 @@ def atomic_path(path: str | Path, suffix: str | None = None) -> Iterator[str]:
         if isinstance(exc, OSError) and not isinstance(exc, OutputError):
             raise OutputError(str(path), os_reason(exc)) from None
         raise
+
+
+@contextmanager
+def atomic_folder(
+    path: str | Path, publish_file: Callable[[Path], Path] | None = None, name: str | None = None
+) -> Iterator[Path]:
+    """A fresh name to make a folder at, inside a temporary folder beside ``path``'s (resolved)
+    target; when the block ends without an exception the folder is moved to ``path``, else
+    removed. The temporary folder is removed either way.
+
+    Parameters
+    ----------
+    path : str or Path
+        The target: a new name, or an empty folder (renamed over atomically).
+    publish_file : callable, optional
+        Given the finished folder, the one file in it to publish to ``path`` instead of the
+        folder (by :func:`publish`: an existing regular file is replaced atomically, a link
+        written through), for writers that make a folder around the one file wanted (a ROS 2
+        bag in one MCAP file).
+    name : str, optional
+        The name of the folder to make (default: the target's; only with ``publish_file``
+        may it differ, since the folder itself is not published then).
+
+    Yields
+    ------
+    Path
+        Where the writer makes its folder (it does not exist yet).
+
+    Raises
+    ------
+    OutputError
+        When the folder cannot be made or published (an ``OSError`` of the block included).
+    """
+    target = _resolved(path)
+    made: list[Path] = []
+    scratch = None
+    try:
+        made = make_folders(target.parent)
+        prefix, end = _temp_affixes(Path(target.name), ".tmp", name_max(target.parent))
+        scratch = Path(tempfile.mkdtemp(prefix=prefix, suffix=end, dir=target.parent))
+        folder = scratch / (name if name and publish_file is not None else target.name)
+        yield folder
+        if publish_file is not None:
+            publish(publish_file(folder), target)
+        else:
+            os.rename(folder, target)  # atomic; only over nothing or an empty folder
+    except BaseException as exc:
+        if scratch is not None:
+            shutil.rmtree(scratch, ignore_errors=True)
+            scratch = None
+        remove_folders(made)
+        if isinstance(exc, OSError) and not isinstance(exc, OutputError):
+            raise OutputError(str(path), os_reason(exc)) from None
+        raise
+    finally:
+        if scratch is not None:
+            shutil.rmtree(scratch, ignore_errors=True)
 
 
 def make_folders(folder: str | Path) -> list[Path]:

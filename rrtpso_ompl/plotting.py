@@ -164,6 +164,25 @@ def world_legend(ax: Axes, handles: list[Any], fontsize: float = 8) -> Legend:
                      borderaxespad=0.0, fontsize=fontsize)  # fmt: skip
 
 
+def fit_layout(fig: Figure) -> None:
+    """``tight_layout``, then, should a world's legend (:func:`world_legend`) still reach past the
+    figure's right edge (long labels: a planner spec and a long path's length), its font made
+    smaller until it fits (down to 5 points)."""
+    fig.tight_layout()
+    for ax in fig.axes:
+        legend = ax.get_legend()
+        if legend is None:
+            continue
+        size = legend.get_texts()[0].get_fontsize() if legend.get_texts() else 8.0
+        while size > 5.0:
+            fig.canvas.draw()
+            if legend.get_window_extent().x1 <= fig.bbox.x1 - 2:
+                break
+            size -= 0.5
+            for text in legend.get_texts():
+                text.set_fontsize(size)
+
+
 def draw_map(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> list[Any]:
     """The occupancy grid under everything: occupied cells dark, unknown cells grey (light grey
     when ``unknown: free``), free cells white; the robot's clearance zone around the blocked
@@ -252,7 +271,7 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
     world_legend(ax, key)
     if history:
         _draw_pso_history(axes[0, 1], history, problem.units)
-    fig.tight_layout()
+    fit_layout(fig)
     return fig
 
 
@@ -285,7 +304,7 @@ def plot_optimum(problem: Problem, result: Any) -> Figure:
     world_legend(ax, key)
     found = f"length {result.length:.4f}" if result.found else "no path"
     ax.set_title(f"{problem.name}: exact optimum, {found}")
-    fig.tight_layout()
+    fit_layout(fig)
     return fig
 
 
@@ -410,7 +429,8 @@ def _plain_number(x: float, pos: int | None = None) -> str:
 
 def plot_velocities(traj: Any, units: str = "") -> Figure:
     """The paper's Figs. 17-18: v_ref and omega_ref, then the wheels' linear and angular speeds,
-    against time (``traj`` is a :class:`~rrtpso_ompl.kinematics.Trajectory`)."""
+    against time (``traj`` is a :class:`~rrtpso_ompl.kinematics.Trajectory`); the in-place turn
+    to a goal heading, if any, shaded."""
     u = units or "units"
     fig, axes = plt.subplots(2, 2, figsize=(12, 7), sharex=True)
     panels = [
@@ -426,6 +446,8 @@ def plot_velocities(traj: Any, units: str = "") -> Figure:
     for ax, series, label in panels:
         for name, legend in series:
             ax.plot(traj.t, getattr(traj, name), label=legend, lw=1.3)
+        if traj.goal_turn_times is not None:
+            ax.axvspan(*traj.goal_turn_times, color="0.85", zorder=0, label="turn to goal_yaw")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
         ax.legend(loc="best", fontsize=8)
@@ -498,7 +520,7 @@ def plot_simulation(problem: Problem, sim: Any) -> Figure:
     ax.set_title(f"{problem.name}: {sim.strategy}, {verdict}, {sim.collisions} collisions")
     world_legend(ax, key, fontsize=7)
     _draw_separation(bx, sim, problem.units)
-    fig.tight_layout()
+    fit_layout(fig)
     return fig
 
 
@@ -545,7 +567,7 @@ def simulation_frames(
     key = draw_world(ax, problem, safety_zones=False)
     scene = _MovingScene(ax, problem, sim)
     world_legend(ax, key + scene.key())
-    fig.tight_layout()
+    fit_layout(fig)
     return fig, scene.draw, frames
 
 

@@ -189,8 +189,8 @@ class Output:
         How the command line names it (``--json``).
     path : str or None
         Where; None when not asked for. ``-`` is standard output (text outputs only).
-    kind : {"text", "image", "gif", "folder"}
-        What is written there.
+    kind : {"text", "image", "gif", "folder", "bag"}
+        What is written there (``bag``: a ROS 2 bag, one MCAP file or a bag directory).
     """
 
     flag: str
@@ -207,7 +207,8 @@ def check_outputs(outputs: Sequence[Output], inputs: Sequence[str | Path] = ()) 
     an existing target that is neither a regular file nor a stream (a socket, a block device);
     an image suffix matplotlib cannot write; an output that is one of the inputs (it would be
     destroyed: pass every file a problem reads, :attr:`~rrtpso_ompl.model.Problem.inputs`) or the
-    same file as another output (one would be lost).
+    same file as another output (one would be lost); a ROS 2 bag over anything but an MCAP
+    file (``.mcap``) or an empty folder.
     """
     given = [o for o in outputs if o.path is not None]
     targets: dict[str, str] = {}
@@ -253,11 +254,15 @@ def _check_place(out: Output) -> None:
         if out.kind == "folder":
             if not stat.S_ISDIR(mode):
                 raise UsageError(f"{flag}: '{path}' exists and is not a directory")
+        elif out.kind == "bag":
+            _check_existing_bag(target, mode, flag, path)
         elif stat.S_ISDIR(mode):
             raise UsageError(f"{flag}: '{path}' is a directory")
         elif not (stat.S_ISREG(mode) or is_stream(target)):
             raise UsageError(f"{flag}: '{path}' is {file_kind(mode)}; it is left as it is")
         parent = target.parent if out.kind != "folder" else target
+    if out.kind == "bag":
+        _check_bag_name(target, parent, flag, path)
     if not parent.is_dir():
         raise UsageError(f"{flag}: cannot write '{path}': '{parent}' is a file, not a directory")
     if not os.access(parent, os.W_OK):
@@ -273,6 +278,52 @@ def _check_place(out: Output) -> None:
             )
     if out.kind == "gif" and Path(path).suffix.lower() != ".gif":
         raise UsageError(f"{flag}: '{path}' must end in .gif")
+
+
+def _check_existing_bag(target: Path, mode: int, flag: str, path: str) -> None:
+    """A ROS 2 bag over something that exists: an MCAP file is replaced like any output file
+    (only an MCAP file: a bag name over another kind of file is a mistake), a stream written
+    through; a sqlite3 bag directory is only made over an empty folder, never over anything
+    with content (a folder is not ours to empty)."""
+    from ..ros.bag import is_mcap, is_mcap_file
+
+    if is_mcap(path):
+        if stat.S_ISDIR(mode):
+            raise UsageError(f"{flag}: '{path}' is a directory; an MCAP bag is one file")
+        if is_stream(target):
+            return
+        if not stat.S_ISREG(mode):
+            raise UsageError(f"{flag}: '{path}' is {file_kind(mode)}; it is left as it is")
+        if not is_mcap_file(target):
+            raise UsageError(f"{flag}: '{path}' exists and is not an MCAP file; it is left as "
+                             "it is")  # fmt: skip
+        return
+    if not stat.S_ISDIR(mode):
+        raise UsageError(
+            f"{flag}: '{path}' is {file_kind(mode)}; a bag directory is made where nothing is "
+            "(or in an empty folder); name the bag OUT.mcap for one file"
+        )
+    with os.scandir(target) as entries:
+        if next(entries, None) is not None:
+            raise UsageError(
+                f"{flag}: '{path}' exists and is not empty; a bag directory is never replaced: "
+                "remove it or name another"
+            )
+
+
+def _check_bag_name(target: Path, existing: Path, flag: str, path: str) -> None:
+    """A bag directory holds its database named after it (``run/run.db3``): that name must fit
+    the file system too."""
+    from ..ros.bag import DATABASE_SUFFIX, is_mcap
+
+    if is_mcap(path):
+        return
+    limit = name_max(existing if existing.is_dir() else existing.parent)
+    size = len(os.fsencode(target.name + DATABASE_SUFFIX))
+    if size > limit:
+        raise UsageError(f"{flag}: cannot write '{path[:40]}...': the bag's database would be "
+                         f"named {size} bytes long, and the file system allows at most "
+                         f"{limit}")  # fmt: skip
 
 
 def _nearest_existing(path: Path) -> Path:

@@ -21,6 +21,7 @@ from .common import (
     note,
     progress_bar,
 )
+from .ros_flags import add_ros_flags, ros_frame, ros_outputs, ros_poses, write_path_out
 
 __all__ = ["OPTION_FLAGS", "add_parser", "run"]
 
@@ -55,7 +56,9 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         "(docs/dynamic.md). Exit status 0 when the goal is reached without a collision, else 1.",
     )
     m.add_argument("problem", help="problem file with moving_obstacles")
-    m.add_argument("--json", metavar="OUT", help="write the simulation as JSON")
+    m.add_argument(
+        "--json", metavar="OUT", help="write the simulation as JSON, in the problem's units"
+    )
     m.add_argument("--gif", metavar="OUT.gif", help="write an animation")
     m.add_argument("--plot", metavar="OUT.png", help="draw the driven path (paper Fig. 24)")
     add_planner_flags(
@@ -80,6 +83,7 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     m.add_argument("--heading-changes", type=float, metavar="RATE",
                    default=DynamicOptions.PARAMS["heading_changes"].default,
                    help=_help("heading_changes"))  # fmt: skip
+    add_ros_flags(m, "the initial static plan (not the path driven)")
     m.set_defaults(func=run)
 
 
@@ -102,8 +106,10 @@ def run(args: argparse.Namespace) -> int:
         Output("--json", args.json),
         Output("--plot", args.plot, "image"),
         Output("--gif", args.gif, "gif"),
+        *ros_outputs(args),
     ]
     check_outputs(outputs, inputs=problem.inputs)
+    frame = ros_frame(args, problem)  # the units and the pose spacing, known before planning
 
     from ..dynamic import simulate
 
@@ -126,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
             bar.refresh()
 
         sim = simulate(problem, options, seed=seed, progress=progress)
-    _write_outputs(args, problem, sim)
+    _write_outputs(args, problem, sim, frame)
     verdict = "reached the goal" if sim.reached_goal else f"did not reach the goal ({sim.status})"
     note(
         f"{problem.name}: {verdict}, {sim.collisions} collisions, {len(sim.replans)} replans, "
@@ -135,7 +141,8 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_OK if sim.success else EXIT_UNSOLVED
 
 
-def _write_outputs(args: argparse.Namespace, problem: Any, sim: Any) -> None:
+def _write_outputs(args: argparse.Namespace, problem: Any, sim: Any, frame: Any) -> None:
+    poses = ros_poses(args, frame, sim.static_path)  # may refuse: before anything is written
     if args.plot:
         from ..plotting import plot_simulation, save_figure
 
@@ -144,7 +151,13 @@ def _write_outputs(args: argparse.Namespace, problem: Any, sim: Any) -> None:
         from ..plotting import animate_simulation
 
         animate_simulation(problem, sim, args.gif)
+    write_path_out(args, frame, poses)  # nothing when no static plan was found
+    if args.bag:
+        from ..ros.bag import write_simulation_bag
+
+        write_simulation_bag(problem, frame, sim, args.bag)
     if args.json:
         from ..outputs import write_json_atomic
+        from ..ros import units_fields
 
-        write_json_atomic(sim.to_dict(), args.json)
+        write_json_atomic({**sim.to_dict(), **units_fields(problem.units)}, args.json)

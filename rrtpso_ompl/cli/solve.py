@@ -15,7 +15,7 @@ from .common import (
     choose_planner,
     note,
 )
-from .ros_flags import add_ros_flags, ros_frame, ros_outputs
+from .ros_flags import add_ros_flags, ros_frame, ros_outputs, ros_poses, write_path_out
 
 __all__ = ["add_parser", "run"]
 
@@ -35,7 +35,11 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         time="time limit (default: the file's planner.time_limit, else 1.0)",
         param="planner parameter, repeatable (e.g. --param swarm_size=50)",
     )
-    p.add_argument("--json", metavar="OUT", help="write the result as JSON")
+    p.add_argument(
+        "--json",
+        metavar="OUT",
+        help="write the result as JSON, in the problem's units (its units key)",
+    )
     p.add_argument(
         "--plot", metavar="OUT.png", help="draw the world, the paths and the PSO best-cost curve"
     )
@@ -61,8 +65,9 @@ def _add_drive_flags(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--trajectory",
         metavar="OUT.csv",
-        help="write the wheel commands every robot.sample_time: "
-        "t,x,y,theta,v,omega,v_right,v_left,omega_right,omega_left",
+        help="write the wheel commands every robot.sample_time, in the problem's units (lengths) "
+        "and seconds, radians: t,x,y,theta,v,omega,v_right,v_left,omega_right,omega_left; with "
+        "goal_yaw it ends with the turn in place to that heading",
     )
     p.add_argument(
         "--plot-velocities",
@@ -132,12 +137,15 @@ def _check_drive_keys(args: argparse.Namespace, problem: Any) -> None:
 
 
 def _drive(problem: Any, result: Any, profile: str) -> Any:
+    import math
+
     from ..errors import ProblemError
     from ..kinematics import TrajectoryError, drive
     from ..model import World
 
+    yaw = None if problem.goal_yaw is None else math.radians(problem.goal_yaw)
     try:
-        return drive(result.path, World.from_problem(problem), problem.robot, profile)
+        return drive(result.path, World.from_problem(problem), problem.robot, profile, yaw)
     except TrajectoryError as exc:  # the path found is longer than the straight line
         raise ProblemError(problem.source, "", str(exc)) from None
 
@@ -145,6 +153,7 @@ def _drive(problem: Any, result: Any, profile: str) -> Any:
 def _write_outputs(
     args: argparse.Namespace, problem: Any, result: Any, motion: Any, frame: Any
 ) -> None:
+    poses = ros_poses(args, frame, result.path if result.solved else None)  # may refuse: first
     if args.plot:
         from ..plotting import plot_solution, save_figure
 
@@ -155,14 +164,16 @@ def _write_outputs(
         save_figure(plot_velocities(motion.trajectory, problem.units), args.plot_velocities)
     if motion and args.trajectory:
         motion.trajectory.write_csv(args.trajectory)
-    if args.path_out and result.solved:
-        from ..ros import nav_path, write_nav_path
+    write_path_out(args, frame, poses)
+    if args.bag:
+        from ..ros.bag import write_plan_bag
 
-        write_nav_path(nav_path(frame.poses(result.path), frame.frame_id), args.path_out)
+        write_plan_bag(problem, frame, result.path if result.solved else None, args.bag)
     if args.json:
         from ..outputs import write_json_atomic
+        from ..ros import units_fields
 
         data = result.to_dict()
         if motion:
             data["kinematics"] = motion.summary()
-        write_json_atomic(data, args.json)
+        write_json_atomic({**data, **units_fields(problem.units)}, args.json)

@@ -168,8 +168,9 @@ class Motion:
             ts = np.append(ts, self.t_end)
         return np.column_stack([ts, self.position(ts), self.heading(ts)])
 
-    def wheel_speeds(self, track_width: float) -> tuple[np.ndarray, np.ndarray]:
-        """Right and left wheel speeds on each piece (paper eqs. 9-10), units/s."""
+    def body_velocities(self) -> tuple[np.ndarray, np.ndarray]:
+        """Linear speed ``v`` (units/s, negative backwards) and turn rate ``omega`` (rad/s) on
+        each piece; 0 on a piece of no duration (an instantaneous turn)."""
         dt = np.diff(self.t)
         safe = np.where(dt > 0, dt, 1.0)
         d = np.diff(self.xy, axis=0)
@@ -177,6 +178,11 @@ class Motion:
         along = d[:, 0] * np.cos(self.theta[:-1]) + d[:, 1] * np.sin(self.theta[:-1])
         v = np.where(dt > 0, along / safe, 0.0)
         w = np.where(dt > 0, np.diff(self.theta) / safe, 0.0)
+        return v, w
+
+    def wheel_speeds(self, track_width: float) -> tuple[np.ndarray, np.ndarray]:
+        """Right and left wheel speeds on each piece (paper eqs. 9-10), units/s."""
+        v, w = self.body_velocities()
         return v + 0.5 * track_width * w, v - 0.5 * track_width * w
 
 

@@ -3,7 +3,8 @@
 Stages, each a pure function:
 
 1. :func:`reference_polynomial`: the paper's cubic fit ``y_ref(x_ref)`` (eq. 6), and
-   :func:`reference_curve`: a smooth curve certified collision-free (:mod:`.reference`);
+   :func:`reference_curve`: a smooth curve certified collision-free (:mod:`.reference`), with
+   :func:`with_goal_heading` the in-place turn to a goal heading at its end;
 2. :func:`time_parametrize`: the paper's constant speed, or a profile within ``max_speed``,
    ``max_wheel_speed`` and ``max_accel``, with v and omega (eqs. 7-8) (:mod:`.profile`);
 3. :func:`wheel_speeds`: eqs. 9-12, and :func:`integrate_wheels`: the corrected eqs. 1-3
@@ -16,8 +17,15 @@ Printed typos and their corrections are listed in ``docs/kinematics.md``.
 
 from .diffdrive import integrate_wheels, wheel_speeds
 from .drive import REQUIRED_ROBOT_KEYS, DriveResult, drive
-from .profile import CSV_HEADER, Trajectory, TrajectoryError, check_samples, time_parametrize
-from .reference import ReferenceCurve, reference_curve, reference_polynomial
+from .profile import (
+    CSV_HEADER,
+    Trajectory,
+    TrajectoryError,
+    check_samples,
+    time_parametrize,
+    turn_limits,
+)
+from .reference import ReferenceCurve, reference_curve, reference_polynomial, with_goal_heading
 from .tracking import TrackingResult, track
 
 __all__ = [
@@ -35,5 +43,7 @@ __all__ = [
     "reference_polynomial",
     "time_parametrize",
     "track",
+    "turn_limits",
     "wheel_speeds",
+    "with_goal_heading",
 ]

@@ -10,7 +10,7 @@ from ..model.problem import Robot
 from ..model.world import World
 from .diffdrive import integrate_wheels
 from .profile import Trajectory, time_parametrize
-from .reference import ReferenceCurve, reference_curve, reference_polynomial
+from .reference import ReferenceCurve, reference_curve, reference_polynomial, with_goal_heading
 from .tracking import TrackingResult, track
 
 __all__ = ["REQUIRED_ROBOT_KEYS", "DriveResult", "drive"]
@@ -18,18 +18,29 @@ __all__ = ["REQUIRED_ROBOT_KEYS", "DriveResult", "drive"]
 
 @dataclass(frozen=True)
 class DriveResult:
-    """The kinematics of one path: reference, trajectory and how well the model follows it."""
+    """The kinematics of one path: reference, trajectory and how well the model follows it.
+
+    ``goal_yaw`` is the heading wanted at the goal (radians, None: any); the curve's last
+    ``turns`` entry is the in-place turn that reaches it.
+    """
 
     polynomial: np.ndarray | None
     curve: ReferenceCurve
     trajectory: Trajectory
     open_loop_error: float
     tracking: TrackingResult
+    goal_yaw: float | None = None
 
     def summary(self) -> dict:
-        """JSON-ready figures (lengths in problem units, times in seconds)."""
+        """JSON-ready figures (lengths in problem units, times in seconds, angles in radians).
+
+        With a goal heading, ``goal_turn``: the in-place turn at the goal, ``{"angle": rad,
+        counter-clockwise positive, "duration": s, "max_omega": rad/s, "max_wheel_speed":
+        units/s}`` (the largest commands of the rows the turn takes part in); without a goal
+        heading the key is absent.
+        """
         tr = self.trajectory
-        return {
+        out = {
             "reference_polynomial": None if self.polynomial is None else self.polynomial.tolist(),
             "curve": self.curve.kind,
             "curve_length": self.curve.length,
@@ -42,15 +53,41 @@ class DriveResult:
             "open_loop_max_error": self.open_loop_error,
             "tracking_max_error": self.tracking.max_error,
         }
+        if self.goal_yaw is not None:
+            out["goal_turn"] = self._goal_turn()
+        return out
+
+    def _goal_turn(self) -> dict:
+        """The in-place turn at the goal, from the trajectory's rows during it."""
+        tr = self.trajectory
+        t0, t1 = tr.goal_turn_times or (float(tr.t[-1]), float(tr.t[-1]))
+        rows = (tr.t + tr.sample_time > t0) & (tr.t < t1)  # the steps the turn takes part in
+        wheels = np.abs(np.concatenate([tr.v_right[rows], tr.v_left[rows]]))
+        return {
+            "angle": float(self.curve.turns[-1]),
+            "duration": t1 - t0,
+            "max_omega": float(np.abs(tr.omega[rows]).max()) if rows.any() else 0.0,
+            "max_wheel_speed": float(wheels.max()) if rows.any() else 0.0,
+        }
 
 
 REQUIRED_ROBOT_KEYS = ("speed", "sample_time", "track_width", "wheel_radius")
 
 
-def drive(path: np.ndarray, world: World, robot: Robot, profile: str = "auto") -> DriveResult:
+def drive(
+    path: np.ndarray,
+    world: World,
+    robot: Robot,
+    profile: str = "auto",
+    goal_yaw: float | None = None,
+) -> DriveResult:
     """Reference polynomial, certified reference curve, trajectory, open-loop replay and closed-loop
-    tracking for a valid path (see the module docstring for each step)."""
-    curve = reference_curve(path, world)
+    tracking for a valid path (see the module docstring for each step).
+
+    ``goal_yaw`` (radians, optional) is the heading wanted at the goal: the trajectory ends with
+    the in-place turn to it, the shorter way round (:func:`~.reference.with_goal_heading`).
+    """
+    curve = with_goal_heading(reference_curve(path, world), goal_yaw)
     traj = time_parametrize(curve, robot, profile)
     poses = integrate_wheels(
         (traj.x[0], traj.y[0], traj.theta[0]), traj.v_right, traj.v_left,
@@ -64,4 +101,5 @@ def drive(path: np.ndarray, world: World, robot: Robot, profile: str = "auto") -
         trajectory=traj,
         open_loop_error=open_loop,
         tracking=tracking,
+        goal_yaw=goal_yaw,
     )

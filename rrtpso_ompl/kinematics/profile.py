@@ -20,7 +20,14 @@ from ..validation import MAX_STEPS
 from .diffdrive import wheel_speeds
 from .reference import ReferenceCurve
 
-__all__ = ["CSV_HEADER", "Trajectory", "TrajectoryError", "check_samples", "time_parametrize"]
+__all__ = [
+    "CSV_HEADER",
+    "Trajectory",
+    "TrajectoryError",
+    "check_samples",
+    "time_parametrize",
+    "turn_limits",
+]
 
 CSV_HEADER = (
     "t", "x", "y", "theta", "v", "omega", "v_right", "v_left", "omega_right", "omega_left",
@@ -61,7 +68,8 @@ class Trajectory:
     All arrays have one entry per sample; lengths in problem units, angles in radians, times in
     seconds, linear speeds in units/s, angular speeds in rad/s. The velocities of a row are the
     commands to hold until the next row (the mean velocities over that step); the last row is the
-    goal, at rest.
+    goal, at rest. ``goal_turn_times`` is when the in-place turn to a goal heading starts and
+    ends (s), None without one.
     """
 
     t: np.ndarray
@@ -78,6 +86,7 @@ class Trajectory:
     track_width: float
     wheel_radius: float
     profile: str
+    goal_turn_times: tuple[float, float] | None = None
 
     def columns(self) -> np.ndarray:
         """``(n, 10)`` array in the order of :data:`CSV_HEADER`."""
@@ -124,8 +133,9 @@ def time_parametrize(curve: ReferenceCurve, robot: Robot, profile: str = "auto")
     Trajectory
         Poses at every sample; v and omega (eqs. 7-8) and the wheel speeds (eqs. 9-12) of row k
         are the mean velocities from row k to row k + 1, i.e. the commands to hold for one sample.
-        Turns in place (the polyline fallback) run at the largest angular speed the wheel limit
-        allows.
+        Turns in place (the polyline fallback's at the waypoints, and the turn to a goal heading
+        at the end, :func:`~.reference.with_goal_heading`) run with the wheels at opposite speeds
+        within the limits (:func:`turn_limits`).
 
     Raises
     ------
@@ -139,15 +149,13 @@ def time_parametrize(curve: ReferenceCurve, robot: Robot, profile: str = "auto")
     profile = _resolve_profile(robot, profile)
     L, ts = robot.track_width, robot.sample_time
     v, v_top = _speeds(curve, robot, profile)
-    # Turns in place: as fast as the wheels allow (w = 2 v_wheel / L), else at the speed the
-    # robot would drive.
-    w_turn = 2.0 * (robot.max_wheel_speed or v_top) / L
-    dt, turn_dt, t_nodes = _node_times(curve, v, w_turn)
+    turn = turn_limits(robot, profile, v_top)
+    dt, turn_dt, t_nodes = _node_times(curve, v, turn)
     t_end = t_nodes[-1] + turn_dt[-1]
     check_samples(t_end, ts)
     n = max(1, math.ceil(t_end / ts - 1e-9))
     t = np.arange(n + 1) * ts
-    out = _states_at(curve, v, dt, turn_dt, t_nodes, w_turn, np.minimum(t, t_end))
+    out = _states_at(curve, v, dt, turn_dt, t_nodes, turn, np.minimum(t, t_end))
     # The commands of row k are held until row k + 1 (what a controller does with them), so they
     # are the *mean* velocities over that step (eqs. 7-8 integrated over Ts): the heading then
     # matches the reference exactly at every sample, and means of limited speeds stay within the
@@ -155,11 +163,74 @@ def time_parametrize(curve: ReferenceCurve, robot: Robot, profile: str = "auto")
     v_out = np.append(np.diff(out["s"]) / ts, 0.0)
     w_out = np.append(np.diff(out["theta"]) / ts, 0.0)
     v_r, v_l, w_r, w_l = wheel_speeds(v_out, w_out, L, robot.wheel_radius)
+    goal_turn = (float(t_nodes[-1]), float(t_end)) if turn_dt[-1] > 0 else None
     return Trajectory(
         t=t, x=out["x"], y=out["y"], theta=out["theta"], v=v_out, omega=w_out,
         v_right=v_r, v_left=v_l, omega_right=w_r, omega_left=w_l, sample_time=ts,
         track_width=L, wheel_radius=robot.wheel_radius, profile=profile,
+        goal_turn_times=goal_turn,
     )  # fmt: skip
+
+
+def turn_limits(robot: Robot, profile: str, v_top: float) -> tuple[float, float | None]:
+    """How fast a turn in place runs: its top angular speed and angular acceleration.
+
+    In place (``v = 0``) eqs. 9-10 give opposite wheel speeds ``v_R = -v_L = L omega / 2``.
+    The wheels run at ``max_wheel_speed`` when it is given, else at ``v_top``, the speed the
+    robot drives at (both wheels' speed on a straight line): ``omega = 2 v_wheel / L``. In the
+    ``limits`` profile with ``max_accel`` each wheel also speeds up and slows down at most at
+    ``max_accel``: the turn is a trapezoid in omega with ``alpha = 2 max_accel / L``.
+
+    Parameters
+    ----------
+    robot : Robot
+        Its ``track_width`` (units) and the optional limits.
+    profile : {"constant", "limits"}
+        The resolved profile (``max_accel`` only shapes ``limits``, as it does for driving).
+    v_top : float
+        The profile's top linear speed, units/s.
+
+    Returns
+    -------
+    omega : float
+        Top angular speed of a turn, rad/s.
+    alpha : float or None
+        Angular acceleration, rad/s^2; None: the turn starts and stops at full speed (the
+        paper's constant-speed assumption).
+    """
+    L = robot.track_width
+    omega = 2.0 * (robot.max_wheel_speed or v_top) / L
+    limited = profile == "limits" and robot.max_accel is not None
+    return omega, (2.0 * robot.max_accel / L if limited else None)
+
+
+def _turn_time(angle: np.ndarray, turn: tuple[float, float | None]) -> np.ndarray:
+    """Seconds to turn in place by ``|angle|`` (rad) within ``turn`` (:func:`turn_limits`):
+    ``|angle| / omega``, plus ``omega / alpha`` for the ramps (a triangle when the turn is too
+    short to reach ``omega``)."""
+    angle = np.abs(angle)
+    omega, alpha = turn
+    if alpha is None:
+        return angle / omega
+    peak = np.minimum(omega, np.sqrt(angle * alpha))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(angle > 0.0, angle / peak + peak / alpha, 0.0)
+
+
+def _turned(tau: np.ndarray, angle: np.ndarray, turn: tuple[float, float | None]) -> np.ndarray:
+    """Radians turned ``tau`` seconds into a turn in place by ``|angle|`` (:func:`_turn_time`)."""
+    angle = np.abs(angle)
+    omega, alpha = turn
+    if alpha is None:
+        return np.minimum(omega * tau, angle)
+    peak = np.minimum(omega, np.sqrt(angle * alpha))
+    total = _turn_time(angle, turn)
+    ramp = peak / alpha
+    tau = np.clip(tau, 0.0, total)
+    rise = 0.5 * alpha * tau**2
+    fall = angle - 0.5 * alpha * (total - tau) ** 2
+    cruise = peak * (tau - 0.5 * ramp)
+    return np.where(tau < ramp, rise, np.where(tau > total - ramp, fall, cruise))
 
 
 def _resolve_profile(robot: Robot, profile: str) -> str:
@@ -203,9 +274,10 @@ def _speeds(curve: ReferenceCurve, robot: Robot, profile: str) -> tuple[np.ndarr
 
 
 def _node_times(
-    curve: ReferenceCurve, v: np.ndarray, w_turn: float
+    curve: ReferenceCurve, v: np.ndarray, turn: tuple[float, float | None]
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Time along the curve at speeds ``v`` (units/s) with turns in place at ``w_turn`` (rad/s).
+    """Time along the curve at speeds ``v`` (units/s) with turns in place within ``turn``
+    (:func:`turn_limits`).
 
     Returns
     -------
@@ -221,7 +293,7 @@ def _node_times(
     dv = v[:-1] + v[1:]
     with np.errstate(divide="ignore", invalid="ignore"):
         dt = np.where(dv > 0, 2.0 * ds / dv, 0.0)
-    turn_dt = np.abs(curve.turns) / w_turn
+    turn_dt = _turn_time(curve.turns, turn)
     t_nodes = np.concatenate([[0.0], np.cumsum(turn_dt[:-1] + dt)])
     return dt, turn_dt, t_nodes
 
@@ -238,7 +310,7 @@ def _limit_acceleration(v: np.ndarray, ds: np.ndarray, a: float) -> None:
         v[i] = min(v[i], math.sqrt(v[i + 1] ** 2 + 2 * a * ds[i]))
 
 
-def _states_at(curve, v, dt, turn_dt, t_nodes, w_turn, tk) -> dict[str, np.ndarray]:
+def _states_at(curve, v, dt, turn_dt, t_nodes, turn, tk) -> dict[str, np.ndarray]:
     """Poses and arc lengths at the times ``tk`` (constant acceleration between curve samples;
     a turn in place, if any, before leaving sample i)."""
     last = len(curve.s) - 1
@@ -255,7 +327,7 @@ def _states_at(curve, v, dt, turn_dt, t_nodes, w_turn, tk) -> dict[str, np.ndarr
     ds = np.where(moving, v[i] * drive_t + 0.5 * acc * drive_t**2, 0.0)
     seg = curve.s[j] - curve.s[i]
     f = np.clip(np.where(seg > 0, ds / np.where(seg > 0, seg, 1.0), 0.0), 0.0, 1.0)
-    turned = curve.theta[i] + np.sign(curve.turns[i]) * w_turn * local
+    turned = curve.theta[i] + np.sign(curve.turns[i]) * _turned(local, curve.turns[i], turn)
     return {
         "x": curve.x[i] + f * (curve.x[j] - curve.x[i]),
         "y": curve.y[i] + f * (curve.y[j] - curve.y[i]),

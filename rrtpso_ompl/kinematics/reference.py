@@ -15,15 +15,15 @@ that bound, so the curve itself keeps the radius everywhere.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from ..model.geometry import dedupe
+from ..model.geometry import dedupe, wrap_angle
 from ..model.world import World
 
-__all__ = ["ReferenceCurve", "reference_curve", "reference_polynomial"]
+__all__ = ["ReferenceCurve", "reference_curve", "reference_polynomial", "with_goal_heading"]
 
 
 def reference_polynomial(path: np.ndarray, degree: int = 3) -> np.ndarray | None:
@@ -49,8 +49,9 @@ class ReferenceCurve:
     s, x, y, theta, kappa : ndarray
         Arc length (units), position, heading (rad, unwrapped) and signed curvature (1/units).
     turns : ndarray
-        Heading change to make *in place* at each sample before moving on (rad); non-zero only for
-        the polyline fallback, at the waypoints.
+        Heading change to make *in place* at each sample before moving on (rad); non-zero only at
+        the waypoints of the polyline fallback, and at the last sample for a goal heading
+        (:func:`with_goal_heading`).
     kind : str
         ``"spline"`` or ``"polyline"`` (stop and turn in place at each waypoint).
     knots : ndarray
@@ -101,9 +102,9 @@ def reference_curve(
     """
     p = dedupe(np.asarray(path, dtype=float).reshape(-1, 2), tol=1e-12)
     total = float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
-    if len(p) < 3 or total == 0.0 or not smooth:
-        return _polyline_curve(p)
     spacing = spacing or total / 200.0
+    if len(p) < 3 or total == 0.0 or not smooth:
+        return _polyline_curve(p, spacing)
     # Tightening only inserts mid-points between consecutive knots, and consecutive knots always
     # lie on one polyline segment, so every knot stays on the (valid) polyline.
     knots = _graded_knots(p)
@@ -114,7 +115,7 @@ def reference_curve(
         bad = np.unique(bad_intervals)
         mids = 0.5 * (knots[bad] + knots[bad + 1])
         knots = np.insert(knots, bad + 1, mids, axis=0)
-    return _polyline_curve(p)
+    return _polyline_curve(p, spacing)
 
 
 def _graded_knots(p: np.ndarray, ratio: float = 2.0) -> np.ndarray:
@@ -176,16 +177,62 @@ def _spline_curve(
     return curve, np.empty(0, dtype=int)
 
 
-def _polyline_curve(p: np.ndarray) -> ReferenceCurve:
-    """Drive the polyline: straight segments (zero curvature), turning in place at waypoints."""
+def _polyline_curve(p: np.ndarray, spacing: float) -> ReferenceCurve:
+    """Drive the polyline: straight segments (zero curvature), turning in place at waypoints.
+
+    Each segment is sampled at most ``spacing`` apart and in at least two steps: the profile
+    takes constant acceleration between samples, and the robot stops at both ends of a segment
+    (to turn, or at the goal), so a segment of one step would have a mean speed of 0 and take
+    no time at all.
+    """
     seg = np.diff(p, axis=0)
-    heading = np.unwrap(np.arctan2(seg[:, 1], seg[:, 0])) if len(seg) else np.zeros(0)
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(seg, axis=1))])
-    theta = np.concatenate([heading[:1], heading]) if len(heading) else np.zeros(len(p))
-    turns = np.zeros(len(p))
-    turns[1:-1] = np.diff(heading) if len(heading) > 1 else 0.0
-    # At waypoint i the robot arrives with heading[i-1] and leaves with heading[i].
+    length = np.linalg.norm(seg, axis=1)
+    if len(seg) == 0:
+        z = np.zeros(len(p))
+        return ReferenceCurve(s=z, x=p[:, 0], y=p[:, 1], theta=z, kappa=z, turns=z.copy(),
+                              kind="polyline", knots=p)  # fmt: skip
+    heading = np.unwrap(np.arctan2(seg[:, 1], seg[:, 0]))
+    # Bounded: at most total / spacing + 2 per segment samples (200 + 2 n by default).
+    steps = np.maximum(2, np.ceil(length / spacing - 1e-9)).astype(np.int64)
+    k = np.repeat(np.arange(len(seg)), steps)  # the segment of each sample but the last
+    first = np.cumsum(steps) - steps
+    frac = (np.arange(int(steps.sum())) - first[k]) / steps[k]
+    xy = np.vstack([p[:-1][k] + frac[:, None] * seg[k], p[-1:]])
+    s = np.append(np.cumsum(np.append(0.0, length))[:-1][k] + frac * length[k], length.sum())
+    # A waypoint sample keeps the heading it is reached with (the segment before it) and turns
+    # there to the next one; the start faces its first segment.
+    theta = np.append(heading[0], heading[k[1:] - (frac[1:] == 0.0)])
+    theta = np.append(theta, heading[-1])
+    turns = np.zeros(len(xy))
+    turns[first[1:]] = np.diff(heading)
     return ReferenceCurve(
-        s=s, x=p[:, 0], y=p[:, 1], theta=theta, kappa=np.zeros(len(p)), turns=turns,
+        s=s, x=xy[:, 0], y=xy[:, 1], theta=theta, kappa=np.zeros(len(xy)), turns=turns,
         kind="polyline", knots=p,
     )  # fmt: skip
+
+
+def with_goal_heading(curve: ReferenceCurve, goal_yaw: float | None) -> ReferenceCurve:
+    """The curve with the in-place turn a differential drive makes at its end to face
+    ``goal_yaw``.
+
+    Parameters
+    ----------
+    curve : ReferenceCurve
+        From :func:`reference_curve`.
+    goal_yaw : float or None
+        Heading wanted at the goal, radians counter-clockwise from +x (any value: read modulo
+        2 pi); None leaves the curve as it is.
+
+    Returns
+    -------
+    ReferenceCurve
+        The same curve whose last sample turns in place by the shorter way round,
+        ``wrap_angle(goal_yaw - theta[-1])`` in [-pi, pi] (half a turn: either way, both as
+        short).
+        The robot is a disc, so turning in place sweeps nothing new: the certification stands.
+    """
+    if goal_yaw is None:
+        return curve
+    turns = curve.turns.copy()
+    turns[-1] = wrap_angle(goal_yaw - float(curve.theta[-1]))
+    return replace(curve, turns=turns)

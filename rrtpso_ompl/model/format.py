@@ -164,6 +164,8 @@ TOP = Section("problem", (
     Key("start", "point", "start position", True, "length"),
     Key("goal", "point", "goal position", True, "length"),
     Key("goal_tolerance", "length", "how close to the goal a path must end", unit="length"),
+    Key("goal_yaw", "number", "heading wanted at the goal, counter-clockwise from +x (any "
+        "number, read modulo 360): the robot turns in place there", unit="deg"),
     Key("robot", "robot", "the robot", True),
     Key("obstacles", "list:obstacle", "static obstacles (circles, rectangles, polygons)"),
     Key("moving_obstacles", "list:moving_obstacle", "moving obstacles"),

@@ -52,6 +52,7 @@ __all__ = [
     "input_files",
     "load_problem",
     "map_file_path",
+    "normalise_degrees",
     "problem_from_dict",
     "touch_tolerance",
 ]
@@ -151,7 +152,11 @@ class PlannerConfig:
 
 @dataclass(frozen=True)
 class Problem:
-    """One validated planning problem. Build it with :func:`load_problem`."""
+    """One validated planning problem. Build it with :func:`load_problem`.
+
+    Lengths are in the problem's ``units``; ``goal_yaw`` is the heading wanted at the goal in
+    degrees, counter-clockwise from +x, normalised to (-180, 180] (None: any heading).
+    """
 
     name: str
     bounds: tuple[Point, Point]
@@ -161,6 +166,7 @@ class Problem:
     obstacles: tuple[Obstacle, ...] = ()
     moving_obstacles: tuple[MovingObstacle, ...] = ()
     goal_tolerance: float = 0.0
+    goal_yaw: float | None = None
     planner: PlannerConfig = field(default_factory=PlannerConfig)
     description: str = ""
     units: str = ""
@@ -299,6 +305,7 @@ def problem_from_dict(
         start=v.point(doc["start"], "start"),
         goal=v.point(doc["goal"], "goal"),
         goal_tolerance=v.number(_get(doc, "goal_tolerance", 0.0), "goal_tolerance", low=0.0),
+        goal_yaw=v.degrees(doc.get("goal_yaw"), "goal_yaw"),
         robot=robot,
         obstacles=obstacles,
         moving_obstacles=moving,
@@ -415,6 +422,13 @@ class _Validator:
             return check_number(value, low=low, strict_low=strict)
         except ValueError as exc:
             raise self.error(key, f"{exc}{number_hint(value)}") from None
+
+    def degrees(self, value: Any, key: str) -> float | None:
+        """An optional heading in degrees, as ``heading_deg``: any finite number, normalised to
+        (-180, 180] (None when absent)."""
+        if value is None:
+            return None
+        return normalise_degrees(self.number(value, key))
 
     def string(self, value: Any, key: str, empty: bool = False) -> str:
         if not isinstance(value, str) or (not empty and not value.strip()):
@@ -685,6 +699,13 @@ def _too_small(bounds: tuple[Point, Point]) -> str:
         f"{need:g} ({MIN_EXTENT:g} of its coordinates' magnitude {magnitude:g})")  # fmt: skip
     return (f"too small to plan in: sides {xmax - xmin:g} x {ymax - ymin:g}, each must be at "
             f"least {why}")  # fmt: skip
+
+
+def normalise_degrees(angle: float) -> float:
+    """``angle`` (degrees) as the same direction in (-180, 180], exactly (``math.remainder``
+    rounds nothing, even for 1e300)."""
+    a = math.remainder(angle, 360.0)
+    return 180.0 if a == -180.0 else a + 0.0  # + 0.0: no -0.0 in outputs
 
 
 def touch_tolerance(bounds: tuple[Point, Point]) -> float:

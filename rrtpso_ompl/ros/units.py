@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import contextlib
+
 from ..errors import ProblemError
 
-__all__ = ["METRES_PER_UNIT", "metres_per_unit"]
+__all__ = ["METRES_PER_UNIT", "metres_per_unit", "units_fields"]
 
 #: Metres in one problem unit, for every spelling a problem's ``units`` key accepts.
 METRES_PER_UNIT: dict[str, float] = {
@@ -55,3 +57,19 @@ def metres_per_unit(units: str, source: str = "<dict>") -> float:
         raise ProblemError(
             source, "units", f"unknown length unit {units!r} for a ROS output (known: {known})"
         ) from None
+
+
+def units_fields(units: str) -> dict[str, str | float]:
+    """What a JSON output says about its lengths: ``{"units": units}``, and
+    ``"metres_per_unit"`` when :func:`metres_per_unit` knows the unit (an unknown unit is no
+    error here: JSON and CSV outputs keep the problem's units, whatever they are).
+
+    Parameters
+    ----------
+    units : str
+        The problem's ``units`` key (empty: metres, as for the ROS outputs).
+    """
+    out: dict[str, str | float] = {"units": units}
+    with contextlib.suppress(ProblemError):
+        out["metres_per_unit"] = metres_per_unit(units)
+    return out

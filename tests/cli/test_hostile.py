@@ -446,6 +446,8 @@ MAP_AS_OUTPUT = [
     ("solve", "maps/lab_clutter.yaml", "--plot", "maps/grids/lab.png"),
     ("optimum", "maps/office_corridor.yaml", "--json", "maps/grids/office.yaml"),
     ("optimum", "maps/lab_clutter.yaml", "--plot", "maps/grids/lab.png"),
+    ("optimum", "maps/office_corridor.yaml", "--path-out", "maps/grids/office.yaml"),
+    ("simulate", "dynamic/office_people.yaml", "--path-out", "hard-link.pgm"),
     ("simulate", "dynamic/office_people.yaml", "--json", "maps/grids/office.yaml"),
     ("simulate", "dynamic/office_people.yaml", "--plot", "image-link.pgm.png"),
 ]
@@ -658,6 +660,8 @@ WRITES = [
     (["solve", "p.yaml", "--path-out", "out.yaml"], True),
     (["simulate", "s.yaml", "--gif", "out.gif"], True),
     (["optimum", "p.yaml", "--json", "out.json"], True),
+    (["optimum", "p.yaml", "--path-out", "out.yaml"], True),
+    (["simulate", "s.yaml", "--path-out", "out.yaml"], True),
     (["generate", "circles", "--seed", "1", "--overwrite", "--out", "out.yaml"], True),
     (["solve", "p.yaml", "--json", "new/folder/out.json"], False),
     (["batch", "p.yaml", "--planner", "RRTConnect", "--out", "new.jsonl"], False),

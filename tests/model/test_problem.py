@@ -308,6 +308,13 @@ BAD = [
         "moving_obstacles[0].heading",
         "did you mean 'heading_deg'",
     ),
+    # the goal heading: a number of degrees, as heading_deg
+    ("goal-yaw-string", _with(goal_yaw="north"), "goal_yaw", "number"),
+    ("goal-yaw-quoted", _with(goal_yaw="90"), "goal_yaw", "remove the quotes"),
+    ("goal-yaw-nan", _with(goal_yaw=float("nan")), "goal_yaw", "finite"),
+    ("goal-yaw-inf", _with(goal_yaw=float("-inf")), "goal_yaw", "finite"),
+    ("goal-yaw-bool", _with(goal_yaw=True), "goal_yaw", "number"),
+    ("goal-yaw-list", _with(goal_yaw=[0, 90]), "goal_yaw", "number"),
     # planner defaults
     ("planner-not-mapping", _with(planner="RRTstar"), "planner", "mapping"),
     (
@@ -399,13 +406,28 @@ def test_optional_keys_default_and_null_means_absent():
     assert p.goal_tolerance == 0.0 and p.obstacles == () and p.moving_obstacles == ()
     assert p.planner.type is None and p.planner.time_limit is None and p.planner.seed is None
     assert dict(p.planner.params) == {}
+    assert p.goal_yaw is None
     nulls = dict.fromkeys(
-        ("description", "units", "goal_tolerance", "obstacles", "moving_obstacles", "planner")
-    )
+        ("description", "units", "goal_tolerance", "goal_yaw", "obstacles", "moving_obstacles",
+         "planner")
+    )  # fmt: skip
     q = problem_from_dict({**doc, **nulls}, name="stem")
     assert q == p
     r = problem_from_dict({**doc, "planner": dict.fromkeys(("type", "time_limit", "seed"))})
     assert r.planner == p.planner
+
+
+@pytest.mark.parametrize(
+    ("written", "read"),
+    [(90, 90.0), (-90.5, -90.5), (180, 180.0), (-180, 180.0), (540, 180.0), (270, -90.0),
+     (-190, 170.0), (720, 0.0), (-0.0, 0.0), (1e300, math.remainder(1e300, 360.0)),
+     (7.25e5, -40.0)],
+)  # fmt: skip
+def test_goal_yaw_is_degrees_normalised_to_the_half_open_circle(written, read):
+    """Any finite number of degrees (as heading_deg), read as the same heading in (-180, 180]."""
+    p = problem_from_dict(_with(goal_yaw=written), source="mem")
+    assert p.goal_yaw == read and -180.0 < p.goal_yaw <= 180.0
+    assert math.copysign(1.0, p.goal_yaw) == 1.0 or p.goal_yaw < 0  # no -0.0
 
 
 def test_name_defaults_to_the_file_stem(tmp_path):
