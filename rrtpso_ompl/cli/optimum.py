@@ -1,10 +1,13 @@
-"""``rrtpso optimum``: the exact shortest path, the reference of every length ratio."""
+"""``rrtpso optimum``: the exact shortest path, the reference of every length ratio; with
+``--cost``, the reference of the problem's objective (length plus the inflation cost)."""
 
 from __future__ import annotations
 
 import argparse
+import math
 from typing import Any
 
+from ..errors import UsageError
 from .common import EXIT_OK, EXIT_UNSOLVED, Output, check_outputs, note
 
 __all__ = ["add_parser", "run"]
@@ -17,22 +20,53 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         help="compute the exact shortest path (the reference for path-length ratios)",
         description="Compute the exact shortest path for the problem's disc robot among its "
         "circles, polygons and map cells: a tangent graph with arcs around the inflated "
-        "obstacles, searched with A* and geodesic lower bounds (docs/benchmarking.md). Moving "
-        "obstacles are ignored. Exit status 0 when a path exists, 1 when none does.",
+        "obstacles, searched with A* and geodesic lower bounds (docs/benchmarking.md). With "
+        "--cost and a robot with inflation, the reference of the objective J (length plus the "
+        "inflation cost, docs/clearance.md) instead: a 16-connected grid search on the costmap. "
+        "Moving obstacles are ignored. Exit status 0 when a path exists, 1 when none does (or "
+        "the grid has none).",
     )
     o.add_argument("problem", help="problem file (YAML)")
     o.add_argument("--json", metavar="OUT", help='write {"length": ..., "path": [...], ...}')
-    o.add_argument("--plot", metavar="OUT.png", help="draw the world and the shortest path")
+    o.add_argument("--plot", metavar="OUT.png", help="draw the world and the path")
+    o.add_argument(
+        "--cost",
+        action="store_true",
+        help="the reference of the problem's objective J: with robot.inflation_radius, the "
+        "grid search of docs/clearance.md (its J, length, resolution, nodes and edges); "
+        "without inflation J is the length and the exact shortest path is the reference",
+    )
+    o.add_argument(
+        "--resolution",
+        type=float,
+        metavar="H",
+        help="node spacing of the --cost grid, problem units (default: the map's resolution, "
+        "else about 500,000 nodes over the bounds; at most 2,000,000 nodes)",
+    )
     o.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..groundtruth import shortest_path
     from ..model import load_problem
+    from ..model.objective import InflationCost
 
+    if args.resolution is not None:
+        if not args.cost:
+            raise UsageError("--resolution: only with --cost")
+        if not (math.isfinite(args.resolution) and args.resolution > 0):
+            raise UsageError(f"--resolution: must be a positive number, got {args.resolution:g}")
     problem = load_problem(args.problem)
     check_outputs([Output("--json", args.json), Output("--plot", args.plot, "image")],
                   inputs=problem.inputs)  # fmt: skip
+    if args.cost and InflationCost.of(problem.robot).active:
+        return _cost_reference(args, problem)
+    return _shortest(args, problem)
+
+
+def _shortest(args: argparse.Namespace, problem: Any) -> int:
+    """The exact shortest path (with ``--cost`` and no inflation: its ``J`` is its length)."""
+    from ..groundtruth import shortest_path
+
     result = shortest_path(problem)
     if args.plot:
         from ..plotting import plot_optimum, save_figure
@@ -42,9 +76,41 @@ def run(args: argparse.Namespace) -> int:
         from ..model import World
         from ..outputs import write_json_atomic
 
-        write_json_atomic(result.to_dict(World.from_problem(problem)), args.json)
+        data = result.to_dict(World.from_problem(problem))
+        if args.cost:
+            data = {"length": data["length"], "path": data["path"], "cost": result.length, **data}
+        write_json_atomic(data, args.json)
     if result.found:
-        note(f"{problem.name}: optimum length={result.length:.6f}")
+        what = "no inflation: J is the length; " if args.cost else ""
+        note(f"{problem.name}: {what}optimum length={result.length:.6f}")
         return EXIT_OK
     note(f"{problem.name}: no path exists")
+    return EXIT_UNSOLVED
+
+
+def _cost_reference(args: argparse.Namespace, problem: Any) -> int:
+    """The grid reference of the objective (:mod:`rrtpso_ompl.groundtruth.costgrid`)."""
+    from ..groundtruth.costgrid import CostGridError, cost_reference
+
+    try:
+        result = cost_reference(problem, resolution=args.resolution)
+    except CostGridError as exc:
+        raise UsageError(f"{args.problem}: {exc}") from None
+    if args.plot:
+        from ..plotting import plot_cost_reference, save_figure
+
+        save_figure(plot_cost_reference(problem, result), args.plot)
+    if args.json:
+        from ..outputs import write_json_atomic
+
+        write_json_atomic(result.to_dict(), args.json)
+    grid = (
+        f"grid h={result.resolution:.4g}{' (coarsened)' if result.coarsened else ''}, "
+        f"{result.nodes:,} nodes, {result.edges:,} edges, {result.time:.1f}s"
+    )
+    if result.found:
+        note(f"{problem.name}: grid reference J={result.cost:.6f} "
+             f"length={result.length:.6f} ({grid})")  # fmt: skip
+        return EXIT_OK
+    note(f"{problem.name}: no path on the grid ({grid}); a finer --resolution may find one")
     return EXIT_UNSOLVED

@@ -9,7 +9,7 @@ import numpy as np
 from ..model.problem import Robot
 from ..model.world import World
 from .diffdrive import integrate_wheels
-from .profile import Trajectory, time_parametrize
+from .profile import Trajectory, densify, time_parametrize
 from .reference import ReferenceCurve, reference_curve, reference_polynomial
 from .tracking import TrackingResult, track
 
@@ -34,6 +34,7 @@ class DriveResult:
             "curve": self.curve.kind,
             "curve_length": self.curve.length,
             "profile": tr.profile,
+            "slow_near_obstacles": tr.slow_near_obstacles,
             "duration": float(tr.t[-1]),
             "samples": len(tr.t),
             "max_v": float(np.abs(tr.v).max()),
@@ -47,11 +48,26 @@ class DriveResult:
 REQUIRED_ROBOT_KEYS = ("speed", "sample_time", "track_width", "wheel_radius")
 
 
-def drive(path: np.ndarray, world: World, robot: Robot, profile: str = "auto") -> DriveResult:
+def drive(
+    path: np.ndarray,
+    world: World,
+    robot: Robot,
+    profile: str = "auto",
+    slow_near_obstacles: bool = False,
+) -> DriveResult:
     """Reference polynomial, certified reference curve, trajectory, open-loop replay and closed-loop
-    tracking for a valid path (see the module docstring for each step)."""
+    tracking for a valid path (see the module docstring for each step).
+
+    With ``slow_near_obstacles`` (it needs ``robot.inflation_radius``) the speed is capped by the
+    clearance along the curve (:func:`~rrtpso_ompl.kinematics.time_parametrize`)."""
     curve = reference_curve(path, world)
-    traj = time_parametrize(curve, robot, profile)
+    clearance = None
+    if slow_near_obstacles:
+        curve = densify(curve, curve.length / 200.0)
+        xy = np.column_stack([curve.x, curve.y])
+        # Beyond the inflation radius the robot drives at full speed: farther needs no number.
+        clearance = world.point_clearance(xy, cap=robot.inflation_radius)
+    traj = time_parametrize(curve, robot, profile, clearance)
     poses = integrate_wheels(
         (traj.x[0], traj.y[0], traj.theta[0]), traj.v_right, traj.v_left,
         traj.track_width, traj.sample_time,
