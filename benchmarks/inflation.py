@@ -102,13 +102,12 @@ def measure(path: Path) -> dict:
         p = opt.valid_polyline(world)
         row.update(optimum=opt.length, optimum_cost=cost.path_cost(world, p),
                    optimum_near=cost.near_share(world, p))  # fmt: skip
-    try:
-        from rrtpso_ompl.groundtruth.costgrid import grid_reference
-    except ImportError:
-        return row
-    ref = grid_reference(problem)
-    if ref is not None and ref.path is not None:
-        row.update(reference=ref.cost, reference_resolution=ref.resolution)
+    from rrtpso_ompl.groundtruth.costgrid import cost_reference
+
+    ref = cost_reference(problem)
+    if ref.found:
+        row.update(reference=ref.cost, reference_resolution=ref.resolution,
+                   reference_length=ref.length, reference_time=ref.time)  # fmt: skip
     return row
 
 
@@ -158,15 +157,16 @@ def summary(rows: list[dict], budget: float) -> list[list[str]]:
     table = []
     for fam in dict.fromkeys(r["family"] for r in rows):
         for planner in PLANNERS:
-            mine = [r for r in rows
-                    if (r["family"], r["planner"], r["budget"]) == (fam, planner, budget)]  # fmt: skip
+            key = (fam, planner, budget)
+            mine = [r for r in rows if (r["family"], r["planner"], r["budget"]) == key]
             ok = [r for r in mine if r.get("solved") and r.get("optimum")]
             near = [r["near"] / r["optimum_near"] for r in ok if r.get("optimum_near")]
             halved = sum(1 for r in ok if r["near"] <= 0.5 * r.get("optimum_near", 0.0))
             longer = [r["length"] / r["optimum"] for r in ok]
             vs_ref = [r["cost"] / r["reference"] for r in ok if r.get("reference")]
-            table.append([fam, planner, f"{len(ok)}/{len(mine)}", _cell(near), f"{halved}/{len(ok)}",
-                          _cell(longer), _cell(vs_ref, "{:.4f}")])  # fmt: skip
+            table.append([fam, planner, f"{len(ok)}/{len(mine)}", _cell(near),
+                          f"{halved}/{len(ok)}", _cell(longer),
+                          _cell(vs_ref, "{:.4f}")])  # fmt: skip
     return table
 
 
@@ -216,8 +216,9 @@ def report(rows: list[dict], args, seeds) -> list[str]:
                   markdown_table(["family", "planner", "solved", "near", "halved", "length",
                                   "cost / ref"], summary(rows, budget)),
                   "", "RRTstarPSO's J over BIT* + simplifier's (same problem and seed):", "",
-                  markdown_table(["family", "J ratio", "RRTstarPSO no worse", "only RRTstarPSO "
-                                  "solved", "only BIT* solved"], head_to_head(rows, budget))]  # fmt: skip
+                  markdown_table(["family", "J ratio", "RRTstarPSO no worse",
+                                  "only RRTstarPSO solved", "only BIT* solved"],
+                                 head_to_head(rows, budget))]  # fmt: skip
         deadline = max((r["time"] / budget for r in rows
                         if r["budget"] == budget and r.get("time")), default=0.0)  # fmt: skip
         lines += ["", f"Largest planning time over the budget: {deadline:.3f}."]
