@@ -49,6 +49,7 @@ from .base import (
     refusing_motions_after,
 )
 from .corridor import search
+from .costroute import cost_route
 from .ompl_planners import RRTSTAR_PARAMS
 from .params import ParamSpec, ParamTable
 from .path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
@@ -120,9 +121,12 @@ class RRTstarPSOStats(PlannerStats):
     one). In OMPL's benchmark terms the corridor stage,
     the RRT* stage and OMPL's simplifier are the planning, the swarm is the simplification.
     ``rrt_path`` is RRT*'s first path, ``seed_path`` the path the returned one was made from
-    (``seed_source`` says whose: ``"corridor"``, ``"RRTstar"`` or ``"BITstar"``; a later RRT*
-    path when the anytime loop found a shorter). ``corridor_*`` describe the corridor stage
-    (``corridor_cells``: its lattice's cells; ``corridor_reason``: why it has no path).
+    (``seed_source`` says whose: ``"corridor"``, ``"RRTstar"``, ``"BITstar"`` or
+    ``"costroute"``; a later RRT* path when the anytime loop found a shorter). ``corridor_*`` describe the corridor stage
+    (``corridor_cells``: its lattice's cells; ``corridor_reason``: why it has no path);
+    ``costroute_time`` the re-routing of the best candidate through the cheapest cells under an
+    inflation cost (:mod:`~rrtpso_ompl.planners.costroute`; its path is a candidate,
+    ``"costroute"``).
     ``range_used`` is the inner RRT*'s range, the one chosen for the world when the ``range``
     parameter is 0 (the parameter itself stays as the user set it).
     """
@@ -146,6 +150,7 @@ class RRTstarPSOStats(PlannerStats):
     rrt_progress: list[tuple[float, float]] = field(default_factory=list)
     simplified_length: float | None = None
     simplify_time: float = 0.0
+    costroute_time: float = 0.0
     pso_length: float | None = None
     pso_cost: float | None = None
     pso_time: float = 0.0
@@ -179,6 +184,7 @@ class RRTstarPSOStats(PlannerStats):
             properties={
                 "corridor time": ("REAL", self.corridor_time),
                 "corridor length": ("REAL", self.corridor_length),
+                "costroute time": ("REAL", self.costroute_time),
                 "rrt iterations": ("INTEGER", self.rrt_iterations),
                 "pso iterations": ("INTEGER", self.pso_iterations),
                 "pso evaluations": ("INTEGER", self.pso_evaluations),
@@ -376,6 +382,15 @@ class RRTstarPSO(PythonPlanner):
             short = shortcut(corridor, self._model.segments_free, self._stop(ptc, t0), window=8)
             stats.simplify_time += time.perf_counter() - t1
             out.append(("corridor", corridor, short))
+        if self._inflation is not None and out:
+            # The shortest path hugs the walls: re-routed through the cheapest cells of a band
+            # round it (the costmap's way), it is a far better seed for the inflation cost.
+            t1 = time.perf_counter()
+            around = min(out, key=lambda c: self._cost(c[2]))[2]
+            routed = cost_route(self._model, self._inflation, around, self._finish_by(t0))
+            stats.costroute_time = time.perf_counter() - t1
+            if routed is not None:
+                out.append(("costroute", routed, routed))
         return out
 
     def _cost(self, xy: np.ndarray) -> float:
