@@ -122,8 +122,9 @@ class RRTstarPSOStats(PlannerStats):
     the RRT* stage and OMPL's simplifier are the planning, the swarm is the simplification.
     ``rrt_path`` is RRT*'s first path, ``seed_path`` the path the returned one was made from
     (``seed_source`` says whose: ``"corridor"``, ``"RRTstar"``, ``"BITstar"`` or
-    ``"costroute"``; a later RRT* path when the anytime loop found a shorter). ``corridor_*`` describe the corridor stage
-    (``corridor_cells``: its lattice's cells; ``corridor_reason``: why it has no path);
+    ``"costroute"``; a later RRT* path when the anytime loop found a shorter). ``corridor_*``
+    describe the corridor stage (``corridor_cells``: its lattice's cells; ``corridor_reason``:
+    why it has no path);
     ``costroute_time`` the re-routing of the best candidate through the cheapest cells under an
     inflation cost (:mod:`~rrtpso_ompl.planners.costroute`; its path is a candidate,
     ``"costroute"``).
