@@ -47,9 +47,11 @@ __all__ = [
     "MAX_SAMPLES",
     "ClearanceField",
     "InflationCost",
+    "default_scaling",
 ]
 
-#: Nav2's default ``cost_scaling_factor`` (1/m), used when only ``inflation_radius`` is given.
+#: Nav2's default ``cost_scaling_factor``, 1/m: a problem in other units gets it converted
+#: (:func:`default_scaling`).
 DEFAULT_COST_SCALING_FACTOR = 3.0
 #: ``w``: Smac 2D's default ``cost_travel_multiplier``.
 DEFAULT_COST_WEIGHT = 2.0
@@ -94,7 +96,8 @@ class InflationCost:
 
     @classmethod
     def of(cls, robot) -> InflationCost:
-        """The cost of a :class:`~rrtpso_ompl.model.Robot` (its inflation keys)."""
+        """The cost of a :class:`~rrtpso_ompl.model.Robot` (its inflation keys; a problem file's
+        robot has its scaling factor in the problem's units, :func:`default_scaling`)."""
         return cls(
             radius=robot.radius,
             inflation_radius=robot.inflation_radius or 0.0,
@@ -196,6 +199,17 @@ class InflationCost:
             return 0.0
         near = InflationCost(self.radius, self.inflation_radius, 0.0, 1.0)  # c = 1 inside R_i
         return float(near.segment_integrals(world, p[:-1], p[1:]).sum()) / total
+
+
+def default_scaling(units: str) -> float:
+    """Nav2's default ``cost_scaling_factor`` (3.0 per metre) per unit of ``units`` (per metre
+    when the unit is not one :mod:`~rrtpso_ompl.model.units` knows)."""
+    from .units import metres_per_unit
+
+    try:
+        return DEFAULT_COST_SCALING_FACTOR * metres_per_unit(units)
+    except ValueError:
+        return DEFAULT_COST_SCALING_FACTOR
 
 
 class ClearanceField:

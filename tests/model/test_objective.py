@@ -67,3 +67,15 @@ def test_the_cost_is_nav2s_normalised_inflation():
     d = np.array([0.0, 0.2, 0.3, 0.55, 0.56])
     expected = [1.0, 1.0, math.exp(-0.3), math.exp(-3.0 * 0.35), 0.0]
     np.testing.assert_allclose(cost.cost(d), expected, rtol=1e-15)
+
+
+def test_the_default_scaling_factor_is_nav2s_per_metre_in_the_problems_units():
+    doc = {"bounds": [[0, 0], [500, 500]], "start": [20, 20], "goal": [450, 450],
+           "robot": {"radius": 28.5, "inflation_radius": 60.0}}  # fmt: skip
+    cm = problem_from_dict({**doc, "units": "cm"})
+    assert cm.robot.cost_scaling_factor == pytest.approx(0.03)
+    assert problem_from_dict(doc).robot.cost_scaling_factor == 3.0  # no units: metres
+    given = problem_from_dict({**doc, "units": "cm",
+                               "robot": {**doc["robot"], "cost_scaling_factor": 0.1}})  # fmt: skip
+    assert given.robot.cost_scaling_factor == 0.1
+    assert problem_from_dict({**doc, "robot": {"radius": 1}}).robot.cost_scaling_factor is None
