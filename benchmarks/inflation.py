@@ -53,11 +53,17 @@ REPORT_SEEDS = (101, 102, 103)
 PLANNERS = ("RRTstarPSO", "BITstar+simplify")
 
 
+#: ``cost_travel_multiplier`` of every problem (None: the default); ``--weight`` sets it.
+WEIGHT: list[float | None] = [None]
+
+
 def inflated(src: Path, dst: Path, radius: float, factor: float) -> Path:
     """A copy of problem ``src`` with the robot's inflation, its map resolved beside it."""
     doc = yaml.safe_load(src.read_text())
     doc["robot"]["inflation_radius"] = radius
     doc["robot"]["cost_scaling_factor"] = factor
+    if WEIGHT[0] is not None:
+        doc["robot"]["cost_travel_multiplier"] = WEIGHT[0]
     if "map" in doc:
         doc["map"] = str((src.parent / doc["map"]).resolve())
     dst.write_text(yaml.safe_dump(doc, sort_keys=False))
@@ -87,7 +93,7 @@ def problem_files(which: str, seeds, folder: Path) -> list[tuple[str, Path]]:
     return out
 
 
-def measure(path: Path) -> dict:
+def measure(path: Path, reference: bool = True) -> dict:
     """The shortest path's and the grid reference's figures of one problem."""
     from rrtpso_ompl.groundtruth import shortest_path
     from rrtpso_ompl.model import World, load_problem
@@ -102,6 +108,8 @@ def measure(path: Path) -> dict:
         p = opt.valid_polyline(world)
         row.update(optimum=opt.length, optimum_cost=cost.path_cost(world, p),
                    optimum_near=cost.near_share(world, p))  # fmt: skip
+    if not reference:
+        return row
     from rrtpso_ompl.groundtruth.costgrid import cost_reference
 
     ref = cost_reference(problem)
@@ -238,14 +246,18 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--seeds", type=int, nargs="+", help="family seeds (default: the set's)")
     ap.add_argument("--out", default="-", help="Markdown report (- prints it)")
     ap.add_argument("--rows", help="also write every run as JSON lines")
+    ap.add_argument("--weight", type=float, help="cost_travel_multiplier (default: the default)")
+    ap.add_argument("--no-reference", action="store_true", help="skip the grid reference")
     args = ap.parse_args(argv)
+    WEIGHT[0] = args.weight
     args.argv = argv
     seeds = args.seeds or (TUNING_SEEDS if args.set == "tuning" else REPORT_SEEDS)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         files = problem_files(args.set, seeds, Path(tmp))
         for i, (family, path) in enumerate(files):
-            base = {"family": family, "file": path.name, **measure(path)}
+            base = {"family": family, "file": path.name,
+                    **measure(path, reference=not args.no_reference)}  # fmt: skip
             print(f"[{i + 1}/{len(files)}] {path.name}", file=sys.stderr, flush=True)
             for budget in args.time:
                 for seed in args.runs:
