@@ -47,6 +47,9 @@ def cost_route(
     start to its goal, with waypoints dropped where that lowers ``J``; None when there is none
     (or ``deadline``, a ``time.perf_counter()`` time, passed).
 
+    The cells are a quarter of the inflated band (``R_i - r``); where the wholly free cells do
+    not join (a passage a few cells wide), cells half and a quarter as large are tried.
+
     Parameters
     ----------
     world : World
@@ -56,17 +59,32 @@ def cost_route(
         A valid path: its ends are the route's, its neighbourhood the band.
     """
     path = np.asarray(path, dtype=float)
+    h = 0.25 * (inflation.inflation_radius - inflation.radius)
+    for size in (h, 0.5 * h, 0.25 * h):
+        if deadline is not None and time.perf_counter() >= deadline:
+            return None
+        route = _route_on_lattice(world, inflation, path, size, deadline)
+        if route is not None:
+            return drop_waypoints(world, inflation, route, deadline)
+    return None
+
+
+def _route_on_lattice(world, inflation: InflationCost, path, h: float, deadline):
+    """:func:`cost_route`'s route on cells of side ``h`` (made larger to keep the lattice within
+    :data:`MAX_BAND_CELLS`), before waypoints are dropped; None when the cells do not join."""
     radius = inflation.inflation_radius
     (xmin, ymin), (xmax, ymax) = world.bounds
-    h = max(0.25 * (radius - inflation.radius), 1e-9)
-    h = max(h, math.sqrt((xmax - xmin) * (ymax - ymin) / MAX_BAND_CELLS))
-    lat = Lattice.over(world.bounds, h)
+    h = max(h, 1e-9, math.sqrt((xmax - xmin) * (ymax - ymin) / MAX_BAND_CELLS))
+    raster = getattr(world, "raster", None)
+    if raster is None:
+        lat = Lattice.over(world.bounds, h)
+    else:  # cells aligned with the map's (its cells split or merged), as its queries need
+        res = raster.resolution
+        h = res / max(1, round(res / h)) if h < res else res * round(h / res)
+        lat = Lattice.over(world.bounds, h, raster.origin)
     if lat.nx < 2 or lat.ny < 2:
         return None
-    within = band(lat, path, BAND_RADII * radius)
-    free = world.free_cells(lat, within)
-    if deadline is not None and time.perf_counter() >= deadline:
-        return None
+    free = world.free_cells(lat, band(lat, path, BAND_RADII * radius))
     # The end points may lie near a wall, where the conservative cells leave a gap: look a few
     # cells (the inflated band's width) round them.
     reach = math.ceil(radius / h) + 2
@@ -75,11 +93,9 @@ def cost_route(
     if s_cell is None or g_cell is None:
         return None
     cells = np.flatnonzero(free.ravel())
-    centres = lat.centres()[cells]
     cost = np.zeros(lat.n_cells)
-    cost[cells] = inflation.cost(world.point_clearance(centres, cap=radius))
-    graph = lattice_graph(free)  # move lengths in cells
-    graph = graph.tocoo()
+    cost[cells] = inflation.cost(world.point_clearance(lat.centres()[cells], cap=radius))
+    graph = lattice_graph(free).tocoo()  # move lengths in cells
     mean = 0.5 * (cost[graph.row] + cost[graph.col])
     graph.data = graph.data * lat.h * (1.0 + inflation.weight * mean)
     ny = lat.ny
@@ -89,13 +105,10 @@ def cost_route(
     dist, pred = dijkstra(graph.tocsr(), directed=False, indices=s, return_predecessors=True)
     if not np.isfinite(dist[g]):
         return None
-    nodes = _walk(pred, g)
     # Into the first cell and out of the last: the end points lie in them or see their centres.
-    centres = np.array([lat.centre((v // ny, v % ny)) for v in nodes])
+    centres = np.array([lat.centre((v // ny, v % ny)) for v in _walk(pred, g)])
     route = np.vstack([path[:1], centres, path[-1:]])
-    if not world.path_valid(route):
-        return None
-    return drop_waypoints(world, inflation, route, deadline)
+    return route if world.path_valid(route) else None
 
 
 def drop_waypoints(
