@@ -112,7 +112,12 @@ def measure(path: Path, reference: bool = True) -> dict:
         return row
     from rrtpso_ompl.groundtruth.costgrid import cost_reference
 
-    ref = cost_reference(problem)
+    # On a map, cells a quarter of the inflated band when the map's are coarser (the generated
+    # maps' 0.78 m cells would make a poor reference), else the map's own.
+    h = None
+    if problem.map is not None:
+        h = min(problem.map.resolution, 0.25 * (cost.inflation_radius - cost.radius))
+    ref = cost_reference(problem, resolution=h)
     if ref.found:
         row.update(reference=ref.cost, reference_resolution=ref.resolution,
                    reference_length=ref.length, reference_time=ref.time)  # fmt: skip

@@ -210,6 +210,9 @@ _CORRIDOR_NO_ROUTE_SHARE = 0.5
 #: stages aim to be done by the rest.
 FINISH_RESERVE = 0.03
 
+#: RRT*'s share of the budget under an inflation cost when the corridor stage has a path.
+INFLATION_RRT_SHARE = 0.1
+
 #: RRT*'s automatic range is at most this many times the median clearance of free points.
 RANGE_PER_CLEARANCE = 10.0
 
@@ -388,7 +391,9 @@ class RRTstarPSO(PythonPlanner):
             # round it (the costmap's way), it is a far better seed for the inflation cost.
             t1 = time.perf_counter()
             around = min(out, key=lambda c: self._cost(c[2]))[2]
-            routed = cost_route(self._model, self._inflation, around, self._finish_by(t0))
+            end = self._finish_by(t0)  # half of what is left, the swarm gets the rest
+            routed = cost_route(self._model, self._inflation, around,
+                                None if end is None else t1 + 0.5 * max(end - t1, 0.0))  # fmt: skip
             stats.costroute_time = time.perf_counter() - t1
             if routed is not None:
                 out.append(("costroute", routed, routed))
@@ -596,6 +601,10 @@ class RRTstarPSO(PythonPlanner):
         t_begin = time.perf_counter()
         # RRT*'s share of what the corridor stage left.
         share = values["rrt_time_fraction"]
+        if self._inflation is not None and not fallback:
+            # With the corridor's path in hand and every motion's cost a Python call (10-30
+            # times fewer vertices a second), the cost route and the swarm make better use of it.
+            share = min(share, INFLATION_RRT_SHARE)
         rrt_end = t_begin + share * max(t0 + budget - t_begin, 0.0) if budget > 0 else None
         if resume:  # grown on after a swarm run: until a stall again, or 70 % of what is left
             rrt_end = t_begin + 0.7 * max(t0 + budget - t_begin, 0.0)
