@@ -37,6 +37,7 @@ The integral is evaluated by the composite midpoint rule with steps no longer th
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -278,6 +279,36 @@ class ClearanceField:
         d = np.minimum(self.world.point_clearance(pts, cap=self.cap), self.cap)
         self._d[nodes[:, 0], nodes[:, 1]] = d
         self._done[tiles[:, 0], tiles[:, 1]] = True
+
+    def prefill(self, path: np.ndarray, margin: float, deadline: float | None = None) -> bool:
+        """Measure, a chunk of tiles at a time, the tiles within ``margin`` of the polyline
+        ``path`` (where a swarm round's candidates lie); False when ``deadline``
+        (``time.perf_counter()`` seconds) came first. A measurement cannot be interrupted, so
+        work that must end in time measures its neighbourhood here first."""
+        p = np.asarray(path, dtype=float).reshape(-1, 2)
+        side = self.tile * self.spacing
+        seg = np.diff(p, axis=0)
+        n = np.maximum(np.ceil(np.hypot(*seg.T) / (0.5 * side)).astype(np.int64), 1)
+        k = np.repeat(np.arange(len(seg)), n)
+        t = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) / n[k]
+        pts = np.vstack([p[:-1][k] + t[:, None] * seg[k], p[-1:]])
+        reach = math.ceil(margin / side) + 1
+        base = np.floor((pts - self.origin) / side).astype(np.int64)
+        offs = np.arange(-reach, reach + 1)
+        di, dj = np.meshgrid(offs, offs, indexing="ij")
+        tiles = (base[:, None, :] + np.stack([di.ravel(), dj.ravel()], 1)[None]).reshape(-1, 2)
+        tiles = np.clip(tiles, 0, np.array(self._done.shape) - 1)
+        flat = np.unique(tiles[:, 0] * self._done.shape[1] + tiles[:, 1])
+        todo = flat[~self._done_flat[flat]]
+        took = 0.0  # the last chunk's time: the next one would take about as long
+        for chunk in np.array_split(todo, max(1, math.ceil(len(todo) / 8))):
+            t0 = time.perf_counter()
+            if deadline is not None and t0 + took >= deadline:
+                return False
+            if len(chunk):
+                self._fill(np.stack(np.divmod(chunk, self._done.shape[1]), axis=1))
+            took = time.perf_counter() - t0
+        return True
 
     def at(self, x: float, y: float) -> float:
         """The interpolated distance at one point, in plain Python (see :meth:`__call__`)."""

@@ -520,6 +520,7 @@ def optimize_path(
     terminate: Callable[[], bool] | None = None,
     deadline: float | None = None,
     objective: InflationCost | None = None,
+    field: ClearanceField | None = None,
 ) -> PathOptimizationResult:
     """Shorten (and optionally smooth) a valid path with the particle swarm, end points fixed.
 
@@ -541,6 +542,8 @@ def optimize_path(
         that would end after it (their cost is measured as they run).
     objective : InflationCost, optional
         The problem's inflation cost: the swarm lowers ``J`` instead of the length.
+    field : ClearanceField, optional
+        Interpolated distances to share (the OMPL objective's: measured once for both).
 
     Returns
     -------
@@ -561,7 +564,7 @@ def optimize_path(
         deadline -= CHECKS_AFTER_SWARM * (now - t_check) + CHECKS_SHARE * max(deadline - now, 0.0)
         stop = terminate
         terminate = lambda: time.perf_counter() >= deadline or bool(stop and stop())  # noqa: E731
-    run = _Rounds(original, world, options, rng, terminate, deadline, objective)
+    run = _Rounds(original, world, options, rng, terminate, deadline, objective, field)
     if valid and not run.stopped():
         run.optimise()
     return run.result(t0)
@@ -570,7 +573,8 @@ def optimize_path(
 class _Rounds:
     """The rounds of one :func:`optimize_path` call and their bookkeeping."""
 
-    def __init__(self, original, world, options, rng, terminate, deadline=None, objective=None):
+    def __init__(self, original, world, options, rng, terminate, deadline=None, objective=None,
+                 field=None):  # fmt: skip
         self.deadline = deadline
         self.original = original
         self.world = world
@@ -578,7 +582,7 @@ class _Rounds:
         self.rng = rng
         self.terminate = terminate
         self.cost_model = PathCost(original[0], original[-1], world, options.smoothness_weight,
-                                   objective=objective)  # fmt: skip
+                                   objective=objective, field=field)  # fmt: skip
         self.current = original
         self.history: list[np.ndarray] = []
         self.iterations = self.evaluations = self.rounds = 0
@@ -589,6 +593,11 @@ class _Rounds:
     def optimise(self) -> None:
         """Prune, then rounds (refining where segments run along obstacles) while they pay."""
         opts, world = self.options, self.world
+        field = self.cost_model.field
+        # With an inflation cost, the distances along the path are measured first and in time
+        # (a measurement cannot be cut short): no time for them, no swarm.
+        if field is not None and not field.prefill(self.original, 0.0, self.deadline):
+            return
         if opts.prune:
             self.current = self._no_costlier(
                 shortcut(self.original, world.segments_free, self.terminate), self.original
@@ -596,6 +605,11 @@ class _Rounds:
         if self.cost_model.objective is not None:
             self.current = _densify(self.current, world, self.cost_model.objective,
                                     opts.max_cost_waypoints)  # fmt: skip
+            # ... and round it, where the rounds' candidates will lie.
+            seg = np.hypot(*np.diff(self.current, axis=0).T)
+            reach = opts.box_fraction * float(seg.max(initial=0.0))
+            if not field.prefill(self.current, reach, self.deadline):
+                return
         # Without a deadline the work is bounded by the refinement rounds (reproducible); with
         # one, polish rounds follow while a round still shortens the path.
         limit = 1 + opts.refine_rounds + (opts.polish_rounds if self.terminate else 0)

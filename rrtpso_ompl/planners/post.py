@@ -129,6 +129,8 @@ class PSOPathOptimizer:
         self.rng = rng
         # The inflation cost needs our world's distances; with a user's checker, the length.
         self.inflation = inflation_of(objective) if hasattr(self.model, "point_clearance") else None
+        # The OMPL objective's measured distances, shared (none to share for a bare cost).
+        self.field = getattr(objective, "field", None) if self.inflation is not None else None
         #: The :class:`PathOptimizationResult` of the last call.
         self.last_result: PathOptimizationResult | None = None
         #: Why the last call left the path alone without running the swarm ("" when it ran).
@@ -205,7 +207,7 @@ class PSOPathOptimizer:
             # views at once, and one view near a detailed polygon can outlast the time left.
             with refusing_motions_after(model, deadline):
                 self.last_result = optimize_path(xy, model, options, self.rng, terminate, deadline,
-                                                 self.inflation)  # fmt: skip
+                                                 self.inflation, self.field)  # fmt: skip
         finally:
             if isinstance(model, SpaceInformationCollisionModel):
                 model.stop = None

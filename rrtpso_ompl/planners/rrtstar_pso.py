@@ -519,8 +519,11 @@ class RRTstarPSO(PythonPlanner):
         # The same post-pass any planner gets with "+pso" (one optimiser, not two).
         si = self.getSpaceInformation()
         options = PathOptimizerOptions.from_values(self._values)
+        objective = self.getProblemDefinition().getOptimizationObjective()
+        if self._inflation is None or getattr(objective, "inflation", None) != self._inflation:
+            objective = self._inflation  # the swarm's own distances (or the length)
         optimizer = PSOPathOptimizer(si, options=options, world=self._model, rng=self._rng(),
-                                     objective=self._inflation)  # fmt: skip
+                                     objective=objective)  # fmt: skip
         result = optimizer.optimize_array(xy, terminate, deadline)
         # Summed over the swarm runs of one solve (one, unless the anytime loop ran more).
         stats.pso_time += result.time
