@@ -25,9 +25,9 @@ from matplotlib.figure import Figure
 from matplotlib.legend import Legend
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle as CirclePatch
-from matplotlib.patches import Patch
+from matplotlib.patches import Patch, Rectangle
 from matplotlib.patches import Polygon as PolygonPatch
-from matplotlib.transforms import ScaledTranslation
+from matplotlib.transforms import Affine2D, ScaledTranslation
 
 from .model.problem import Circle, Polygon, Problem
 from .outputs import atomic_path
@@ -201,7 +201,9 @@ def fit_layout(fig: Figure) -> None:
 def draw_map(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> list[Any]:
     """The occupancy grid under everything: occupied cells dark, unknown cells grey (light grey
     when ``unknown: free``), free cells white; the robot's clearance zone around the blocked
-    cells shaded. Returns the legend handles of the kinds of cells the map has.
+    cells shaded; when unknown space blocks, the bounds beyond the map grey too. A turned map
+    (origin yaw) is drawn turned about its origin, as RViz shows it. Returns the legend handles
+    of the kinds of cells the map has.
 
     The shading is drawing only (cells whose centre lies within the robot radius of a blocked
     cell's centre, from a Euclidean distance transform); the checks use the exact squares.
@@ -218,7 +220,15 @@ def draw_map(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> list[A
     key: list[Any] = []
     if (grid.state == 1).any():
         key.append(Patch(color=OBSTACLE, label="occupied cells"))
-    if (grid.state == -1).any():
+    (bx0, by0), (bx1, by1) = problem.bounds
+    if grid.frame is not None:
+        beyond = bool(problem.map_outside)
+    else:
+        beyond = bx0 < x0 or by0 < y0 or bx1 > x1 or by1 > y1
+    beyond = beyond and grid.unknown_blocks
+    if beyond:  # the bounds beyond the map, under the image
+        ax.add_patch(Rectangle((bx0, by0), bx1 - bx0, by1 - by0, fc=unknown, ec="none", zorder=0))
+    if (grid.state == -1).any() or beyond:
         what = "blocked" if grid.unknown_blocks else "treated as free"
         key.append(Patch(color=unknown, label=f"unknown space ({what})"))
     r = problem.robot.radius
@@ -229,7 +239,10 @@ def draw_map(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> list[A
         rgb[zone] = 0.55 * rgb[zone] + 0.45 * np.asarray(to_rgb(SAFETY))
         key.append(Patch(color=tuple(shade), label="clearance zone (robot centre stays out)"))
     # Image row 0 is the top of the map, as in the file.
-    ax.imshow(rgb, extent=(x0, x1, y0, y1), origin="upper", interpolation="nearest", zorder=0)
+    image = ax.imshow(rgb, extent=(x0, x1, y0, y1), origin="upper", interpolation="nearest",
+                      zorder=0)  # fmt: skip
+    if grid.frame is not None:  # turned about the image's lower-left corner (the origin)
+        image.set_transform(Affine2D().rotate_around(*grid.origin, grid.yaw) + ax.transData)
     return key
 
 

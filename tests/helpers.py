@@ -139,6 +139,64 @@ def _map(tmp_path, img, name="m", image=None, **keys) -> str:
     return str(path)
 
 
+def turned_copy(tmp_path, name: str, yaw: float, pivot=(0.0, 0.0), **problem):
+    """A copy of ``problems/maps/<name>.yaml`` whose map is turned by ``yaw`` radians about
+    ``pivot``: its YAML's origin becomes ``[*pivot, yaw]`` (the image's lower-left corner moves
+    to ``pivot``), and the start and goal move and turn with it. Returns the problem file and
+    the move (a function of ``(..., 2)`` points: ``pivot + R(yaw) (p - old origin)``)."""
+    import yaml
+
+    src = PROBLEMS / "maps" / f"{name}.yaml"
+    doc = yaml.safe_load(src.read_text())
+    map_yaml = src.parent / doc["map"]
+    grid = yaml.safe_load(map_yaml.read_text())
+    shutil.copy(map_yaml.parent / grid["image"], tmp_path / grid["image"])
+    old = np.array(grid["origin"][:2], dtype=float)
+    grid["origin"] = [float(pivot[0]), float(pivot[1]), float(yaw)]
+    (tmp_path / f"{name}_map.yaml").write_text(json.dumps(grid))
+    c, s = np.cos(yaw), np.sin(yaw)
+
+    def move(p):
+        d = np.asarray(p, dtype=float) - old
+        return np.asarray(pivot) + np.stack([c * d[..., 0] - s * d[..., 1],
+                                             s * d[..., 0] + c * d[..., 1]], axis=-1)  # fmt: skip
+
+    doc.update({"map": f"{name}_map.yaml", "start": move(doc["start"]).tolist(),
+                "goal": move(doc["goal"]).tolist(), **problem})  # fmt: skip
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(json.dumps(doc))
+    return path, move
+
+
+def map_shapes(problem, cells: bool = False):
+    """What a map problem's map blocks, as one shapely geometry in the map frame, built
+    independently of the world's checks: its blocked cells (``cells``: each cell's square, else
+    the merged boxes) turned by shapely about the origin, and, when unknown space blocks, the
+    bounds outside the map's turned rectangle."""
+    import shapely
+    from shapely import affinity
+
+    m = problem.map
+    if cells:
+        rows, cols = np.nonzero(m.blocked)
+        boxes = np.array([m.cell_box(i, j) for i, j in zip(rows, cols, strict=True)])
+    else:
+        boxes = m.boxes
+    blocked = shapely.union_all(shapely.box(*boxes.T)) if len(boxes) else shapely.Polygon()
+    (x0, y0), (x1, y1) = m.extent
+    rect = shapely.box(x0, y0, x1, y1)
+    blocked = affinity.rotate(blocked, m.yaw, origin=m.origin, use_radians=True)
+    rect = affinity.rotate(rect, m.yaw, origin=m.origin, use_radians=True)
+    if m.unknown_blocks:
+        (bx0, by0), (bx1, by1) = problem.bounds
+        outside = shapely.box(bx0, by0, bx1, by1).difference(rect)
+        # Round-off slivers (a map turned by pi/2 in its own bounding box) are no unknown space:
+        # an opening by 1e-9 drops them and keeps the rest (mitred, its corners stay sharp).
+        outside = outside.buffer(-1e-9, join_style="mitre").buffer(1e-9, join_style="mitre")
+        blocked = blocked.union(outside)
+    return blocked
+
+
 def _corridor(tmp_path, **problem) -> str:
     """A 20 x 10-cell map at 0.5 m: walls around, a wall with a gap in the middle, an unknown
     patch."""

@@ -113,3 +113,17 @@ def test_ompl_messages_come_back_when_asked_for():
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=120)  # fmt: skip
     assert proc.returncode == 0, proc.stderr
+
+
+def test_the_turned_maps_report_finds_the_unturned_optimum_on_every_turned_map():
+    """docs/turned-maps.md (benchmarks/turned_maps.py): each map problem's exact optimum turned
+    by 0.3 rad, with unknown space blocked and free, is the unturned one's to the printed digits;
+    and its own figures are quoted in problem-format.md only through the link."""
+    lines = (DOCS / "turned-maps.md").read_text().splitlines()
+    first = lines.index(next(line for line in lines if line.startswith("## Exact optimum")))
+    table = lines[first + 2 : lines.index("", first + 2)]
+    assert len(table) == 2 + 6  # header, rule, the six map problems
+    for row in table[2:]:
+        cells = [c.strip().split(" ")[0] for c in row.strip("|").split("|")[1:]]
+        assert cells[0] == cells[1] and cells[2] == cells[3], row
+    assert "(turned-maps.md)" in (DOCS / "problem-format.md").read_text()

@@ -8,9 +8,10 @@ import re
 
 import numpy as np
 import pytest
-from helpers import PROBLEMS
+import shapely
+from helpers import PROBLEMS, turned_copy
 
-from rrtpso_ompl import load_problem, problem_from_dict, solve
+from rrtpso_ompl import World, load_problem, problem_from_dict, solve
 from rrtpso_ompl.harness.bench import SummaryRow
 from rrtpso_ompl.plotting import (  # the Agg backend: files only
     plot_bench,
@@ -120,6 +121,52 @@ def test_a_narrow_world_alone_in_its_figure_keeps_its_legend_inside():
     try:
         assert len(fig.axes) == 1
         assert_legend_hides_nothing(fig, fig.axes[0])
+    finally:
+        _close(fig)
+
+
+def test_a_turned_map_is_drawn_turned_about_its_origin(tmp_path):
+    """The image lands on the map's turned rectangle; a blocked cell's centre, a free point and
+    the unknown corner beyond the map are painted in their colours (read back from the rendered
+    pixels)."""
+    from matplotlib.colors import to_rgb
+
+    from rrtpso_ompl.plotting import OBSTACLE, UNKNOWN_BLOCKED
+
+    path, move = turned_copy(tmp_path, "office_corridor", 0.3, pivot=(2.0, -1.0))
+    problem = load_problem(path)
+    m = problem.map
+    result = solve(problem, "RRTstarPSO", time_limit=0.3, seed=1)
+    fig = plot_solution(problem, result)
+    try:
+        ax = fig.axes[0]
+        assert_legend_hides_nothing(fig, ax)
+        assert "unknown space (blocked)" in legend_labels(ax)
+        (image,) = ax.images
+        x0, x1, y0, y1 = image.get_extent()
+        corners = [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+        on_data = (image.get_transform() - ax.transData).transform(corners)
+        np.testing.assert_allclose(on_data, m.corners, atol=1e-9)
+        # An occupied cell amid occupied ones (a desk's), a point in the corridor far from
+        # every blocked cell, and the middle of an unknown corner beyond the map.
+        occupied = m.state == 1
+        inner = occupied[1:-1, 1:-1].copy()
+        for di, dj in ((-1, 0), (1, 0), (0, -1), (0, 1), (-2, 0), (2, 0)):
+            inner &= np.roll(occupied, (di, dj), axis=(0, 1))[1:-1, 1:-1]
+        row, col = np.argwhere(inner)[len(np.argwhere(inner)) // 2] + 1
+        blocked = m.cell_centre(row, col)
+        free = move([12.0, 10.0])  # the corridor of the unturned map
+        assert World.from_problem(problem).point_clearance(free[None])[0] > 1.0
+        corner = shapely.Polygon(problem.map_outside[0].points).centroid
+        fig.canvas.draw()
+        pixels = np.asarray(fig.canvas.buffer_rgba())[..., :3] / 255.0
+        height = pixels.shape[0]
+        for point, colour in ((blocked, OBSTACLE), (free, "white"),
+                              ((corner.x, corner.y), UNKNOWN_BLOCKED)):  # fmt: skip
+            px, py = ax.transData.transform(point)
+            got = pixels[height - 1 - round(py), round(px)]
+            np.testing.assert_allclose(got, to_rgb(colour), atol=0.02)
+        save_figure(fig, tmp_path / "turned.png")
     finally:
         _close(fig)
 

@@ -432,9 +432,7 @@ class ReplanningManager:
                 *wall,
                 *self._sweeps(obs, t_now, p_s, t_s, horizon),
             ]
-            world = World.from_obstacles(
-                self.problem.bounds, obstacles, self.sr, self.problem.map_boxes
-            )
+            world = World.from_problem(self.problem, obstacles, self.sr, lattice=False)
             if world.point_free(*goal):
                 return t_g, goal, obstacles, world
         return None

@@ -56,6 +56,13 @@ counts as entering; the corners are therefore rounded with a radius of twice the
 (``2e-9`` of the workspace size), which changes the length by less than that. Two map cells that
 touch only at a corner therefore close the diagonal between them.
 
+A turned map (its cells squares of a :class:`~rrtpso_ompl.model.geometry.GridFrame`) is solved
+in its grid coordinates when every free configuration lies in the map's rectangle (unknown space
+blocks and the map lies in the bounds: the frame's ``confined``): there the rectangle is the
+bounds, the cells keep their lattice, and the circles and polygons turn with the query; a
+rotation keeps lengths, and the pieces of the path turn back. Otherwise the turned cells become
+polygons in the world's coordinates: as exact, slower on large maps (no lattice).
+
 Nothing here imports OMPL: :func:`shortest_path_in_world` needs only a
 :class:`~rrtpso_ompl.model.World` and a query.
 """
@@ -67,7 +74,7 @@ import itertools
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -318,6 +325,16 @@ def shortest_path_in_world(
     name, source : str
         The problem's name (for the result) and where it came from (for messages).
     """
+    frame = world.box_frame
+    if frame is not None and frame.confined is not None:
+        local = shortest_path_in_world(
+            _grid_frame_world(world), frame.to_grid(np.asarray(start, dtype=float)[:2]),
+            frame.to_grid(np.asarray(goal, dtype=float)[:2]), goal_tolerance,
+            upper_bound=upper_bound, terminate=terminate, name=name, source=source,
+        )  # fmt: skip
+        return replace(local, pieces=[_turned(p, frame) for p in local.pieces])
+    if frame is not None:
+        world = _boxes_as_polygons(world)
     t0 = time.perf_counter()
     radius = max(world.robot_radius, 2.0 * world.tol)  # see the module docstring for R = 0
     if radius != world.robot_radius:
@@ -366,6 +383,36 @@ def shortest_path_in_world(
         if found is not None or bound >= cap:
             return result(found, search, rounds=k + 1)
     return result(None, search)  # pragma: no cover - the last bound is the cap
+
+
+def _grid_frame_world(world: World) -> World:
+    """The world of a turned map in its grid coordinates, where its free configurations are
+    the same (the frame's ``confined`` holds them all, module docstring): the map's rectangle as
+    the bounds, the boxes as they are, the circles and polygons turned into grid coordinates."""
+    f = world.box_frame
+    x0, y0, x1, y1 = f.confined
+    circles = np.column_stack([f.to_grid(world.circles[:, :2]), world.circles[:, 2]])
+    polygons = [f.to_grid(p) for p in world.polygons]
+    return World(((x0, y0), (x1, y1)), circles, polygons, world.robot_radius, world.boxes)
+
+
+def _boxes_as_polygons(world: World) -> World:
+    """The world of a turned map with its boxes as polygons (their turned squares) in the world's
+    coordinates: the search below treats boxes as axis-aligned."""
+    squares = list(world.box_frame.box_corners(world.boxes))
+    return World(world.bounds, world.circles, [*world.polygons, *squares], world.robot_radius)
+
+
+def _turned(piece: Piece, frame) -> Piece:
+    """A piece found in grid coordinates, in the world's."""
+
+    def back(p):
+        return tuple(frame.to_world(np.asarray(p, dtype=float)).tolist())
+
+    if piece.kind != "arc":
+        return replace(piece, start=back(piece.start), end=back(piece.end))
+    return replace(piece, start=back(piece.start), end=back(piece.end),
+                   center=back(piece.center), angle=piece.angle + frame.yaw)  # fmt: skip
 
 
 #: The rounds' bounds, as multiples of the lower bound on the optimum: a round that finds no
@@ -907,7 +954,9 @@ class _TangentSearch:
             disc[x, :2] = 0.5 * (box[:, :2] + box[:, 2:])
             disc[x, 2] = 0.5 * np.minimum(box[:, 2] - box[:, 0], box[:, 3] - box[:, 1])
             disc[x, 2] += w.threshold
-            use = kind != 2  # polygons cast no shadow here
+            # Polygons (their edges and interiors, whose rows above stay unset) cast no shadow
+            # here.
+            use = kind <= 1
             # Strictly inside (grazing tangents stay candidates); the circle's own obstacle, at
             # distance 0, blocks nothing a tangent to it could use.
             rel = disc[:, :2] - c[query]

@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 
 __all__ = [
+    "GridFrame",
     "cross",
     "cumulative_length",
     "dedupe",
@@ -28,6 +30,75 @@ __all__ = [
 
 #: Segments per vectorised visibility call in :func:`shortcut` (bounds its temporary arrays).
 _CHUNK = 4096
+
+
+@dataclass(frozen=True)
+class GridFrame:
+    """The frame in which a rotated occupancy grid's cells are axis-aligned squares.
+
+    A map_server map whose YAML says ``origin: [x, y, yaw]`` lays its image with the lower-left
+    corner of its lower-left cell at ``pivot = (x, y)`` and its rows along the direction ``yaw``
+    (nav_msgs/MapMetaData: the origin is the pose of that corner, the image turned about it). In
+    *grid coordinates* every cell is the square it would be with ``yaw = 0``: a world point ``p``
+    has grid coordinates ``pivot + R(-yaw) (p - pivot)``. A rotation keeps distances, so a
+    distance computed exactly in grid coordinates is the exact distance in the world (up to the
+    round-off of the turn, about ``1e-16`` of the coordinates, far inside the touch tolerance).
+
+    Attributes
+    ----------
+    pivot : (float, float)
+        The point the grid is turned about (the map's origin), world units; the same point in
+        both frames.
+    yaw : float
+        The grid's turn, radians, counter-clockwise.
+    confined : (xmin, ymin, xmax, ymax) or None
+        A box in grid coordinates that holds every free configuration of the world this frame
+        belongs to, when one is known: the map's rectangle, when unknown space blocks and the map
+        lies within the bounds (everything else is blocked). The exact optimum then plans in grid
+        coordinates, where the map's cells keep their lattice.
+    """
+
+    pivot: tuple[float, float]
+    yaw: float
+    confined: tuple[float, float, float, float] | None = None
+    _cos: float = field(init=False, repr=False, compare=False)
+    _sin: float = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "pivot", (float(self.pivot[0]), float(self.pivot[1])))
+        object.__setattr__(self, "yaw", float(self.yaw))
+        object.__setattr__(self, "_cos", math.cos(self.yaw))
+        object.__setattr__(self, "_sin", math.sin(self.yaw))
+
+    def to_grid(self, points) -> np.ndarray:
+        """Grid coordinates of world points ``(..., 2)``."""
+        p = np.asarray(points, dtype=float)
+        px, py = self.pivot
+        dx, dy = p[..., 0] - px, p[..., 1] - py
+        c, s = self._cos, self._sin
+        return np.stack([px + c * dx + s * dy, py - s * dx + c * dy], axis=-1)
+
+    def to_world(self, points) -> np.ndarray:
+        """World coordinates of grid points ``(..., 2)``."""
+        q = np.asarray(points, dtype=float)
+        px, py = self.pivot
+        dx, dy = q[..., 0] - px, q[..., 1] - py
+        c, s = self._cos, self._sin
+        return np.stack([px + c * dx - s * dy, py + s * dx + c * dy], axis=-1)
+
+    def to_grid_xy(self, x: float, y: float) -> tuple[float, float]:
+        """:meth:`to_grid` of one point, in plain floats (the scalar checks)."""
+        px, py = self.pivot
+        dx, dy = x - px, y - py
+        c, s = self._cos, self._sin
+        return px + c * dx + s * dy, py - s * dx + c * dy
+
+    def box_corners(self, boxes) -> np.ndarray:
+        """World corners ``(k, 4, 2)`` of grid-coordinate boxes ``(k, 4)`` ``(xmin, ymin, xmax,
+        ymax)``, counter-clockwise from ``(xmin, ymin)``."""
+        b = np.asarray(boxes, dtype=float).reshape(-1, 4)
+        corners = np.stack([b[:, [0, 1]], b[:, [2, 1]], b[:, [2, 3]], b[:, [0, 3]]], axis=1)
+        return self.to_world(corners)
 
 
 def segment_lengths(path: np.ndarray) -> np.ndarray:

@@ -2,7 +2,7 @@
 file and an image (PGM, PNG, BMP).
 
 The map YAML holds ``image`` (relative to the YAML file), ``resolution`` (metres per cell),
-``origin: [x, y, yaw]`` (the lower-left corner of the image in the map frame), ``negate``,
+``origin: [x, y, yaw]`` (the pose of the image's lower-left corner in the map frame), ``negate``,
 ``occupied_thresh``, ``free_thresh`` and ``mode`` (``trinary``, ``scale`` or ``raw``); other keys
 are ignored. Each pixel becomes a cell state, as ``docs/problem-format.md`` specifies:
 
@@ -27,6 +27,13 @@ blocked cells are merged into axis-aligned rectangles (runs along rows, then equ
 consecutive rows), which the exact checks of :class:`~rrtpso_ompl.model.world.World` treat as
 boxes: a 1.7-million-cell warehouse map becomes a few thousand boxes, not 260,000 squares.
 
+A yaw other than 0 turns the whole image about ``(ox, oy)``, the lower-left corner of its
+lower-left cell, as map_server and RViz place it (nav_msgs/MapMetaData: the origin is the pose of
+that corner). The squares above are then the cells in *grid coordinates*
+(:class:`~rrtpso_ompl.model.geometry.GridFrame`); in the map frame each is that square turned by
+``yaw`` about ``(ox, oy)``. The merged boxes stay in grid coordinates, and the world's checks
+turn each query into them, exactly (a rotation keeps distances).
+
 Every way a map can be wrong is one :class:`~rrtpso_ompl.errors.ProblemError` naming the file and
 the key. Images larger than :data:`MAX_CELLS` cells are refused before they are decoded.
 """
@@ -47,6 +54,7 @@ import numpy as np
 
 from ..errors import ProblemError
 from ..validation import MAX_COORDINATE, describe, number_hint
+from .geometry import GridFrame
 from .yamlfile import open_input, read_yaml_file
 
 __all__ = [
@@ -85,7 +93,7 @@ class OccupancyMap:
     resolution : float
         Side of a cell, map units (metres) per cell.
     origin : (float, float)
-        Map-frame position of the lower-left corner of the image (yaw must be 0).
+        Map-frame position of the lower-left corner of the image (of its lower-left cell).
     state : ndarray of int8, shape (H, W)
         Cell states in image order (row 0 on top): 0 free, 1 occupied, -1 unknown or, in
         ``scale`` mode, in between.
@@ -95,6 +103,8 @@ class OccupancyMap:
         ``trinary``, ``scale`` or ``raw``.
     negate : bool
     occupied_thresh, free_thresh : float
+    yaw : float
+        The image's turn about ``origin``, radians, counter-clockwise (``origin[2]`` of the YAML).
     """
 
     source: str
@@ -107,6 +117,7 @@ class OccupancyMap:
     negate: bool = False
     occupied_thresh: float = 0.65
     free_thresh: float = 0.196
+    yaw: float = 0.0
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -115,10 +126,36 @@ class OccupancyMap:
 
     @property
     def extent(self) -> tuple[tuple[float, float], tuple[float, float]]:
-        """``((xmin, ymin), (xmax, ymax))`` of the map, map units."""
+        """``((xmin, ymin), (xmax, ymax))`` of the map in grid coordinates, map units (the map
+        frame's when the yaw is 0; see :attr:`bounding_box`)."""
         h, w = self.state.shape
         ox, oy = self.origin
         return (ox, oy), (ox + w * self.resolution, oy + h * self.resolution)
+
+    @cached_property
+    def frame(self) -> GridFrame | None:
+        """The grid's frame when the map is turned (a yaw other than 0), else None (grid
+        coordinates are the map frame's)."""
+        return GridFrame(self.origin, self.yaw) if self.yaw != 0.0 else None
+
+    @property
+    def corners(self) -> np.ndarray:
+        """(4, 2) corners of the map's rectangle in the map frame, counter-clockwise from the
+        origin (the image's lower-left corner)."""
+        (x0, y0), (x1, y1) = self.extent
+        corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+        return corners if self.frame is None else self.frame.to_world(corners)
+
+    @property
+    def bounding_box(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """``((xmin, ymin), (xmax, ymax))`` of the map's rectangle in the map frame: its extent,
+        or for a turned map the smallest axis-aligned box around it (a problem's default
+        bounds)."""
+        if self.frame is None:
+            return self.extent
+        c = self.corners
+        lo, hi = c.min(axis=0), c.max(axis=0)
+        return (float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1]))
 
     @cached_property
     def blocked(self) -> np.ndarray:
@@ -133,19 +170,32 @@ class OccupancyMap:
         return merge_cells(self.blocked, self.resolution, self.origin)
 
     def cell_box(self, row: int, col: int) -> tuple[float, float, float, float]:
-        """The square of the cell in image row ``row``, column ``col``: (xmin, ymin, xmax, ymax)."""
+        """The square of the cell in image row ``row``, column ``col``: (xmin, ymin, xmax, ymax),
+        grid coordinates (the map frame's when the yaw is 0)."""
         h = self.state.shape[0]
         res = self.resolution
         x0 = self.origin[0] + col * res
         y0 = self.origin[1] + (h - 1 - row) * res
         return x0, y0, x0 + res, y0 + res
 
-    def nearest_blocked(self, x: float, y: float, reach: float) -> tuple[int, int, float] | None:
-        """The blocked cell nearest to ``(x, y)`` within ``reach``: ``(row, col, distance)``.
+    def cell_centre(self, row: int, col: int) -> tuple[float, float]:
+        """The map-frame centre of the cell in image row ``row``, column ``col``."""
+        x0, y0, x1, y1 = self.cell_box(row, col)
+        x, y = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+        if self.frame is not None:
+            x, y = self.frame.to_world([x, y]).tolist()
+        return x, y
 
-        Exact distance from the point to the cell's square (0 inside it); only the cells of the
-        window ``reach`` around the point are looked at.
+    def nearest_blocked(self, x: float, y: float, reach: float) -> tuple[int, int, float] | None:
+        """The blocked cell nearest to the map-frame point ``(x, y)`` within ``reach``:
+        ``(row, col, distance)``.
+
+        Exact distance from the point to the cell's square (0 inside it; for a turned map, from
+        the point in grid coordinates, which keeps distances); only the cells of the window
+        ``reach`` around the point are looked at.
         """
+        if self.frame is not None:
+            x, y = self.frame.to_grid_xy(x, y)
         h, w = self.state.shape
         res = self.resolution
         ox, oy = self.origin
@@ -233,6 +283,7 @@ def load_map(path: str | Path, unknown_blocks: bool = True) -> OccupancyMap:
         image=str(image_path),
         resolution=keys.resolution,
         origin=keys.origin,
+        yaw=keys.yaw,
         state=state,
         unknown_blocks=unknown_blocks,
         mode=keys.mode,
@@ -249,6 +300,7 @@ class _MapKeys:
     image: str
     resolution: float
     origin: tuple[float, float]
+    yaw: float
     negate: bool
     occupied_thresh: float
     free_thresh: float
@@ -273,7 +325,7 @@ def _map_keys(source: str, doc: dict) -> _MapKeys:
     if not isinstance(image, str) or not image.strip():
         raise ProblemError(source, "image", f"must be a file name, got {describe(image)}")
     resolution = _resolution(source, doc["resolution"])
-    origin = _origin(source, doc["origin"])
+    ox, oy, yaw = _origin(source, doc["origin"])
     negate = _negate(source, doc.get("negate", _DEFAULTS["negate"]))
     occ, free = _thresholds(source, doc)
     mode = _get(doc, "mode")
@@ -283,7 +335,7 @@ def _map_keys(source: str, doc: dict) -> _MapKeys:
         )
     if "\0" in image:
         raise ProblemError(source, "image", "the file name holds a NUL byte")
-    return _MapKeys(image, resolution, origin, negate, occ, free, mode)
+    return _MapKeys(image, resolution, (ox, oy), yaw, negate, occ, free, mode)
 
 
 def _resolution(source: str, value: Any) -> float:
@@ -303,23 +355,16 @@ def _resolution(source: str, value: Any) -> float:
     return resolution
 
 
-def _origin(source: str, origin: Any) -> tuple[float, float]:
-    """``[x, y]`` or ``[x, y, yaw]`` with yaw 0: the image's lower-left corner."""
+def _origin(source: str, origin: Any) -> tuple[float, float, float]:
+    """``[x, y]`` or ``[x, y, yaw]``: the pose of the image's lower-left corner (yaw in radians,
+    any finite number)."""
     if not isinstance(origin, list | tuple) or len(origin) not in (2, 3):
         raise ProblemError(source, "origin", f"must be [x, y, yaw], got {describe(origin)}")
     ox, oy, *rest = (_number(source, f"origin[{i}]", v) for i, v in enumerate(origin))
     for i, v in enumerate((ox, oy)):
         if abs(v) > MAX_COORDINATE:
             raise ProblemError(source, f"origin[{i}]", f"must be within +-{MAX_COORDINATE:g}")
-    yaw = rest[0] if rest else 0.0
-    if yaw != 0.0:
-        raise ProblemError(
-            source,
-            "origin[2]",
-            f"a rotated map (yaw {yaw:g} rad) is not supported: the checks are exact for "
-            "axis-aligned cells; rotate the image and set yaw to 0",
-        )
-    return ox, oy
+    return ox, oy, (rest[0] if rest else 0.0)
 
 
 def _negate(source: str, negate: Any) -> bool:
@@ -348,7 +393,7 @@ def _thresholds(source: str, doc: dict) -> tuple[float, float]:
 
 
 def _check_extent(source: str, keys: _MapKeys, shape: tuple[int, int]) -> None:
-    """The map's far corner stays within the coordinate limit."""
+    """The map's far corners stay within the coordinate limit (turned with the map)."""
     h, w = shape
     for i, (corner, cells) in enumerate(((keys.origin[0], w), (keys.origin[1], h))):
         end = corner + cells * keys.resolution
@@ -360,6 +405,17 @@ def _check_extent(source: str, keys: _MapKeys, shape: tuple[int, int]) -> None:
                 f"{cells} cells of {keys.resolution:g} from origin {corner:g} reach {axis} = "
                 f"{end:g}, beyond +-{MAX_COORDINATE:g} (the coordinate limit: exact checks allow "
                 "for round-off of 1e-9 of the workspace's scale)",
+            )
+    if keys.yaw != 0.0:
+        (x0, y0), res = keys.origin, keys.resolution
+        corners = [[x0 + w * res, y0], [x0 + w * res, y0 + h * res], [x0, y0 + h * res]]
+        far = np.abs(GridFrame(keys.origin, keys.yaw).to_world(corners)).max()
+        if far > MAX_COORDINATE:
+            raise ProblemError(
+                source,
+                "origin[2]",
+                f"turned by {keys.yaw:g} rad, the map's corners reach {far:g}, beyond "
+                f"+-{MAX_COORDINATE:g} (the coordinate limit)",
             )
 
 

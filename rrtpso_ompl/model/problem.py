@@ -15,7 +15,7 @@ import math
 import numbers
 import os
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any, TypeVar
@@ -34,6 +34,7 @@ from ..validation import (
     number_hint,
 )
 from .format import MAP, MOVING, OBSTACLES, PLANNER, ROBOT, TOP
+from .geometry import GridFrame
 from .objective import default_scaling
 from .occupancy import OccupancyMap, load_map, map_image_path
 from .yamlfile import read_yaml_file
@@ -177,16 +178,45 @@ class Problem:
 
     @property
     def map_boxes(self) -> np.ndarray | None:
-        """(k, 4) boxes ``(xmin, ymin, xmax, ymax)`` blocked by the map: its merged blocked cells
-        and, when unknown cells block, the parts of the bounds outside the map; None without a
-        map."""
+        """(k, 4) boxes ``(xmin, ymin, xmax, ymax)`` blocked by the map, in its grid coordinates
+        (:attr:`map_frame`; the map frame's for a map that is not turned): its merged blocked
+        cells and, for a map that is not turned when unknown cells block, the parts of the bounds
+        outside the map (a turned map's are :attr:`map_outside`); None without a map."""
         if self.map is None:
             return None
         boxes = self.map.boxes
-        if not self.map.unknown_blocks:
+        if not self.map.unknown_blocks or self.map.frame is not None:
             return boxes
         outside = _outside(self.bounds, self.map.extent)
         return np.vstack([boxes, outside]) if len(outside) else boxes
+
+    @property
+    def map_frame(self) -> GridFrame | None:
+        """The grid frame of a turned map (None without one): :attr:`map_boxes` are in its
+        coordinates. Its ``confined`` is the map's rectangle when every free configuration lies
+        in it (unknown space blocks, and the map lies within the bounds)."""
+        if self.map is None or self.map.frame is None:
+            return None
+        frame = self.map.frame
+        (bx0, by0), (bx1, by1) = self.bounds
+        tol = touch_tolerance(self.bounds)
+        c = self.map.corners
+        inside = (c[:, 0] >= bx0 - tol) & (c[:, 0] <= bx1 + tol)
+        inside &= (c[:, 1] >= by0 - tol) & (c[:, 1] <= by1 + tol)
+        if self.map.unknown_blocks and inside.all():
+            (x0, y0), (x1, y1) = self.map.extent
+            frame = replace(frame, confined=(x0, y0, x1, y1))
+        return frame
+
+    @property
+    def map_outside(self) -> tuple[Polygon, ...]:
+        """The parts of the bounds outside a turned map, as convex polygons in the map frame,
+        when unknown space blocks (there the robot's disc may not go); none otherwise (a map that
+        is not turned has them among :attr:`map_boxes`). Parts thinner than the round-off
+        allowance are left out: a disc reaching into them is within it anyway."""
+        if self.map is None or self.map.frame is None or not self.map.unknown_blocks:
+            return ()
+        return _outside_turned(self.bounds, self.map.corners, touch_tolerance(self.bounds))
 
     @property
     def inputs(self) -> tuple[str, ...]:
@@ -369,7 +399,8 @@ class _Validator:
     def region(
         self, doc: Mapping[str, Any], base: Path
     ) -> tuple[OccupancyMap | None, tuple[Point, Point]]:
-        """The map (read, or None) and the bounds: the ``bounds`` key, else the map's extent."""
+        """The map (read, or None) and the bounds: the ``bounds`` key, else the map's extent (the
+        box around a turned map)."""
         occupancy = self.map(doc.get("map"), "map", base)
         if doc.get("bounds") is not None:
             return occupancy, self.bounds(doc["bounds"], "bounds")
@@ -377,11 +408,11 @@ class _Validator:
             raise self.error(
                 "bounds", "required key is missing (or give a map, whose extent it is)"
             )
-        small = _too_small(occupancy.extent)
+        small = _too_small(occupancy.bounding_box)
         if small:
             raise self.error("map", f"its extent (image size x resolution) is {small}; give bounds "
                              "or a map of larger cells")  # fmt: skip
-        return occupancy, occupancy.extent
+        return occupancy, occupancy.bounding_box
 
     # -- containers ------------------------------------------------------------------------------
     def mapping(
@@ -640,11 +671,15 @@ class _Validator:
         state = "occupied" if hit and grid.state[hit[0], hit[1]] == 1 else "unknown"
         if hit is not None and hit[2] < need:
             row, col, d = hit
-            x0, y0, x1, y1 = grid.cell_box(row, col)
-            where = (
-                f"the {state} map cell at image row {row}, column {col} "
-                f"(x {x0:g}..{x1:g}, y {y0:g}..{y1:g}) of {grid.source}"
-            )
+            if grid.frame is None:
+                x0, y0, x1, y1 = grid.cell_box(row, col)
+                square = f"x {x0:g}..{x1:g}, y {y0:g}..{y1:g}"
+            else:
+                cx, cy = grid.cell_centre(row, col)
+                square = (f"the {grid.resolution:g} square centred at ({cx:g}, {cy:g}), turned "
+                          f"{grid.yaw:g} rad with the map")  # fmt: skip
+            where = (f"the {state} map cell at image row {row}, column {col} ({square}) of "
+                     f"{grid.source}")  # fmt: skip
             if d == 0.0:
                 raise self.error(key, f"({x:g}, {y:g}) lies in {where}")
             if d >= r:  # only within the round-off allowance: say so, not "overlaps"
@@ -660,17 +695,19 @@ class _Validator:
                 f"clearance {d:.4g} < {r:g}",
             )
         if grid.unknown_blocks:
-            outside = _outside(problem.bounds, grid.extent)
-            if len(outside):
+            if grid.frame is None:
+                outside = _outside(problem.bounds, grid.extent)
                 dx = np.maximum.reduce([outside[:, 0] - x, 0 * outside[:, 0], x - outside[:, 2]])
                 dy = np.maximum.reduce([outside[:, 1] - y, 0 * outside[:, 1], y - outside[:, 3]])
-                d = float(np.hypot(dx, dy).min())
-                if d < need:
-                    raise self.error(
-                        key,
-                        f"the robot disc (radius {r:g}) at ({x:g}, {y:g}) reaches beyond the map "
-                        f"{grid.source} (unknown space, blocked; set map.unknown: free to allow)",
-                    )
+                d = float(np.hypot(dx, dy).min(initial=math.inf))
+            else:
+                d = min((_clearance(p, x, y) for p in problem.map_outside), default=math.inf)
+            if d < need:
+                raise self.error(
+                    key,
+                    f"the robot disc (radius {r:g}) at ({x:g}, {y:g}) reaches beyond the map "
+                    f"{grid.source} (unknown space, blocked; set map.unknown: free to allow)",
+                )
 
 
 # ----------------------------------------------------------------------------------------------
@@ -688,6 +725,56 @@ def _outside(bounds: tuple[Point, Point], extent: tuple[Point, Point]) -> np.nda
     ]
     out = np.array([b for b in boxes if b[2] > b[0] and b[3] > b[1]], dtype=float)
     return out.reshape(-1, 4)
+
+
+def _outside_turned(bounds: tuple[Point, Point], corners: np.ndarray, tol: float):
+    """Convex polygons covering the part of ``bounds`` outside the turned rectangle ``corners``
+    ((4, 2), counter-clockwise): the part beyond its first side, then what is left beyond its
+    second side, and so on (a convex polygon clipped by half-planes each time). A vertex within
+    ``tol`` of a side's line counts as on it (so that round-off makes no sliver or repeated
+    vertex), and parts that reach no more than ``tol`` beyond their side are left out."""
+    (bx0, by0), (bx1, by1) = bounds
+    rest = [(bx0, by0), (bx1, by0), (bx1, by1), (bx0, by1)]
+    pieces = []
+    for k in range(4):
+        (ax, ay), (cx, cy) = corners[k].tolist(), corners[(k + 1) % 4].tolist()
+        ex, ey = cx - ax, cy - ay
+        n = math.hypot(ex, ey)
+
+        def inward(p, ax=ax, ay=ay, ex=ex, ey=ey, n=n) -> float:
+            """Signed distance of ``p`` into the rectangle's side of the line (left of it),
+            0 within ``tol``."""
+            d = (ex * (p[1] - ay) - ey * (p[0] - ax)) / n
+            return 0.0 if abs(d) <= tol else d
+
+        beyond = _clip_convex(rest, inward, -1.0, tol)
+        rest = _clip_convex(rest, inward, 1.0, tol)
+        if len(beyond) >= 3 and min(inward(p) for p in beyond) < 0.0:
+            pieces.append(Polygon(tuple(beyond)))
+        if len(rest) < 3:
+            break
+    return tuple(pieces)
+
+
+def _clip_convex(ring: list[Point], side: Callable[[Point], float], sign: float, tol: float):
+    """The part of a convex ring where ``sign * side`` is >= 0 (one Sutherland-Hodgman step);
+    counter-clockwise stays counter-clockwise; vertices within ``tol`` of the one before merge."""
+    out: list[Point] = []
+    for i, p in enumerate(ring):
+        q = ring[(i + 1) % len(ring)]
+        sp, sq = sign * side(p), sign * side(q)
+        if sp >= 0.0:
+            out.append(p)
+        if (sp > 0.0 > sq) or (sp < 0.0 < sq):
+            t = sp / (sp - sq)
+            out.append((p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])))
+    kept: list[Point] = []
+    for p in out:
+        if not kept or math.dist(p, kept[-1]) > tol:
+            kept.append(p)
+    while len(kept) > 1 and math.dist(kept[0], kept[-1]) <= tol:
+        kept.pop()
+    return kept
 
 
 def _too_small(bounds: tuple[Point, Point]) -> str:

@@ -101,7 +101,9 @@ class Lattice:
 
 @dataclass(frozen=True, eq=False)
 class MapRaster:
-    """An occupancy grid's blocked cells in the map frame, for lattice queries.
+    """An occupancy grid's blocked cells in the map frame, for lattice queries (a map that is not
+    turned: a turned map's cells are no lattice of the world's axes, and its world has no raster,
+    so the corridor stage uses generic cells there).
 
     Attributes
     ----------

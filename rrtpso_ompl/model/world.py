@@ -26,6 +26,11 @@ callers:
 * :meth:`World.segments_free`, :meth:`World.segment_violation` and friends are vectorised numpy
   over many segments at once: the PSO evaluates whole swarms of paths per iteration.
 
+A turned map (an origin yaw other than 0) keeps its merged cells as axis-aligned boxes in the
+map's grid coordinates (:class:`~rrtpso_ompl.model.geometry.GridFrame`, ``box_frame``): each check
+turns its point or segment into them before the box formulas, which stay exact (a rotation keeps
+distances), and the index registers each box by the bounding box of its turned square.
+
 Touching at exactly the robot radius is allowed, up to a tolerance of ``1e-9`` times the scale of
 the workspace (floating-point round-off; :func:`~rrtpso_ompl.model.problem.touch_tolerance`).
 """
@@ -42,7 +47,12 @@ from contextlib import contextmanager
 import numpy as np
 import shapely
 
-from .geometry import point_segment_distance, point_segment_distance_xy, segments_cross
+from .geometry import (
+    GridFrame,
+    point_segment_distance,
+    point_segment_distance_xy,
+    segments_cross,
+)
 from .problem import Circle, Polygon, Problem, clearance_threshold, touch_tolerance
 from .raster import Lattice, MapRaster
 from .spatial import Grid
@@ -82,12 +92,16 @@ class World:
     robot_radius : float
         Radius ``R`` of the robot disc (its safety zone), in the same unit.
     boxes : sequence of (xmin, ymin, xmax, ymax)
-        Axis-aligned rectangles (a map's blocked cells, merged; rectangles of a problem file).
+        Axis-aligned rectangles (a map's blocked cells, merged; rectangles of a problem file), in
+        the coordinates of ``box_frame`` when one is given.
     raster : MapRaster, optional
         The occupancy grid the last ``raster_boxes`` boxes were merged from, for lattice queries
-        (:meth:`free_cells`).
+        (:meth:`free_cells`). Not with a ``box_frame``.
     raster_boxes : int
         How many of the boxes (the last ones) come from ``raster``.
+    box_frame : GridFrame, optional
+        The grid frame of a turned map: every box is a square of it (circles, polygons and the
+        bounds stay in the world's coordinates).
     """
 
     def __init__(
@@ -99,7 +113,10 @@ class World:
         boxes: Sequence[Sequence[float]] = (),
         raster: MapRaster | None = None,
         raster_boxes: int = 0,
+        box_frame: GridFrame | None = None,
     ) -> None:
+        if raster is not None and box_frame is not None:
+            raise ValueError("a raster is a lattice of the world's axes: not with a box frame")
         (xmin, ymin), (xmax, ymax) = bounds
         self.bounds = ((float(xmin), float(ymin)), (float(xmax), float(ymax)))
         self.robot_radius = float(robot_radius)
@@ -113,6 +130,8 @@ class World:
         self.polygons = [np.asarray(p, dtype=float).reshape(-1, 2) for p in polygons]
         self._n_circles = len(self.circles)
         self._n_boxes = len(self.boxes)
+        #: The grid frame the boxes are in (None: the world's own axes).
+        self.box_frame = box_frame
         #: ``time.perf_counter()`` after which :meth:`motion_free` and :meth:`segments_free`
         #: answer "blocked" unchecked (None: never); see :meth:`refusing_motions_after`.
         self.refuse_after: float | None = None
@@ -128,17 +147,34 @@ class World:
 
     # ------------------------------------------------------------------------------------------
     @classmethod
-    def from_problem(cls, problem: Problem) -> World:
+    def from_problem(
+        cls,
+        problem: Problem,
+        obstacles: Sequence[Circle | Polygon] | None = None,
+        robot_radius: float | None = None,
+        *,
+        lattice: bool = True,
+    ) -> World:
         """Build the static world of a :class:`~rrtpso_ompl.model.Problem` (moving obstacles
-        are not part of it; a map's blocked cells are boxes)."""
-        extra = getattr(problem, "map_boxes", None)
+        are not part of it; a map's blocked cells are boxes, in its grid frame when it is
+        turned, and the unknown space around a turned map polygons).
+
+        ``obstacles`` (default the problem's) and ``robot_radius`` (default its robot's) replace
+        the problem's, over the same map and bounds (a detour among sweeps of moving obstacles).
+        ``lattice=False`` leaves out the map's lattice view (:class:`MapRaster`, for the corridor
+        stage; a turned map never has one: its cells are no lattice of the world's axes).
+        """
         occupancy = getattr(problem, "map", None)
+        frame = getattr(problem, "map_frame", None)
         raster = None
-        if occupancy is not None:
+        if occupancy is not None and frame is None and lattice:
             o = occupancy
             raster = MapRaster.from_image(o.blocked, o.origin, o.resolution, o.unknown_blocks)
-        return cls.from_obstacles(problem.bounds, problem.obstacles, problem.robot.radius, extra,
-                                  raster)  # fmt: skip
+        shapes = [*(problem.obstacles if obstacles is None else obstacles),
+                  *getattr(problem, "map_outside", ())]  # fmt: skip
+        radius = problem.robot.radius if robot_radius is None else robot_radius
+        return cls.from_obstacles(problem.bounds, shapes, radius,
+                                  getattr(problem, "map_boxes", None), raster, frame)  # fmt: skip
 
     @classmethod
     def from_obstacles(
@@ -148,17 +184,20 @@ class World:
         robot_radius: float,
         boxes: np.ndarray | None = None,
         raster: MapRaster | None = None,
+        box_frame: GridFrame | None = None,
     ) -> World:
         """A world of the problem model's obstacles (:class:`~rrtpso_ompl.model.Circle`,
-        :class:`~rrtpso_ompl.model.Polygon`; axis-aligned rectangles become boxes) and extra
-        ``boxes``."""
+        :class:`~rrtpso_ompl.model.Polygon`; axis-aligned rectangles become boxes, unless the
+        boxes are in a ``box_frame``) and extra ``boxes``."""
         circles = [(*o.center, o.radius) for o in obstacles if isinstance(o, Circle)]
         polys = [o for o in obstacles if isinstance(o, Polygon)]
-        rects = [_box_of(o) for o in polys if _is_box(o)]
-        polygons = [np.asarray(o.points) for o in polys if not _is_box(o)]
+        as_box = [box_frame is None and _is_box(o) for o in polys]
+        rects = [_box_of(o) for o, b in zip(polys, as_box, strict=True) if b]
+        polygons = [np.asarray(o.points) for o, b in zip(polys, as_box, strict=True) if not b]
         extra = np.asarray(boxes if boxes is not None else (), dtype=float).reshape(-1, 4)
         all_boxes = np.vstack([np.asarray(rects, dtype=float).reshape(-1, 4), extra])
-        return cls(bounds, circles, polygons, robot_radius, all_boxes, raster, len(extra))
+        return cls(bounds, circles, polygons, robot_radius, all_boxes, raster, len(extra),
+                   box_frame)  # fmt: skip
 
     @contextmanager
     def refusing_motions_after(self, deadline: float | None) -> Iterator[None]:
@@ -181,7 +220,7 @@ class World:
     def with_robot_radius(self, robot_radius: float) -> World:
         """The same obstacles for another robot radius."""
         return World(self.bounds, self.circles, self.polygons, robot_radius, self.boxes,
-                     self.raster, self._raster_boxes)  # fmt: skip
+                     self.raster, self._raster_boxes, self.box_frame)  # fmt: skip
 
     # ------------------------------------------------------------------------------------------
     # Lattice queries (the corridor search)
@@ -259,7 +298,10 @@ class World:
         # A box's cross (its own rows grown by `need` up and down, its own columns grown left
         # and right) is close wholesale: marked by slicing, no distances; only the corners of
         # its grown box need them.
+        # (Not for the turned squares of a box frame: they are measured as every other item.)
         box_ids = np.arange(self._n_circles, self._n_circles + self._n_boxes)
+        if self.box_frame is not None:
+            box_ids = box_ids[:0]
         corners_of = self._mark_box_crosses(clear, lat, need, box_ids[ni[box_ids] > 0])
         counts = ni * nj
         counts[box_ids] = 0
@@ -340,7 +382,7 @@ class World:
             return self
         keep = self._n_boxes - self._raster_boxes
         return World(self.bounds, self.circles, self.polygons, self.robot_radius,
-                     self.boxes[:keep])  # fmt: skip
+                     self.boxes[:keep], box_frame=self.box_frame)  # fmt: skip
 
     @property
     def n_obstacles(self) -> int:
@@ -363,8 +405,9 @@ class World:
         if self._n_boxes:
             q, ids = self._pairs_near_points(p, 0.0, kind=_BOX)
             b = self.boxes[ids - self._n_circles]
-            inside = (p[q, 0] >= b[:, 0]) & (p[q, 0] <= b[:, 2])
-            inside &= (p[q, 1] >= b[:, 1]) & (p[q, 1] <= b[:, 3])
+            g = self._in_box_frame(p[q])
+            inside = (g[:, 0] >= b[:, 0]) & (g[:, 0] <= b[:, 2])
+            inside &= (g[:, 1] >= b[:, 1]) & (g[:, 1] <= b[:, 3])
             out[q[inside]] = True
         return out.reshape(x.shape)
 
@@ -388,12 +431,29 @@ class World:
             self._edge_start = np.zeros(1, dtype=np.intp)
             self._shapes = np.empty(0, dtype=object)
             self._poly_union = None
-        x0, y0, x1, y1 = self.boxes.T if self._n_boxes else (np.empty(0),) * 4
-        box_edges = np.concatenate([
-            np.column_stack([x0, y0, x1, y0]), np.column_stack([x1, y0, x1, y1]),
-            np.column_stack([x1, y1, x0, y1]), np.column_stack([x0, y1, x0, y0]),
-        ]) if self._n_boxes else np.empty((0, 4))  # fmt: skip
-        self._all_edges = np.vstack([self._edges, box_edges])
+        # The boxes' edges in world coordinates: all first sides, then all second sides, ...
+        c = self._box_corners()
+        box_edges = np.concatenate([np.hstack([c[:, k], c[:, (k + 1) % 4]]) for k in range(4)])
+        self._all_edges = np.vstack([self._edges, box_edges.reshape(-1, 4)])
+
+    def _box_corners(self) -> np.ndarray:
+        """World corners ``(n_boxes, 4, 2)`` of the boxes, counter-clockwise from the first."""
+        if self.box_frame is not None:
+            return self.box_frame.box_corners(self.boxes)
+        b = self.boxes
+        return np.stack([b[:, [0, 1]], b[:, [2, 1]], b[:, [2, 3]], b[:, [0, 3]]], axis=1)
+
+    def _in_box_frame(self, p: np.ndarray) -> np.ndarray:
+        """Points ``(..., 2)`` in the boxes' coordinates (themselves without a box frame)."""
+        return p if self.box_frame is None else self.box_frame.to_grid(p)
+
+    def _box_bounding_boxes(self) -> np.ndarray:
+        """``(n_boxes, 4)`` world bounding boxes of the boxes (the boxes themselves without a
+        box frame)."""
+        if self.box_frame is None:
+            return self.boxes
+        c = self._box_corners()
+        return np.hstack([c.min(axis=1), c.max(axis=1)]).reshape(-1, 4)
 
     def _item_boxes(self) -> np.ndarray:
         """Bounding box of every item of the index, in id order: circles, boxes, polygon edges,
@@ -405,7 +465,8 @@ class World:
         edge = np.hstack([np.minimum(e[:, :2], e[:, 2:]), np.maximum(e[:, :2], e[:, 2:])])
         poly = np.array([[p[:, 0].min(), p[:, 1].min(), p[:, 0].max(), p[:, 1].max()]
                          for p in self.polygons]).reshape(-1, 4)  # fmt: skip
-        return np.vstack([circ.reshape(-1, 4), self.boxes, edge.reshape(-1, 4), poly])
+        return np.vstack([circ.reshape(-1, 4), self._box_bounding_boxes(), edge.reshape(-1, 4),
+                          poly])  # fmt: skip
 
     def _prepare_scalar(self) -> None:
         """Plain Python data for the scalar checks (no numpy scalars in the hot loop)."""
@@ -459,6 +520,7 @@ class World:
             return self._clear_crowded(self._grid.cell_of(x, y), x, y, x, y, True)
         r = self.threshold
         py = self._py
+        gx, gy = (x, y) if self.box_frame is None else self.box_frame.to_grid_xy(x, y)
         for k in ids:
             item = py[k]
             kind = item[0]
@@ -467,8 +529,8 @@ class World:
                 if dx * dx + dy * dy < item[4]:
                     return False
             elif kind == _BOX:
-                ex = max(item[1] - x, 0.0, x - item[3])
-                ey = max(item[2] - y, 0.0, y - item[4])
+                ex = max(item[1] - gx, 0.0, gx - item[3])
+                ey = max(item[2] - gy, 0.0, gy - item[4])
                 if ex * ex + ey * ey < r * r:
                     return False
             elif kind == _EDGE:
@@ -541,6 +603,14 @@ class World:
         len2 = dx * dx + dy * dy
         sx0, sx1 = (ax, bx) if ax <= bx else (bx, ax)
         sy0, sy1 = (ay, by) if ay <= by else (by, ay)
+        # The segment in the boxes' coordinates, and its bounding box there.
+        if self.box_frame is None:
+            gax, gay, gbx, gby, gx0, gx1, gy0, gy1 = ax, ay, bx, by, sx0, sx1, sy0, sy1
+        else:
+            gax, gay = self.box_frame.to_grid_xy(ax, ay)
+            gbx, gby = self.box_frame.to_grid_xy(bx, by)
+            gx0, gx1 = (gax, gbx) if gax <= gbx else (gbx, gax)
+            gy0, gy1 = (gay, gby) if gay <= gby else (gby, gay)
         r = self.threshold
         py = self._py
         for k in ids:
@@ -558,9 +628,9 @@ class World:
                     return False
             elif kind == _BOX:
                 _, x0, y0, x1, y1 = item
-                if sx1 < x0 - r or sx0 > x1 + r or sy1 < y0 - r or sy0 > y1 + r:
+                if gx1 < x0 - r or gx0 > x1 + r or gy1 < y0 - r or gy0 > y1 + r:
                     continue
-                if _segment_box_distance(ax, ay, bx, by, x0, y0, x1, y1) < r:
+                if _segment_box_distance(gax, gay, gbx, gby, x0, y0, x1, y1) < r:
                     return False
             elif kind == _EDGE:
                 x0, y0, x1, y1 = item[5]
@@ -814,8 +884,8 @@ class World:
             d[c] = np.maximum(dc, 0.0)
         x = kind == _BOX
         if x.any():
-            d[x] = _segment_box_distance_v(a[seg[x]], b[seg[x]],
-                                           self.boxes[ids[x] - self._n_circles])  # fmt: skip
+            ga, gb = self._in_box_frame(a[seg[x]]), self._in_box_frame(b[seg[x]])
+            d[x] = _segment_box_distance_v(ga, gb, self.boxes[ids[x] - self._n_circles])
         e = kind == _EDGE
         if e.any():
             edges = self._edges[ids[e] - self._first_edge]
@@ -892,9 +962,10 @@ class LocalViolation:
             v += np.maximum(0.0, r_need - np.maximum(d, 0.0)).sum(axis=2)
         if self.boxes.shape[1]:
             shape = (a.shape[0], a.shape[1], self.boxes.shape[1])
+            GA, GB = world._in_box_frame(A), world._in_box_frame(B)  # once per (path, segment)
             d = _segment_box_distance_v(
-                np.broadcast_to(A, (*shape, 2)).reshape(-1, 2),
-                np.broadcast_to(B, (*shape, 2)).reshape(-1, 2),
+                np.broadcast_to(GA, (*shape, 2)).reshape(-1, 2),
+                np.broadcast_to(GB, (*shape, 2)).reshape(-1, 2),
                 np.broadcast_to(self.boxes[None], (*shape, 4)).reshape(-1, 4),
             ).reshape(shape)
             v += np.maximum(0.0, r_need - d).sum(axis=2)

@@ -212,6 +212,8 @@ FINISH_RESERVE = 0.03
 
 #: RRT*'s share of the budget under an inflation cost when the corridor stage has a path.
 INFLATION_RRT_SHARE = 0.1
+#: ... and none when that share is under this many seconds (:meth:`RRTstarPSO._rrt_futile`).
+INFLATION_RRT_MIN = 0.05
 
 #: RRT*'s automatic range is at most this many times the median clearance of free points.
 RANGE_PER_CLEARANCE = 10.0
@@ -302,7 +304,8 @@ class RRTstarPSO(PythonPlanner):
         if not isinstance(self._model, World):
             self._inflation = None  # it needs our world's distances; the length then
         corridor = self._corridor(ptc, t0, stats)  # stage 0
-        self._run_rrtstar(ptc, t0, stats, fallback=corridor is None)  # stage 1
+        if not self._rrt_futile(corridor):
+            self._run_rrtstar(ptc, t0, stats, fallback=corridor is None)  # stage 1
         candidates = self._candidates(corridor, ptc, t0, stats)  # stage 2
         if not candidates:
             if pdef.hasSolution():  # RRT*'s tree never reached the goal
@@ -581,6 +584,15 @@ class RRTstarPSO(PythonPlanner):
         connect.solve(ob.plannerOrTerminationCondition(
             ptc, ob.timedPlannerTerminationCondition(left)))  # fmt: skip
         stats.first_solution = "BITstar"
+
+    def _rrt_futile(self, corridor) -> bool:
+        """Under an inflation cost with the corridor stage's path in hand, RRT* is left out when
+        its share of the budget is under :data:`INFLATION_RRT_MIN` seconds: each of its motion
+        costs is a Python call that may first measure new distances, so in so little time it
+        adds a few vertices and overruns its share."""
+        budget = self._values["budget"]
+        return (self._inflation is not None and corridor is not None and budget > 0
+                and INFLATION_RRT_SHARE * budget < INFLATION_RRT_MIN)  # fmt: skip
 
     def _run_rrtstar(
         self,

@@ -95,6 +95,4 @@ def occupancy_grid(msgs: Messages, grid: Any, scale: float, t: float) -> Any:
 
 def origin_yaw(grid: Any) -> float:
     """The yaw of the map YAML's origin, radians (0 for a map read without one)."""
-    if len(grid.origin) > 2:
-        return float(grid.origin[2])
-    return float(getattr(grid, "origin_yaw", 0.0) or 0.0)
+    return float(getattr(grid, "yaw", 0.0) or 0.0)

@@ -8,7 +8,8 @@ import subprocess
 
 import numpy as np
 import pytest
-from helpers import PROBLEMS, _corridor, _map, _pgm, rrtpso_exe
+import shapely
+from helpers import PROBLEMS, _corridor, _map, _pgm, map_shapes, rrtpso_exe
 
 from rrtpso_ompl.model import World, load_problem
 
@@ -18,7 +19,7 @@ pytestmark = pytest.mark.slow
 @pytest.mark.parametrize(
     ("keys", "key", "words"),
     [
-        ({"origin": [0, 0, 0.5]}, "origin[2]", "rotated map"),
+        ({"origin": [0, 0, "half"]}, "origin[2]", "must be a number"),
         ({"free_thresh": 0.7}, "free_thresh", "below occupied_thresh"),
         ({"occupied_thresh": 1.5}, "occupied_thresh", "between 0 and 1"),
         ({"negate": 2}, "negate", "0 or 1"),
@@ -104,3 +105,67 @@ def test_simulate_and_bench_accept_map_problems(tmp_path):
                          capture_output=True, text=True)  # fmt: skip
     assert run.returncode == 0, run.stderr
     assert (tmp_path / "b" / "benchmark.db").exists()
+
+
+def _turned_corridor(tmp_path, yaw: float, **problem) -> str:
+    """:func:`_corridor` with its map turned by ``yaw`` about the origin, start and goal with it."""
+    prob = _corridor(tmp_path, **problem)
+    grid = tmp_path / "corridor.yaml"
+    doc = json.loads(grid.read_text())
+    doc["origin"] = [0.0, 0.0, yaw]
+    grid.write_text(json.dumps(doc))
+    c, s = math.cos(yaw), math.sin(yaw)
+    doc = json.loads((tmp_path / "prob.yaml").read_text())
+    for key in ("start", "goal"):
+        x, y = doc[key]
+        doc[key] = [c * x - s * y, s * x + c * y]
+    (tmp_path / "prob.yaml").write_text(json.dumps(doc))
+    return prob
+
+
+def test_solve_optimum_and_simulate_on_a_turned_map(tmp_path):
+    """A map whose origin yaw is 0.4 rad: planned, proved and driven exactly (paths checked
+    against shapely's turned squares), drawn turned."""
+    prob = _turned_corridor(
+        tmp_path, 0.4,
+        robot={"radius": 0.3, "wheel_radius": 0.05, "track_width": 0.3, "speed": 0.5,
+               "sample_time": 0.1, "sensor_range": 2.0},
+    )  # fmt: skip
+    exe = rrtpso_exe()
+    sol, opt, sim = tmp_path / "s.json", tmp_path / "o.json", tmp_path / "sim.json"
+    run = subprocess.run([*exe, "solve", prob, "--time", "0.5", "--seed", "3", "--json", str(sol),
+                          "--plot", str(tmp_path / "s.png")],
+                         capture_output=True, text=True)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    run = subprocess.run([*exe, "optimum", prob, "--json", str(opt)],
+                         capture_output=True, text=True)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    problem = load_problem(prob)
+    shapes = map_shapes(problem)
+    tol = World.from_problem(problem).tol
+    for doc in (json.loads(sol.read_text()), json.loads(opt.read_text())):
+        path = np.array(doc["path"])
+        d = shapely.distance(shapes, shapely.linestrings(np.stack([path[:-1], path[1:]], 1)))
+        assert d.min() >= 0.3 - tol
+    o, s = json.loads(opt.read_text()), json.loads(sol.read_text())
+    assert o["length"] <= s["length"] + 1e-9
+    # The unturned problem's optimum: a rotation keeps lengths.
+    (tmp_path / "flat").mkdir()
+    flat = _corridor(tmp_path / "flat", robot={"radius": 0.3})
+    run = subprocess.run([*exe, "optimum", flat, "--json", str(tmp_path / "f.json")],
+                         capture_output=True, text=True)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert json.loads((tmp_path / "f.json").read_text())["length"] == pytest.approx(
+        o["length"], abs=1e-6)
+    doc = json.loads((tmp_path / "prob.yaml").read_text())
+    c, s = math.cos(0.4), math.sin(0.4)  # from (8.5, 4) on the unturned map, toward -x
+    doc["moving_obstacles"] = [{"radius": 0.2, "start": [8.5 * c - 4 * s, 8.5 * s + 4 * c],
+                                "speed": 0.3, "heading_deg": 180 + math.degrees(0.4)}]  # fmt: skip
+    (tmp_path / "prob.yaml").write_text(json.dumps(doc))
+    run = subprocess.run([*exe, "simulate", prob, "--json", str(sim), "--seed", "1"],
+                         capture_output=True, text=True)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    doc = json.loads(sim.read_text())
+    assert doc["reached_goal"] and doc["collisions"] == 0
+    xy = np.array(doc["trajectory"])[:, 1:3]
+    assert shapely.distance(shapes, shapely.points(xy)).min() >= 0.3 - tol

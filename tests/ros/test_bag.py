@@ -264,6 +264,21 @@ def test_an_offset_map_with_nav2_thresholds_keeps_its_origin_and_rows(tmp_path):
     assert np.all(data[-1] == 100) and np.all(data[4, 3:6] == 0) and data[1, 9] == -1
 
 
+def test_a_turned_map_is_published_with_its_yaw_and_unturned_cells(tmp_path):
+    # map_server turns the image about its lower-left corner: the message keeps the cells in
+    # their rows and says the turn in the origin's orientation.
+    img = np.full((10, 12), 254, dtype=np.uint8)
+    img[0, :] = 0
+    prob = _map_problem(tmp_path, img, [1.0, 1.0], [2.0, 2.0], origin=[0.0, 0.0, 0.3])
+    problem = load_problem(prob)
+    out = tmp_path / "turned.mcap"
+    write_plan_bag(problem, RosFrame.for_problem(problem), None, out)
+    grid = read_bag(out)[0]["/map"][0][1]
+    assert xy_yaw(grid.info.origin) == pytest.approx((0.0, 0.0, 0.3))
+    data = np.asarray(grid.data).reshape(10, 12)
+    assert np.array_equal(data, expected_trinary(img, 0.65, 0.196)[::-1])
+
+
 def test_scale_and_raw_maps_keep_the_values_between_the_thresholds(tmp_path):
     grey = np.array([[0, 50, 100, 150], [200, 230, 254, 120]], dtype=np.uint8)
     prob = _map_problem(tmp_path, np.tile(grey, (3, 3)), [1.25, 2.25], [3.25, 1.25], mode="scale")
