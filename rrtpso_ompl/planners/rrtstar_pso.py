@@ -545,6 +545,8 @@ class RRTstarPSO(PythonPlanner):
         v = self._values
         if v["budget"] <= 0 or v["stall_fraction"] <= 0 or v["rrt_max_iterations"] > 0:
             return False
+        if self._inflation is not None and INFLATION_RRT_SHARE * v["budget"] < INFLATION_RRT_MIN:
+            return False  # RRT* cannot help in what is left (:meth:`_rrt_futile`)
         return not ptc() and time.perf_counter() < t0 + 0.98 * v["budget"]
 
     def _has_exact(self) -> bool:
