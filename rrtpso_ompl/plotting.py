@@ -6,6 +6,7 @@ failed or interrupted plot never leaves half an image behind.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -34,9 +35,12 @@ from .planners.result import SolveResult
 
 __all__ = [
     "animate_simulation",
+    "draw_costmap",
     "draw_map",
     "draw_world",
     "plot_bench",
+    "plot_clearance_profile",
+    "plot_cost_reference",
     "plot_optimum",
     "plot_simulation",
     "plot_solution",
@@ -57,6 +61,14 @@ START = "tab:green"
 GOAL = "tab:blue"
 #: Map cells: unknown space drawn blocked, or free (``unknown: free``).
 UNKNOWN_BLOCKED, UNKNOWN_FREE = "0.62", "0.85"
+#: The inflation cost (the costmap's shade, the inflated band of the clearance profile).
+COSTMAP = "#1f8a8a"
+#: Opacity of the costmap's shade where the cost is 1 (the robot touching an obstacle).
+COSTMAP_ALPHA = 0.6
+#: Most pixels along the longer side of the costmap's raster (one clearance query per pixel).
+COSTMAP_PIXELS = 400
+#: Most clearance samples along one path of :func:`plot_clearance_profile`.
+PROFILE_SAMPLES = 200_000
 #: One marker per planner in the benchmark figures (with its colour, so that planners whose
 #: lines coincide stay apart).
 MARKERS = ("o", "s", "^", "D", "v", "P", "X", "<", ">", "h")
@@ -160,6 +172,9 @@ def world_legend(ax: Axes, handles: list[Any], fontsize: float = 8) -> Legend:
     first one's label is used), as :func:`draw_world` returns them.
     """
     labels = [(h[0] if isinstance(h, tuple) else h).get_label() for h in handles]
+    # An equal-aspect world narrower than its panel shrinks towards the panel's left edge, not its
+    # centre: centred, it pushed the legend beside it past the figure's right edge.
+    ax.set_anchor("W")
     return ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.02, 1.0),
                      borderaxespad=0.0, fontsize=fontsize)  # fmt: skip
 
@@ -231,6 +246,147 @@ def draw_map(ax: Axes, problem: Problem, *, safety_zones: bool = True) -> list[A
     return key
 
 
+def draw_costmap(ax: Axes, problem: Problem, world: Any = None,
+                 pixels: int = COSTMAP_PIXELS) -> list[Any]:  # fmt: skip
+    """Shade the inflation cost ``c(d)`` (:mod:`rrtpso_ompl.model.objective`) over the visible
+    area, when the robot has inflation: opaque in :data:`COSTMAP` where the robot touches an
+    obstacle (``c = 1``), fading to nothing at the inflation radius. Call it after
+    :func:`draw_world` (it covers the axes' limits).
+
+    A raster of at most ``pixels`` along the longer side, its clearances from one call of
+    :meth:`~rrtpso_ompl.model.World.point_clearance` (with the inflation radius as its cap).
+    Inside obstacles nothing is shaded (they are drawn). Returns the legend handles (none without
+    inflation).
+    """
+    from .model.objective import InflationCost
+    from .model.world import World
+
+    cost = InflationCost.of(problem.robot)
+    if not cost.active:
+        return []
+    world = world if world is not None else World.from_problem(problem)
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    side = max(x1 - x0, y1 - y0)
+    nx = max(1, round(pixels * (x1 - x0) / side))
+    ny = max(1, round(pixels * (y1 - y0) / side))
+    gx, gy = np.meshgrid(x0 + (np.arange(nx) + 0.5) * (x1 - x0) / nx,
+                         y0 + (np.arange(ny) + 0.5) * (y1 - y0) / ny)  # fmt: skip
+    d = world.point_clearance(np.column_stack([gx.ravel(), gy.ravel()]),
+                              cap=cost.inflation_radius).reshape(ny, nx)  # fmt: skip
+    from matplotlib.colors import to_rgb
+
+    rgba = np.zeros((ny, nx, 4))
+    rgba[..., :3] = to_rgb(COSTMAP)
+    rgba[..., 3] = np.where(d > 0.0, COSTMAP_ALPHA * cost.cost(d), 0.0)
+    ax.imshow(rgba, extent=(x0, x1, y0, y1), origin="lower", interpolation="bilinear",
+              zorder=0.5)  # fmt: skip
+    ax.set_xlim(x0, x1)  # imshow would reset the limits to its extent (the same, but exactly)
+    ax.set_ylim(y0, y1)
+    unit = f" {problem.units}" if problem.units else ""
+    return [
+        Patch(
+            color=COSTMAP,
+            alpha=COSTMAP_ALPHA,
+            label=f"inflation cost (0 beyond R_i = {cost.inflation_radius:g}{unit})",
+        )
+    ]
+
+
+def plot_clearance_profile(problem: Problem, paths: dict[str, Any], world: Any = None) -> Figure:
+    """Clearance along each path: the distance from the robot's centre to the nearest obstacle
+    against arc length, with the robot radius (below it the robot would touch an obstacle) and
+    the inflation radius (below it the inflation cost is charged) drawn.
+
+    Parameters
+    ----------
+    problem : Problem
+        Gives the world, the radii and the units.
+    paths : dict
+        Name -> ``(n, 2)`` polyline; one line each, its length (and with inflation its ``J`` and
+        the share of its length within the inflation radius) in the legend.
+    world : World, optional
+        The problem's static world, when already built.
+
+    Notes
+    -----
+    Each path is sampled every :attr:`InflationCost.step
+    <rrtpso_ompl.model.objective.InflationCost.step>` or finer (at least 1,000 samples, at most
+    :data:`PROFILE_SAMPLES`), plus its vertices, where it turns round corners and its clearance is
+    least. Clearances above 2.5 times the larger radius are drawn at the top of the axes.
+    """
+    from .model.objective import InflationCost
+    from .model.world import World
+
+    world = world if world is not None else World.from_problem(problem)
+    cost = InflationCost.of(problem.robot)
+    r = problem.robot.radius
+    (xmin, ymin), (xmax, ymax) = problem.bounds
+    top = 2.5 * max(cost.inflation_radius if cost.active else 0.0, r)
+    top = top if top > 0 else 0.05 * max(xmax - xmin, ymax - ymin)
+    u = problem.units or "length units"
+    unit = f" {problem.units}" if problem.units else ""
+    fig, ax = plt.subplots(figsize=(9.0 + LEGEND_WIDTH, 4.5))
+    for name, path in paths.items():
+        p = np.asarray(path, dtype=float).reshape(-1, 2)
+        if len(p) < 2:
+            continue
+        s, d = _clearance_along(world, cost, p, top)
+        label = f"{name} (length {s[-1]:.2f}"
+        if cost.active:
+            with np.errstate(invalid="ignore"):  # near_share's cost of inf distances
+                share = cost.near_share(world, p)
+            label += f", J {cost.path_cost(world, p):.2f}, {share:.0%} of it within R_i"
+        ax.plot(s, np.minimum(d, top), lw=1.4, label=label + ")")
+    ax.axhline(r, color=SAFETY, ls="--", lw=1.2,
+               label=f"robot radius r = {r:g}{unit} (touching an obstacle)")  # fmt: skip
+    if cost.active:
+        ax.axhspan(r, cost.inflation_radius, color=COSTMAP, alpha=0.12, lw=0,
+                   label="inflated band (the cost is charged)")  # fmt: skip
+        ax.axhline(cost.inflation_radius, color=COSTMAP, ls=":", lw=1.4,
+                   label=f"inflation radius R_i = {cost.inflation_radius:g}{unit}")  # fmt: skip
+    ax.set_ylim(0.0, top * 1.02)
+    ax.set_xlim(left=0.0)
+    ax.set_xlabel(f"arc length along the path [{u}]")
+    ax.set_ylabel(f"clearance [{u}]")
+    ax.set_title(f"{problem.name}: distance from the robot's centre to the nearest obstacle "
+                 f"(drawn up to {top:g}{unit})", fontsize=10)  # fmt: skip
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def _clearance_along(world: Any, cost: Any, p: np.ndarray, cap: float):
+    """Arc lengths and clearances (``inf`` beyond ``cap``) of samples along a polyline: every
+    :attr:`InflationCost.step` or finer, and the vertices."""
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))])
+    total = float(cum[-1])
+    spacing = min(cost.step, total / 1000.0) if total > 0 else 1.0
+    n = int(min(math.ceil(total / spacing), PROFILE_SAMPLES)) + 1 if total > 0 else 1
+    s = np.unique(np.concatenate([np.linspace(0.0, total, n), cum]))
+    pts = np.column_stack([np.interp(s, cum, p[:, 0]), np.interp(s, cum, p[:, 1])])
+    return s, world.point_clearance(pts, cap=cap)
+
+
+def plot_cost_reference(problem: Problem, result: Any) -> Figure:
+    """The world, its costmap (:func:`draw_costmap`) and the grid reference of the inflation
+    objective (a :class:`~rrtpso_ompl.groundtruth.costgrid.CostGridResult`)."""
+    fig, ax = plt.subplots(figsize=(world_width(problem, 6.0), 6))
+    key = draw_world(ax, problem)
+    key += draw_costmap(ax, problem)
+    path = np.asarray(result.path, dtype=float).reshape(-1, 2)
+    if result.found:
+        key += ax.plot(path[:, 0], path[:, 1], "-", color=PATH_COLOUR, lw=1.8, zorder=4,
+                       label=f"grid reference (J {result.cost:.2f})")  # fmt: skip
+    world_legend(ax, key)
+    found = (f"J {result.cost:.4f}, length {result.length:.4f}" if result.found
+             else "no path on the grid")  # fmt: skip
+    ax.set_title(f"{problem.name}: grid reference (h = {result.resolution:.3g}), {found}",
+                 fontsize=10)  # fmt: skip
+    fig.tight_layout()
+    return fig
+
+
 def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> Figure:
     """The paper's Fig. 15: the world with the raw RRT* path and the final path (a), and the PSO's
     best cost per iteration (b) when the planner ran a swarm. ``curve`` (a
@@ -243,6 +399,7 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
                              gridspec_kw={"width_ratios": widths})  # fmt: skip
     ax = axes[0, 0]
     key = draw_world(ax, problem)
+    key += draw_costmap(ax, problem)
     raw = np.asarray(stages.get("rrt_path") or [], dtype=float).reshape(-1, 2)
     if len(raw):
         key += ax.plot(
@@ -466,7 +623,10 @@ def plot_velocities(traj: Any, units: str = "") -> Figure:
         ax.legend(loc="best", fontsize=8)
     for ax in axes[1]:
         ax.set_xlabel("t [s]")
-    fig.suptitle(f"Reference velocities ({traj.profile} profile, Ts = {traj.sample_time:g} s)")
+    slowed = ", slowed near obstacles" if traj.slow_near_obstacles else ""
+    fig.suptitle(
+        f"Reference velocities ({traj.profile} profile{slowed}, Ts = {traj.sample_time:g} s)"
+    )
     fig.tight_layout()
     return fig
 

@@ -58,6 +58,24 @@ def test_benchmarking_guide_quotes_the_family_report_verbatim():
     assert not [r for r in rows if r["solved"] and not r["valid"]]
 
 
+def test_benchmarking_guide_quotes_the_inflation_report_verbatim():
+    """docs/benchmarking.md repeats the 1 s tables of docs/inflation.md (written by
+    benchmarks/inflation.py); every path of its runs was valid and none failed."""
+    import json
+
+    report = (DOCS / "inflation.md").read_text()
+    guide = (DOCS / "benchmarking.md").read_text()
+    one_second = report[report.index("## 1 s") : report.index("## 4 s")]
+    tables = [b for b in one_second.split("\n\n") if b.startswith("| family |")]
+    assert len(tables) == 2
+    for table in tables:
+        assert table in guide
+    rows = [json.loads(line) for line in (DOCS / "inflation.jsonl").read_text().splitlines()]
+    assert {r["budget"] for r in rows} == {0.25, 1.0, 4.0}
+    assert not [r for r in rows if r.get("solved") and not r.get("valid")]
+    assert not [r for r in rows if r.get("error")]
+
+
 def test_the_published_json_schema_is_the_declared_format_and_accepts_the_library():
     import json
 

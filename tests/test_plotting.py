@@ -111,6 +111,20 @@ def test_the_legend_of_the_warehouse_map_hides_no_rack_and_explains_unknown_spac
         _close(fig)
 
 
+def test_a_narrow_world_alone_in_its_figure_keeps_its_legend_inside():
+    """The warehouse (50 x 85 m) drawn without a second panel (a planner without a swarm, or an
+    unsolved run): its equal-aspect panel used to shrink towards its centre and push the legend
+    past the figure's right edge."""
+    problem = load_problem(PROBLEMS / "maps" / "warehouse_aisles.yaml")
+    result = solve(problem, "BITstar", time_limit=0.3, seed=1)
+    fig = plot_solution(problem, result)
+    try:
+        assert len(fig.axes) == 1
+        assert_legend_hides_nothing(fig, fig.axes[0])
+    finally:
+        _close(fig)
+
+
 def test_a_turned_map_is_drawn_turned_about_its_origin(tmp_path):
     """The image lands on the map's turned rectangle; a blocked cell's centre, a free point and
     the unknown corner beyond the map are painted in their colours (read back from the rendered
@@ -176,6 +190,101 @@ def test_the_optimum_legend_hides_nothing():
     fig = plot_optimum(problem, shortest_path(problem))
     try:
         assert_legend_hides_nothing(fig, fig.axes[0])
+    finally:
+        _close(fig)
+
+
+# ----------------------------------------------------------------------------------------------
+# Clearance: the costmap under the path, the clearance profile
+# ----------------------------------------------------------------------------------------------
+#: A wall across x = 5 with a door 0.8 m wide at y = 5; the robot's inflation reaches 1 m.
+DOOR = {
+    "name": "door",
+    "units": "m",
+    "bounds": [[0, 0], [10, 10]],
+    "start": [1, 2],
+    "goal": [9, 2],
+    "robot": {"radius": 0.2, "inflation_radius": 1.0},
+    "obstacles": [
+        {"type": "rectangle", "min": [4.9, -1], "max": [5.1, 4.6]},
+        {"type": "rectangle", "min": [4.9, 5.4], "max": [5.1, 11]},
+    ],
+}
+
+
+def test_the_costmap_is_shaded_under_the_path_only_with_inflation():
+    from rrtpso_ompl.plotting import COSTMAP_ALPHA, COSTMAP_PIXELS
+
+    problem = problem_from_dict(DOOR)
+    result = solve(problem, "RRTstarPSO", time_limit=0.3, seed=1)
+    fig = plot_solution(problem, result)
+    try:
+        ax = fig.axes[0]
+        assert_legend_hides_nothing(fig, ax)
+        assert any("inflation cost" in label for label in legend_labels(ax))
+        (image,) = ax.get_images()
+        rgba = np.asarray(image.get_array())
+        assert max(rgba.shape[:2]) <= COSTMAP_PIXELS
+        # Opaque next to the wall, clear far from it (the image's columns span the x limits).
+        x0, x1 = ax.get_xlim()
+        column = rgba[:, [int((x - x0) / (x1 - x0) * rgba.shape[1]) for x in (5.2, 2.0)], 3]
+        assert column[:, 0].max() == pytest.approx(COSTMAP_ALPHA, rel=0.05)
+        assert column[:, 1].max() == 0.0
+        assert image.get_zorder() < 1  # under the safety zones, the obstacles and the paths
+    finally:
+        _close(fig)
+    plain = problem_from_dict({**DOOR, "robot": {"radius": 0.2}})
+    fig = plot_solution(plain, solve(plain, "RRTstarPSO", time_limit=0.2, seed=1))
+    try:
+        assert not fig.axes[0].get_images()
+        assert not any("inflation" in label for label in legend_labels(fig.axes[0]))
+    finally:
+        _close(fig)
+
+
+def test_the_clearance_profile_draws_each_path_and_both_radii_with_units():
+    from rrtpso_ompl.groundtruth import shortest_path
+    from rrtpso_ompl.groundtruth.costgrid import cost_reference
+    from rrtpso_ompl.model import World
+    from rrtpso_ompl.plotting import plot_clearance_profile
+
+    problem = problem_from_dict(DOOR)
+    world = World.from_problem(problem)
+    exact = shortest_path(problem, world).valid_polyline(world)
+    ref = cost_reference(problem, world, resolution=0.1).path
+    fig = plot_clearance_profile(problem, {"shortest": exact, "reference": ref}, world)
+    try:
+        ax = fig.axes[0]
+        fig.canvas.draw()
+        box = ax.get_legend().get_window_extent(fig.canvas.get_renderer())
+        assert not box.overlaps(ax.get_window_extent(fig.canvas.get_renderer()))
+        assert fig.bbox.contains(box.x0, box.y0) and fig.bbox.contains(box.x1, box.y1)
+        assert ax.get_xlabel() == "arc length along the path [m]"
+        assert ax.get_ylabel() == "clearance [m]"
+        lines = {line.get_label(): line for line in ax.get_lines()}
+        shortest = next(v for k, v in lines.items() if k.startswith("shortest ("))
+        reference = next(v for k, v in lines.items() if k.startswith("reference ("))
+        # The shortest path brushes the door's frames at the radius; the reference keeps to the
+        # door's middle, 0.4 m from both frames.
+        assert shortest.get_ydata().min() == pytest.approx(0.2, abs=1e-3)
+        assert reference.get_ydata().min() == pytest.approx(0.4, abs=0.06)
+        assert shortest.get_xdata()[-1] == pytest.approx(np.hypot(*np.diff(exact, axis=0).T).sum())
+        flat = {k: v.get_ydata() for k, v in lines.items() if k.startswith(("robot", "inflation"))}
+        assert [float(np.unique(v)[0]) for v in flat.values()] == [0.2, 1.0]
+        assert "within R_i" in shortest.get_label() and "J " in shortest.get_label()
+    finally:
+        _close(fig)
+
+
+def test_the_cost_reference_legend_hides_nothing():
+    from rrtpso_ompl.groundtruth.costgrid import cost_reference
+    from rrtpso_ompl.plotting import plot_cost_reference
+
+    problem = problem_from_dict(DOOR)
+    fig = plot_cost_reference(problem, cost_reference(problem, resolution=0.1))
+    try:
+        assert_legend_hides_nothing(fig, fig.axes[0])
+        assert any(label.startswith("grid reference (J ") for label in legend_labels(fig.axes[0]))
     finally:
         _close(fig)
 

@@ -41,7 +41,16 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         help="write the result as JSON, in the problem's units (its units key)",
     )
     p.add_argument(
-        "--plot", metavar="OUT.png", help="draw the world, the paths and the PSO best-cost curve"
+        "--plot",
+        metavar="OUT.png",
+        help="draw the world, the paths and the PSO best-cost curve "
+        "(and the costmap's inflation cost under them when the robot has inflation)",
+    )
+    p.add_argument(
+        "--plot-clearance",
+        metavar="OUT.png",
+        help="draw the path's clearance (distance to the nearest obstacle) against arc length, "
+        "with the robot radius and the inflation radius",
     )
     add_ros_flags(p)
     p.add_argument(
@@ -81,6 +90,13 @@ def _add_drive_flags(p: argparse.ArgumentParser) -> None:
         help="velocity profile: the paper's constant robot.speed, or within the robot's "
         "limits from rest to rest (auto: limits when any limit is given)",
     )
+    p.add_argument(
+        "--slow-near-obstacles",
+        action="store_true",
+        help="cap the speed where clearance is small: full speed from robot.inflation_radius "
+        "on, down to 30%% of it at robot.radius (docs/clearance.md); needs "
+        "robot.inflation_radius",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -92,6 +108,7 @@ def run(args: argparse.Namespace) -> int:
     outputs = [
         Output("--json", args.json),
         Output("--plot", args.plot, "image"),
+        Output("--plot-clearance", args.plot_clearance, "image"),
         Output("--trajectory", args.trajectory),
         Output("--plot-velocities", args.plot_velocities, "image"),
         *ros_outputs(args),
@@ -101,11 +118,15 @@ def run(args: argparse.Namespace) -> int:
     wants_motion = bool(args.trajectory or args.plot_velocities)
     if wants_motion:
         _check_drive_keys(args, problem)
+    elif args.slow_near_obstacles:
+        raise UsageError("--slow-near-obstacles: only with --trajectory or --plot-velocities")
 
     from ..planners import solve
 
     result = solve(request)
-    motion = _drive(problem, result, args.profile) if wants_motion and result.solved else None
+    motion = None
+    if wants_motion and result.solved:
+        motion = _drive(problem, result, args.profile, args.slow_near_obstacles)
     _write_outputs(args, problem, result, motion, frame)
     length = f"{result.length:.3f}" if result.length is not None else "-"
     note(
@@ -128,6 +149,9 @@ def _check_drive_keys(args: argparse.Namespace, problem: Any) -> None:
     for key in REQUIRED_ROBOT_KEYS:
         if getattr(robot, key) is None:
             raise UsageError(f"{args.problem}: robot.{key}: required for {flag}")
+    if args.slow_near_obstacles and not (robot.inflation_radius or 0.0) > robot.radius:
+        raise UsageError(f"{args.problem}: robot.inflation_radius: required, above robot.radius, "
+                         "for --slow-near-obstacles (the speed falls inside it)")  # fmt: skip
     shortest = max(0.0, math.dist(problem.start, problem.goal) - problem.goal_tolerance)
     top = max(robot.speed, robot.max_speed or 0.0)  # no profile drives faster
     try:
@@ -136,7 +160,7 @@ def _check_drive_keys(args: argparse.Namespace, problem: Any) -> None:
         raise ProblemError(problem.source, "", f"{exc} (for {flag})") from None
 
 
-def _drive(problem: Any, result: Any, profile: str) -> Any:
+def _drive(problem: Any, result: Any, profile: str, slow: bool = False) -> Any:
     import math
 
     from ..errors import ProblemError
@@ -145,7 +169,14 @@ def _drive(problem: Any, result: Any, profile: str) -> Any:
 
     yaw = None if problem.goal_yaw is None else math.radians(problem.goal_yaw)
     try:
-        return drive(result.path, World.from_problem(problem), problem.robot, profile, yaw)
+        return drive(
+            result.path,
+            World.from_problem(problem),
+            problem.robot,
+            profile,
+            yaw,
+            slow_near_obstacles=slow,
+        )
     except TrajectoryError as exc:  # the path found is longer than the straight line
         raise ProblemError(problem.source, "", str(exc)) from None
 
@@ -158,6 +189,11 @@ def _write_outputs(
         from ..plotting import plot_solution, save_figure
 
         save_figure(plot_solution(problem, result, motion.curve if motion else None), args.plot)
+    if args.plot_clearance:
+        from ..plotting import plot_clearance_profile, save_figure
+
+        paths = {result.planner: result.path} if result.solved else {}
+        save_figure(plot_clearance_profile(problem, paths), args.plot_clearance)
     if motion and args.plot_velocities:
         from ..plotting import plot_velocities, save_figure
 

@@ -2,19 +2,24 @@
 
 - :mod:`.optimum`: :func:`shortest_path`, the exact shortest path for the disc robot (the
   reference of every length ratio);
+- :mod:`.costgrid`: :func:`cost_reference`, the reference of the inflation objective (length plus
+  the costmap's inflation cost): a 16-connected grid search, as NavFn and Smac 2D plan;
 - :mod:`.certify`: :func:`grid_path`, a collision-checked grid path that certifies a problem
   solvable (and bounds the optimum from above);
 - :mod:`.generate`: seeded random problems with such a certificate.
 """
 
 from .certify import grid_path, is_solvable
+from .costgrid import CostGridResult, cost_reference
 from .generate import generate, generate_to_file
 from .map_kinds import GeneratedMap, generate_map
 from .optimum import OptimumResult, shortest_path
 
 __all__ = [
+    "CostGridResult",
     "GeneratedMap",
     "OptimumResult",
+    "cost_reference",
     "generate",
     "generate_map",
     "generate_to_file",

@@ -75,6 +75,7 @@ RUN_PROPERTIES: list[tuple[str, str]] = [
     ("simplification time", "REAL"),
     ("total time", "REAL"),
     ("solution clearance", "REAL"),
+    ("solution cost", "REAL"),
     ("length over optimum", "REAL"),
     ("seed", "INTEGER"),
 ]
@@ -312,6 +313,7 @@ def run_properties(row: RunRecord) -> dict[str, Any]:
         "simplification time": run.simplification_time,
         "total time": run.total_time,
         "solution clearance": row.clearance if solved else None,
+        "solution cost": row.cost if solved else None,
         "length over optimum": final / optimum if final is not None and optimum else None,
         "seed": row.seed,
         **{name: value for name, (_, value) in run.properties.items()},

@@ -62,7 +62,17 @@ class RunKey(NamedTuple):
 #: The keys a solve adds to a row (``rrtpso solve --json``'s beyond the first ones, and the
 #: harness's ``wall``): an error row, which has no solve, has none of them.
 _SOLVE_KEYS = frozenset(
-    ("ompl_status", "time_limit", "valid", "clearance", "params", "stages", "benchmark", "wall")
+    (
+        "ompl_status",
+        "time_limit",
+        "valid",
+        "clearance",
+        "cost",
+        "params",
+        "stages",
+        "benchmark",
+        "wall",
+    )
 )
 #: Keys written only when the batch looked the optimum up (``run_batch(optimum=True)``).
 _OPTIMUM_KEYS = frozenset(("optimum", "ratio"))
@@ -113,6 +123,9 @@ class RunRecord:
         Whether the path passed the exact check.
     clearance : float or None
         Least distance from the path to an obstacle beyond the robot radius.
+    cost : float or None
+        The problem's objective of the path (its length without an inflation cost), problem
+        units (None in rows written before it existed).
     params : dict
         The planner's parameters as applied.
     stages : dict
@@ -152,6 +165,7 @@ class RunRecord:
     time_limit: float | None = None
     valid: bool = False
     clearance: float | None = None
+    cost: float | None = None
     params: dict[str, Any] = field(default_factory=dict)
     stages: dict[str, Any] = field(default_factory=dict)
     benchmark: BenchmarkRun | None = None

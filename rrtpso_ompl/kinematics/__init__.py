@@ -6,7 +6,8 @@ Stages, each a pure function:
    :func:`reference_curve`: a smooth curve certified collision-free (:mod:`.reference`), with
    :func:`with_goal_heading` the in-place turn to a goal heading at its end;
 2. :func:`time_parametrize`: the paper's constant speed, or a profile within ``max_speed``,
-   ``max_wheel_speed`` and ``max_accel``, with v and omega (eqs. 7-8) (:mod:`.profile`);
+   ``max_wheel_speed`` and ``max_accel``, optionally slower where clearance is small, with v and
+   omega (eqs. 7-8) (:mod:`.profile`);
 3. :func:`wheel_speeds`: eqs. 9-12, and :func:`integrate_wheels`: the corrected eqs. 1-3
    (:mod:`.diffdrive`);
 4. :func:`track`: Kanayama's kinematic controller on that model (:mod:`.tracking`);
@@ -19,9 +20,11 @@ from .diffdrive import integrate_wheels, wheel_speeds
 from .drive import REQUIRED_ROBOT_KEYS, DriveResult, drive
 from .profile import (
     CSV_HEADER,
+    SLOW_FLOOR,
     Trajectory,
     TrajectoryError,
     check_samples,
+    clearance_speed_share,
     time_parametrize,
     turn_limits,
 )
@@ -31,12 +34,14 @@ from .tracking import TrackingResult, track
 __all__ = [
     "CSV_HEADER",
     "REQUIRED_ROBOT_KEYS",
+    "SLOW_FLOOR",
     "DriveResult",
     "ReferenceCurve",
     "TrackingResult",
     "Trajectory",
     "TrajectoryError",
     "check_samples",
+    "clearance_speed_share",
     "drive",
     "integrate_wheels",
     "reference_curve",

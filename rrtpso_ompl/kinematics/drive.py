@@ -9,7 +9,7 @@ import numpy as np
 from ..model.problem import Robot
 from ..model.world import World
 from .diffdrive import integrate_wheels
-from .profile import Trajectory, time_parametrize
+from .profile import Trajectory, densify, time_parametrize
 from .reference import ReferenceCurve, reference_curve, reference_polynomial, with_goal_heading
 from .tracking import TrackingResult, track
 
@@ -45,6 +45,7 @@ class DriveResult:
             "curve": self.curve.kind,
             "curve_length": self.curve.length,
             "profile": tr.profile,
+            "slow_near_obstacles": tr.slow_near_obstacles,
             "duration": float(tr.t[-1]),
             "samples": len(tr.t),
             "max_v": float(np.abs(tr.v).max()),
@@ -80,15 +81,26 @@ def drive(
     robot: Robot,
     profile: str = "auto",
     goal_yaw: float | None = None,
+    slow_near_obstacles: bool = False,
 ) -> DriveResult:
     """Reference polynomial, certified reference curve, trajectory, open-loop replay and closed-loop
     tracking for a valid path (see the module docstring for each step).
 
     ``goal_yaw`` (radians, optional) is the heading wanted at the goal: the trajectory ends with
-    the in-place turn to it, the shorter way round (:func:`~.reference.with_goal_heading`).
+    the in-place turn to it, the shorter way round (:func:`~.reference.with_goal_heading`). With
+    ``slow_near_obstacles`` (it needs ``robot.inflation_radius``) the speed is capped by the
+    clearance along the curve (:func:`~rrtpso_ompl.kinematics.time_parametrize`).
     """
-    curve = with_goal_heading(reference_curve(path, world), goal_yaw)
-    traj = time_parametrize(curve, robot, profile)
+    curve = reference_curve(path, world)
+    clearance = None
+    if slow_near_obstacles:
+        curve = densify(curve, curve.length / 200.0)
+    curve = with_goal_heading(curve, goal_yaw)
+    if slow_near_obstacles:
+        xy = np.column_stack([curve.x, curve.y])
+        # Beyond the inflation radius the robot drives at full speed: farther needs no number.
+        clearance = world.point_clearance(xy, cap=robot.inflation_radius)
+    traj = time_parametrize(curve, robot, profile, clearance)
     poses = integrate_wheels(
         (traj.x[0], traj.y[0], traj.theta[0]), traj.v_right, traj.v_left,
         traj.track_width, traj.sample_time,

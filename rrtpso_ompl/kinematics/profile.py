@@ -22,9 +22,12 @@ from .reference import ReferenceCurve
 
 __all__ = [
     "CSV_HEADER",
+    "SLOW_FLOOR",
     "Trajectory",
     "TrajectoryError",
     "check_samples",
+    "clearance_speed_share",
+    "densify",
     "time_parametrize",
     "turn_limits",
 ]
@@ -57,6 +60,95 @@ def check_samples(duration: float, sample_time: float, what: str = "the path") -
         )
 
 
+#: Lowest share of the top speed near obstacles (``--slow-near-obstacles``): at the robot's radius
+#: from an obstacle the robot still drives at 30 % of its speed, so that it never stops short of a
+#: door it must pass.
+SLOW_FLOOR = 0.3
+
+
+def clearance_speed_share(clearance, radius: float, inflation_radius: float,
+                          floor: float = SLOW_FLOOR) -> np.ndarray:  # fmt: skip
+    """Share of the top speed allowed at a clearance (``--slow-near-obstacles``):
+    ``clamp((d - r) / (R_i - r), floor, 1)``.
+
+    Full speed from the inflation radius ``R_i`` on, falling linearly to ``floor`` at the robot
+    radius ``r``: the band where the inflation cost is charged (:mod:`rrtpso_ompl.model.objective`)
+    is also where a careful robot slows.
+
+    Parameters
+    ----------
+    clearance : array_like
+        Distances from the robot's centre to the nearest obstacle (``inf`` allowed), length units.
+    radius, inflation_radius : float
+        ``r < R_i``, length units.
+    floor : float
+        The share at ``d <= r``, in (0, 1].
+    """
+    d = np.asarray(clearance, dtype=float)
+    return np.clip((d - radius) / (inflation_radius - radius), floor, 1.0)
+
+
+def densify(curve: ReferenceCurve, spacing: float) -> ReferenceCurve:
+    """The polyline fallback (:func:`~rrtpso_ompl.kinematics.reference_curve`) with samples at
+    most ``spacing`` apart along its straight segments (a speed cap needs samples where it
+    changes; the polyline has them only at its waypoints). A spline is returned as it is."""
+    if curve.kind != "polyline" or len(curve.s) < 2 or spacing <= 0:
+        return curve
+    return _subdivide(curve, np.ceil(np.diff(curve.s) / spacing))[0]
+
+
+def _subdivide(curve: ReferenceCurve, parts: np.ndarray) -> tuple[ReferenceCurve, np.ndarray]:
+    """The curve with segment ``k`` cut into ``parts[k]`` equal pieces (straight segments: the
+    polyline fallback's, whose samples other than the waypoints turn nowhere and drive on with
+    the heading the waypoint leaves with). Also returns, for each new sample, the old sample it
+    is (index ``>= 0``) or ``-1 - k`` when it lies inside segment ``k``."""
+    parts = np.maximum(1, np.asarray(parts)).astype(np.int64)
+    seg = np.repeat(np.arange(len(parts)), parts)
+    f = (np.arange(int(parts.sum())) - np.repeat(np.cumsum(parts) - parts, parts)) / parts[seg]
+    node = f == 0.0
+    leave = curve.theta[seg] + curve.turns[seg]
+
+    def lerp(v: np.ndarray) -> np.ndarray:
+        return np.append(v[seg] + f * (v[seg + 1] - v[seg]), v[-1])
+
+    out = ReferenceCurve(
+        s=lerp(curve.s), x=lerp(curve.x), y=lerp(curve.y),
+        theta=np.append(np.where(node, curve.theta[seg], leave), curve.theta[-1]),
+        kappa=np.append(np.where(node, curve.kappa[seg], 0.0), curve.kappa[-1]),
+        turns=np.append(np.where(node, curve.turns[seg], 0.0), curve.turns[-1]),
+        kind=curve.kind, knots=curve.knots,
+    )  # fmt: skip
+    origin = np.append(np.where(node, seg, -1 - seg), len(curve.s) - 1)
+    return out, origin
+
+
+def _split_rests(
+    curve: ReferenceCurve, profile: str, clearance: np.ndarray | None
+) -> tuple[ReferenceCurve, np.ndarray | None]:
+    """Split each segment between two samples where the robot is at rest at its middle.
+
+    The robot rests where it turns in place and, with ``"limits"``, at both ends; speed is
+    interpolated between samples, so a segment between two rests would be crossed at zero speed
+    in zero time: a jump (the polyline fallback of a straight path from start to goal, or two
+    turning waypoints in a row). Its middle sample lets the robot speed up and brake again. A
+    clearance there is the lower bound ``max(d_i, d_j) - ds / 2`` (clearance changes by at most
+    the distance moved).
+    """
+    rest = curve.turns != 0.0
+    if profile == "limits":
+        rest[0] = rest[-1] = True
+    ds = np.diff(curve.s)
+    jump = rest[:-1] & rest[1:] & (ds > 0.0)
+    if not jump.any():
+        return curve, clearance
+    out, origin = _subdivide(curve, np.where(jump, 2, 1))
+    if clearance is not None:
+        k = np.where(origin < 0, -1 - origin, 0)  # the segment an inserted sample halves
+        bound = np.maximum(clearance[k], clearance[k + 1]) - 0.5 * ds[k]
+        clearance = np.where(origin >= 0, clearance[np.maximum(origin, 0)], bound)
+    return out, clearance
+
+
 #: Rows formatted at a time when writing the CSV (bounds the memory the text takes).
 _CSV_CHUNK = 10_000
 
@@ -87,6 +179,7 @@ class Trajectory:
     wheel_radius: float
     profile: str
     goal_turn_times: tuple[float, float] | None = None
+    slow_near_obstacles: bool = False
 
     def columns(self) -> np.ndarray:
         """``(n, 10)`` array in the order of :data:`CSV_HEADER`."""
@@ -111,7 +204,9 @@ class Trajectory:
         return float(np.hypot(np.diff(self.x), np.diff(self.y)).sum())
 
 
-def time_parametrize(curve: ReferenceCurve, robot: Robot, profile: str = "auto") -> Trajectory:
+def time_parametrize(
+    curve: ReferenceCurve, robot: Robot, profile: str = "auto", clearance: np.ndarray | None = None
+) -> Trajectory:
     """Sample the curve in time every ``robot.sample_time``.
 
     Parameters
@@ -127,6 +222,13 @@ def time_parametrize(curve: ReferenceCurve, robot: Robot, profile: str = "auto")
         allows, slower where a wheel would exceed ``max_wheel_speed`` in a turn, accelerating
         from rest and braking to rest within ``max_accel``. ``"auto"`` picks ``"limits"`` when any
         limit is given.
+    clearance : (len(curve.s),) array_like, optional
+        Distance from each curve sample to the nearest obstacle (``inf`` beyond the inflation
+        radius will do). When given, the robot slows where clearance is small: its speed is at
+        most the profile's top speed times :func:`clearance_speed_share` (``robot.radius`` and
+        ``robot.inflation_radius``, which must exceed it) of the least clearance the curve can
+        have on either side of a sample (clearance changes by at most the distance moved, so
+        the cap holds between samples too); accelerations stay within ``max_accel``.
 
     Returns
     -------
@@ -147,8 +249,16 @@ def time_parametrize(curve: ReferenceCurve, robot: Robot, profile: str = "auto")
         if getattr(robot, key) is None:
             raise ValueError(f"robot.{key} is required to compute velocities")
     profile = _resolve_profile(robot, profile)
+    if clearance is not None:
+        if not robot.inflation_radius or robot.inflation_radius <= robot.radius:
+            raise ValueError("robot.inflation_radius (above robot.radius) is required to slow "
+                             "near obstacles")  # fmt: skip
+        clearance = np.asarray(clearance, dtype=float).reshape(-1)
+        if len(clearance) != len(curve.s):
+            raise ValueError(f"{len(clearance)} clearances for {len(curve.s)} curve samples")
+    curve, clearance = _split_rests(curve, profile, clearance)
     L, ts = robot.track_width, robot.sample_time
-    v, v_top = _speeds(curve, robot, profile)
+    v, v_top = _speeds(curve, robot, profile, clearance)
     turn = turn_limits(robot, profile, v_top)
     dt, turn_dt, t_nodes = _node_times(curve, v, turn)
     t_end = t_nodes[-1] + turn_dt[-1]
@@ -169,6 +279,7 @@ def time_parametrize(curve: ReferenceCurve, robot: Robot, profile: str = "auto")
         v_right=v_r, v_left=v_l, omega_right=w_r, omega_left=w_l, sample_time=ts,
         track_width=L, wheel_radius=robot.wheel_radius, profile=profile,
         goal_turn_times=goal_turn,
+        slow_near_obstacles=clearance is not None,
     )  # fmt: skip
 
 
@@ -245,7 +356,9 @@ def _resolve_profile(robot: Robot, profile: str) -> str:
     return profile
 
 
-def _speeds(curve: ReferenceCurve, robot: Robot, profile: str) -> tuple[np.ndarray, float]:
+def _speeds(
+    curve: ReferenceCurve, robot: Robot, profile: str, clearance: np.ndarray | None = None
+) -> tuple[np.ndarray, float]:
     """The speed at each curve sample (units/s) and the top speed of the profile."""
     L = robot.track_width
     v_top = robot.max_speed if profile == "limits" and robot.max_speed else robot.speed
@@ -262,6 +375,8 @@ def _speeds(curve: ReferenceCurve, robot: Robot, profile: str) -> tuple[np.ndarr
             np.concatenate([k_int[:1], k_int]), np.concatenate([k_int, k_int[-1:]])
         )
         v = np.minimum(v, robot.max_wheel_speed / (1.0 + 0.5 * L * k_worst))
+    if clearance is not None:
+        v = np.minimum(v, v_top * _clearance_caps(curve, robot, clearance))
     stops = curve.turns != 0.0
     if profile == "limits":
         v[0] = v[-1] = 0.0
@@ -271,6 +386,22 @@ def _speeds(curve: ReferenceCurve, robot: Robot, profile: str) -> tuple[np.ndarr
     elif stops.any():
         v[stops] = 0.0  # the polyline fallback must stop to turn, whatever the profile
     return v, float(v_top)
+
+
+def _clearance_caps(curve: ReferenceCurve, robot: Robot, clearance: np.ndarray) -> np.ndarray:
+    """The speed share at each sample (:func:`clearance_speed_share`) of the least clearance on
+    the intervals either side of it: a point ``t`` along an interval of length ``ds`` has at least
+    ``max(d_i - t, d_j - (ds - t)) >= (d_i + d_j - ds) / 2``. The speed between two samples lies
+    between theirs, so it keeps the cap of the interval everywhere."""
+    if len(clearance) < 2:
+        low = clearance
+    else:
+        ds = np.diff(curve.s)
+        with np.errstate(invalid="ignore"):  # inf + inf is inf; never inf - inf here
+            between = 0.5 * (clearance[:-1] + clearance[1:] - ds)
+        low = np.minimum(np.concatenate([between[:1], between]),
+                         np.concatenate([between, between[-1:]]))  # fmt: skip
+    return clearance_speed_share(low, robot.radius, robot.inflation_radius)
 
 
 def _node_times(

@@ -111,6 +111,13 @@ ROBOT = Section("robot", (
     Key("max_wheel_speed", "positive", "speed limit of each wheel", unit="length/s"),
     Key("max_accel", "positive", "acceleration limit of the velocity profile",
         unit="length/s^2"),
+    Key("inflation_radius", "positive", "Nav2's inflation_radius: how far from obstacles the "
+        "clearance cost reaches (default: none, the shortest path)", unit="length"),
+    Key("cost_scaling_factor", "positive", "Nav2's cost_scaling_factor k: the clearance cost "
+        "falls as exp(-k (d - radius)) (default: Nav2's 3.0 per metre, in the problem's units)",
+        unit="1/length"),
+    Key("cost_travel_multiplier", "positive", "w, Smac 2D's name: driving at the radius from a "
+        "wall costs 1 + w times the length (default: 2.0)"),
 ), "the robot: a disc plus its drive parameters")  # fmt: skip
 
 PLANNER = Section("planner", (

@@ -10,6 +10,7 @@ wrong is reported by one :class:`ProblemError` that names the file, the key and 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import numbers
 import os
@@ -34,6 +35,7 @@ from ..validation import (
 )
 from .format import MAP, MOVING, OBSTACLES, PLANNER, ROBOT, TOP
 from .geometry import GridFrame
+from .objective import default_scaling
 from .occupancy import OccupancyMap, load_map, map_image_path
 from .yamlfile import read_yaml_file
 
@@ -136,6 +138,9 @@ class Robot:
     max_speed: float | None = None
     max_wheel_speed: float | None = None
     max_accel: float | None = None
+    inflation_radius: float | None = None
+    cost_scaling_factor: float | None = None
+    cost_travel_multiplier: float | None = None
 
 
 @dataclass(frozen=True)
@@ -324,10 +329,14 @@ def problem_from_dict(
     robot = v.robot(doc["robot"], "robot")
     obstacles = v.each(doc, "obstacles", v.obstacle)
     moving = v.each(doc, "moving_obstacles", v.moving)
+    units = v.string(_get(doc, "units", "m" if occupancy else ""), "units", empty=True)
+    if robot.inflation_radius and robot.cost_scaling_factor is None:
+        # Nav2's default is per metre: the same falling cost in the problem's units.
+        robot = dataclasses.replace(robot, cost_scaling_factor=default_scaling(units))
     problem = Problem(
         name=v.string(_get(doc, "name", name or "problem"), "name"),
         description=v.string(_get(doc, "description", ""), "description", empty=True),
-        units=v.string(_get(doc, "units", "m" if occupancy else ""), "units", empty=True),
+        units=units,
         bounds=bounds,
         start=v.point(doc["start"], "start"),
         goal=v.point(doc["goal"], "goal"),

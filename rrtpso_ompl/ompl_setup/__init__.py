@@ -1,8 +1,10 @@
 """From a problem to OMPL objects: the only place that builds them for a problem.
 
 - :func:`make_context`: ``RealVectorStateSpace(2)`` with the problem's bounds, a validity checker
-  and an *exact* motion validator over the :class:`~rrtpso_ompl.model.World`, the path-length
+  and an *exact* motion validator over the :class:`~rrtpso_ompl.model.World`, the problem's
   objective, start and goal (:mod:`.context`);
+- :func:`objective_for`, :class:`InflationObjective`: length plus the inflation cost as an OMPL
+  objective every planner optimises (:mod:`.objective`);
 - :func:`path_to_array`, :func:`array_to_path`, :func:`assign_path`: paths as numpy arrays
   and back (:mod:`.convert`);
 - :func:`seed_ompl`, :func:`set_ompl_log_level`: OMPL's process-wide seed, once per process
@@ -16,15 +18,18 @@ from .context import (
     make_context,
 )
 from .convert import array_to_path, assign_path, path_to_array
+from .objective import InflationObjective, objective_for
 from .process import seed_ompl, set_ompl_log_level
 
 __all__ = [
     "ExactMotionValidator",
+    "InflationObjective",
     "PlanningContext",
     "WorldValidityChecker",
     "array_to_path",
     "assign_path",
     "make_context",
+    "objective_for",
     "path_to_array",
     "seed_ompl",
     "set_ompl_log_level",

@@ -4,7 +4,8 @@
 * a state validity checker and an *exact* motion validator over the same
   :class:`~rrtpso_ompl.model.World` (no discretisation: a segment is valid only when every point of
   it keeps the robot radius from every obstacle);
-* the path-length objective, the start and the goal (with its tolerance).
+* the problem's objective (path length, plus the inflation cost when the robot has one:
+  :mod:`.objective`), the start and the goal (with its tolerance).
 
 See ``docs/design.md`` for why some OMPL calls are avoided from Python (the bindings notes).
 """
@@ -17,8 +18,10 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
+from ..model.objective import InflationCost
 from ..model.problem import Problem
 from ..model.world import World
+from .objective import objective_for
 
 __all__ = ["ExactMotionValidator", "PlanningContext", "WorldValidityChecker", "make_context"]
 
@@ -74,6 +77,9 @@ class PlanningContext:
     space: ob.RealVectorStateSpace
     checker: WorldValidityChecker
     motion_validator: ExactMotionValidator
+    #: Held here too: OMPL holds it in C++, and a Python subclass whose Python object is
+    #: collected silently loses its overrides (its motion costs fall back to the length).
+    objective: ob.OptimizationObjective | None = None
 
 
 def make_context(problem: Problem, world: World | None = None) -> PlanningContext:
@@ -112,5 +118,6 @@ def make_context(problem: Problem, world: World | None = None) -> PlanningContex
     # scale, relative as every exact check; a path ending at the sampled goal state has d = 0).
     threshold = max(problem.goal_tolerance, world.tol)
     ss.setStartAndGoalStates(start, goal, threshold)
-    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
-    return PlanningContext(problem, world, ss, si, space, checker, validator)
+    objective = objective_for(si, InflationCost.of(problem.robot), world)
+    ss.setOptimizationObjective(objective)
+    return PlanningContext(problem, world, ss, si, space, checker, validator, objective)

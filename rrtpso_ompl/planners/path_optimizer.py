@@ -11,7 +11,9 @@ Cost of a candidate path ``q_0 .. q_n`` (``q_0`` = start and ``q_n`` = goal fixe
     J = \\sum_j \\lVert q_{j+1} - q_j \\rVert + \\lambda_s \\sum_j \\alpha_j^2
         + [V > 0] \\, (J_0 + \\lambda_v V)
 
-where ``alpha_j`` is the turning angle at interior waypoint ``j`` (radians), ``V`` the total
+plus, when the robot has an inflation cost, ``w`` times its integral along the path (the
+problem's objective ``J``, :mod:`rrtpso_ompl.model.objective`), where ``alpha_j`` is the turning
+angle at interior waypoint ``j`` (radians), ``V`` the total
 intrusion of the path's segments into the robot's safety zone (exact, see
 :meth:`rrtpso_ompl.model.World.segment_violation`) and ``J_0`` the cost of the path the swarm was
 seeded with. The ``J_0`` offset makes every colliding candidate worse than the seed, so the global
@@ -19,7 +21,8 @@ best is always collision-free (Deb's feasibility rule folded into one number), w
 still tells colliding particles which way is out.
 
 Guarantees of :func:`optimize_path`: the result is valid (every segment checked exactly) and never
-longer than the input; when it cannot improve, it returns the input unchanged.
+costlier than the input (longer, without an inflation cost); when it cannot improve, it returns
+the input unchanged.
 
 Stages, each optional:
 
@@ -34,6 +37,11 @@ Stages, each optional:
    chords' tangents), insert mid-points and run the swarm again, up to ``max_waypoints``;
 4. *polish* (only with a deadline): more rounds re-centred on the best path while each still
    pays, so the caller's budget is used while the cost falls.
+
+With an inflation cost a path must bend away from walls, which a taut path's few waypoints
+cannot: before the first round, segments that pass within the inflation radius of an obstacle
+are cut into pieces no longer than the inflation radius (up to ``max_cost_waypoints``), and
+waypoints are only dropped (prune, the last shortcut) where that does not raise ``J``.
 """
 
 from __future__ import annotations
@@ -45,6 +53,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..model.geometry import path_length, shortcut, turning_angles
+from ..model.objective import ClearanceField, InflationCost
 from ..model.world import World
 from . import swarm as pso
 from .params import declared, param
@@ -57,6 +66,13 @@ __all__ = [
     "PathOptimizerOptions",
     "optimize_path",
 ]
+
+
+#: Validations of the whole path that follow the swarm's last iteration: the time kept back for
+#: them, measured on the input (a world refusing motions after the deadline fails them late).
+CHECKS_AFTER_SWARM = 4
+#: ... and this share of the time left besides (the last iteration's overrun, the final costs).
+CHECKS_SHARE = 0.03
 
 
 @declared
@@ -115,6 +131,13 @@ class PathOptimizerOptions(PSOOptions):
         high=10.0,
     )
     max_waypoints: int = param(48, "Most waypoints refinement may create.", low=2, high=10_000)
+    max_cost_waypoints: int = param(
+        400,
+        "With an inflation cost: most waypoints the path may be cut into so that it can bend "
+        "away from walls (segments near obstacles get one waypoint per inflation radius).",
+        low=2,
+        high=100_000,
+    )
     window: int = param(
         4,
         "Waypoints each sub-swarm moves: the path's waypoints are cut into windows of this many, "
@@ -169,6 +192,8 @@ class PathOptimizationResult:
     length: float
     input_length: float
     improved: bool
+    cost: float
+    input_cost: float
     history: np.ndarray = field(repr=False)
     n_iterations: int
     n_evaluations: int
@@ -187,6 +212,14 @@ class PathCost:
         Exact collision model.
     smoothness_weight : float
         ``lambda_s`` (see the module docstring).
+    violation : callable, optional
+        ``violation(a, b)`` of segments; the world's when omitted.
+    objective : InflationCost, optional
+        Adds ``w`` times the inflation cost's integral (nothing when inactive or omitted),
+        measured on a :class:`~rrtpso_ompl.model.objective.ClearanceField` (interpolated
+        distances: the swarm's evaluations are many; the final comparison is exact).
+    field : ClearanceField, optional
+        The field to share (rounds of one optimisation share their measurements).
     """
 
     def __init__(
@@ -196,6 +229,8 @@ class PathCost:
         world: World,
         smoothness_weight: float = 0.0,
         violation: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None,
+        objective: InflationCost | None = None,
+        field: ClearanceField | None = None,
     ) -> None:
         self.start = np.asarray(start, dtype=float)
         self.goal = np.asarray(goal, dtype=float)
@@ -204,6 +239,19 @@ class PathCost:
         #: ``violation(a, b)`` for segments ``(P, S, 2)``; a culled model when the caller knows the
         #: candidates stay in boxes, else the world's full check.
         self.violation = violation or world.segment_violation
+        self.objective = objective if objective is not None and objective.active else None
+        if self.objective is not None and field is None:
+            step = self.objective.step
+            field = ClearanceField(world, step, self.objective.inflation_radius + 2.0 * step)
+        self.field = field
+
+    def inflation(self, a: np.ndarray, b: np.ndarray) -> np.ndarray | float:
+        """``w`` times the inflation cost's integral along segments ``a[..]-b[..]`` (0 without
+        one)."""
+        if self.objective is None:
+            return 0.0
+        return self.objective.weight * self.objective.segment_integrals(self.world, a, b,
+                                                                        self.field)  # fmt: skip
 
     def full_paths(self, x: np.ndarray) -> np.ndarray:
         """Particles ``(P, 2k)`` to paths ``(P, k + 2, 2)`` with the fixed end points."""
@@ -221,6 +269,8 @@ class PathCost:
         cost = seg_len.sum(axis=1)
         if self.smoothness_weight > 0 and seg.shape[1] > 1:
             cost = cost + self.smoothness_weight * turning_angles(paths).__pow__(2).sum(axis=1)
+        if self.objective is not None:
+            cost = cost + self.inflation(paths[:, :-1], paths[:, 1:]).sum(axis=1)
         violation = self.violation(paths[:, :-1], paths[:, 1:]).sum(axis=1)
         return cost, violation
 
@@ -288,9 +338,8 @@ def _pso_round(
     sigma = np.repeat(options.init_spread * np.maximum(local, world.tol), 2)
     violation = _violation_within(world, np.vstack([seed_path[:1], lo, seed_path[-1:]]),
                                   np.vstack([seed_path[:1], hi, seed_path[-1:]]))  # fmt: skip
-    round_cost = PathCost(
-        cost_model.start, cost_model.goal, world, cost_model.smoothness_weight, violation
-    )
+    round_cost = PathCost(cost_model.start, cost_model.goal, world, cost_model.smoothness_weight,
+                          violation, cost_model.objective, cost_model.field)  # fmt: skip
 
     n = options.swarm_size
     x0 = interior.reshape(-1)
@@ -437,6 +486,8 @@ def _window_round(
             # windows and is left out, so that the windows' costs stay independent.
             length = length + cost_model.smoothness_weight * (
                 turning_angles(ch) ** 2).sum(axis=2)  # fmt: skip
+        if cost_model.objective is not None:
+            length = length + cost_model.inflation(ch[:, :, :-1], ch[:, :, 1:]).sum(axis=2)
         n = ch.shape[0]
         v = violation(ch[:, :, :-1].reshape(n, -1, 2), ch[:, :, 1:].reshape(n, -1, 2))
         return length, v.reshape(n, n_win, width + 1).sum(axis=2)
@@ -468,6 +519,8 @@ def optimize_path(
     rng: np.random.Generator | None = None,
     terminate: Callable[[], bool] | None = None,
     deadline: float | None = None,
+    objective: InflationCost | None = None,
+    field: ClearanceField | None = None,
 ) -> PathOptimizationResult:
     """Shorten (and optionally smooth) a valid path with the particle swarm, end points fixed.
 
@@ -487,19 +540,32 @@ def optimize_path(
     deadline : float, optional
         ``time.perf_counter()`` seconds by which the swarm must be done: no PSO iteration starts
         that would end after it (their cost is measured as they run).
+    objective : InflationCost, optional
+        The problem's inflation cost: the swarm lowers ``J`` instead of the length.
+    field : ClearanceField, optional
+        Interpolated distances to share (the OMPL objective's: measured once for both).
 
     Returns
     -------
     PathOptimizationResult
-        Its ``path`` is valid and no longer than the input; it equals the input when the input was
-        invalid or nothing shorter was found.
+        Its ``path`` is valid and no costlier than the input (``J``; the length without an
+        objective); it equals the input when the input was invalid or nothing better was found.
     """
     t0 = time.perf_counter()
     options = options or PathOptimizerOptions()
     rng = rng if rng is not None else np.random.default_rng()
     original = np.array(path, dtype=float).reshape(-1, 2)
-    run = _Rounds(original, world, options, rng, terminate, deadline)
-    if len(original) >= 2 and world.path_valid(original) and not run.stopped():
+    t_check = time.perf_counter()
+    valid = len(original) >= 2 and world.path_valid(original)
+    if deadline is not None:
+        # The swarm ends early enough for the checks after it (a round's, the last shortcut's
+        # and the result's), which a world refusing motions after the deadline would fail.
+        now = time.perf_counter()
+        deadline -= CHECKS_AFTER_SWARM * (now - t_check) + CHECKS_SHARE * max(deadline - now, 0.0)
+        stop = terminate
+        terminate = lambda: time.perf_counter() >= deadline or bool(stop and stop())  # noqa: E731
+    run = _Rounds(original, world, options, rng, terminate, deadline, objective, field)
+    if valid and not run.stopped():
         run.optimise()
     return run.result(t0)
 
@@ -507,14 +573,16 @@ def optimize_path(
 class _Rounds:
     """The rounds of one :func:`optimize_path` call and their bookkeeping."""
 
-    def __init__(self, original, world, options, rng, terminate, deadline=None) -> None:
+    def __init__(self, original, world, options, rng, terminate, deadline=None, objective=None,
+                 field=None):  # fmt: skip
         self.deadline = deadline
         self.original = original
         self.world = world
         self.options = options
         self.rng = rng
         self.terminate = terminate
-        self.cost_model = PathCost(original[0], original[-1], world, options.smoothness_weight)
+        self.cost_model = PathCost(original[0], original[-1], world, options.smoothness_weight,
+                                   objective=objective, field=field)  # fmt: skip
         self.current = original
         self.history: list[np.ndarray] = []
         self.iterations = self.evaluations = self.rounds = 0
@@ -525,8 +593,23 @@ class _Rounds:
     def optimise(self) -> None:
         """Prune, then rounds (refining where segments run along obstacles) while they pay."""
         opts, world = self.options, self.world
+        field = self.cost_model.field
+        # With an inflation cost, the distances along the path are measured first and in time
+        # (a measurement cannot be cut short): no time for them, no swarm.
+        if field is not None and not field.prefill(self.original, 0.0, self.deadline):
+            return
         if opts.prune:
-            self.current = shortcut(self.original, world.segments_free, self.terminate)
+            self.current = self._no_costlier(
+                shortcut(self.original, world.segments_free, self.terminate), self.original
+            )
+        if self.cost_model.objective is not None:
+            self.current = _densify(self.current, world, self.cost_model.objective,
+                                    opts.max_cost_waypoints)  # fmt: skip
+            # ... and round it, where the rounds' candidates will lie.
+            seg = np.hypot(*np.diff(self.current, axis=0).T)
+            reach = opts.box_fraction * float(seg.max(initial=0.0))
+            if not field.prefill(self.current, reach, self.deadline):
+                return
         # Without a deadline the work is bounded by the refinement rounds (reproducible); with
         # one, polish rounds follow while a round still shortens the path.
         limit = 1 + opts.refine_rounds + (opts.polish_rounds if self.terminate else 0)
@@ -545,8 +628,18 @@ class _Rounds:
             if still >= (2 if opts.window and len(seed) - 2 > opts.window else 1):
                 break
         if self.rounds:
-            # Drop waypoints that ended up collinear or redundant.
-            self.current = shortcut(self.current, world.segments_free, self.terminate)
+            # Drop waypoints that ended up collinear or redundant (where that costs nothing).
+            self.current = self._no_costlier(
+                shortcut(self.current, world.segments_free, self.terminate), self.current
+            )
+
+    def _no_costlier(self, candidate: np.ndarray, fallback: np.ndarray) -> np.ndarray:
+        """``candidate`` unless it costs more than ``fallback`` (a shortcut never lengthens a
+        path, but with an inflation cost it may run it along a wall)."""
+        if self.cost_model.objective is None:
+            return candidate
+        worse = _cost_of(self.cost_model, candidate) > _cost_of(self.cost_model, fallback)
+        return fallback if worse else candidate
 
     def _round(self, seed: np.ndarray, r: int) -> float:
         """One swarm round from ``seed``; keeps its path when valid and no worse. Returns the
@@ -572,23 +665,56 @@ class _Rounds:
         return before
 
     def result(self, t0: float) -> PathOptimizationResult:
-        """Keep the contract: valid and never longer than the input, else the input itself."""
+        """Keep the contract: valid and never costlier than the input, else the input itself."""
         p = self.current
-        input_length = path_length(self.original)
+        input_cost = self.cost(self.original)
         ok = p is not self.original and self.world.path_valid(p)
-        if not (ok and path_length(p) < input_length):
+        if not (ok and self.cost(p) < input_cost):
             p = self.original
         return PathOptimizationResult(
             path=p,
             length=path_length(p),
-            input_length=input_length,
+            input_length=path_length(self.original),
             improved=p is not self.original,
+            cost=self.cost(p),
+            input_cost=input_cost,
             history=np.concatenate(self.history) if self.history else np.empty(0),
             n_iterations=self.iterations,
             n_evaluations=self.evaluations,
             rounds=self.rounds,
             time=time.perf_counter() - t0,
         )
+
+    def cost(self, path: np.ndarray) -> float:
+        """The objective ``J`` of a path (its length without an inflation cost)."""
+        objective = self.cost_model.objective
+        if objective is None:
+            return path_length(path)
+        return objective.path_cost(self.world, path)
+
+
+def _densify(path: np.ndarray, world: World, objective: InflationCost, limit: int) -> np.ndarray:
+    """Cut every segment that passes within the inflation radius of an obstacle into equal pieces
+    no longer than that radius, so that the swarm can bend the path away from the wall; at most
+    ``limit`` waypoints in all (the pieces are made longer to fit)."""
+    seg = np.diff(path, axis=0)
+    length = np.hypot(seg[:, 0], seg[:, 1])
+    near = world.segment_distance(path[:-1], path[1:], cap=objective.inflation_radius)
+    near = near < objective.inflation_radius
+    spacing = objective.inflation_radius
+    room = limit - len(path)
+    if room <= 0 or not near.any():
+        return path
+    pieces = np.where(near, np.ceil(length / spacing), 1.0)
+    extra = pieces.sum() - len(pieces)
+    if extra > room:  # longer pieces, so the waypoints fit the limit
+        pieces = np.where(near, np.maximum(1.0, np.floor(pieces * room / extra)), 1.0)
+    pieces = pieces.astype(np.int64)
+    seg_of = np.repeat(np.arange(len(seg)), pieces)
+    first = np.cumsum(pieces) - pieces
+    t = (np.arange(int(pieces.sum())) - first[seg_of]) / pieces[seg_of]
+    out = path[:-1][seg_of] + t[:, None] * seg[seg_of]
+    return np.vstack([out, path[-1:]])
 
 
 def _cost_of(cost_model: PathCost, path: np.ndarray) -> float:

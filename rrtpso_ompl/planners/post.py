@@ -28,7 +28,9 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from ..model.geometry import path_length as path_length_of
-from ..ompl_setup import assign_path, path_to_array
+from ..model.objective import InflationCost
+from ..ompl_setup import InflationObjective, assign_path, path_to_array
+from ..ompl_setup.objective import path_cost
 from .base import SpaceInformationCollisionModel, collision_model_for, refusing_motions_after
 from .path_optimizer import PathOptimizationResult, PathOptimizerOptions, optimize_path
 from .request import POST_PARAMS, POST_STEPS, parse_steps, split_spec
@@ -59,16 +61,22 @@ MIN_SWARM = 4
 
 @dataclass(frozen=True)
 class PostStep:
-    """One post-pass on one path: lengths before and after (units) and its time (s)."""
+    """One post-pass on one path: lengths and objective costs before and after (units; the costs
+    equal the lengths without an inflation cost) and its time (s)."""
 
     step: str
     length_before: float
     length_after: float
     time: float
+    cost_before: float | None = None
+    cost_after: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        return {"step": self.step, "length_before": self.length_before,
-                "length_after": self.length_after, "time": self.time}  # fmt: skip
+        out = {"step": self.step, "length_before": self.length_before,
+               "length_after": self.length_after, "time": self.time}  # fmt: skip
+        if self.cost_before is not None:
+            out |= {"cost_before": self.cost_before, "cost_after": self.cost_after}
+        return out
 
 
 class PSOPathOptimizer:
@@ -86,6 +94,10 @@ class PSOPathOptimizer:
         validity checker when the setup is ours).
     rng : numpy.random.Generator, optional
         Drawn from OMPL's RNG when omitted, so ``ompl.util.RNG.setSeed`` makes runs reproducible.
+    objective : ompl.base.OptimizationObjective or InflationCost, optional
+        What the swarm lowers: the problem's inflation cost when it is ours
+        (:class:`~rrtpso_ompl.ompl_setup.InflationObjective`, or the
+        :class:`~rrtpso_ompl.model.objective.InflationCost` itself), else the length.
     **params
         Parameters by name (``swarm_size=40, ...``), as :data:`PathOptimizerOptions` declares.
 
@@ -103,6 +115,7 @@ class PSOPathOptimizer:
         options: PathOptimizerOptions | None = None,
         world: Any = None,
         rng: np.random.Generator | None = None,
+        objective: Any = None,
         **params: Any,
     ) -> None:
         if options is not None and params:
@@ -114,6 +127,10 @@ class PSOPathOptimizer:
         if rng is None:
             rng = np.random.default_rng(ou.RNG().uniformInt(0, 2**31 - 2))
         self.rng = rng
+        # The inflation cost needs our world's distances; with a user's checker, the length.
+        self.inflation = inflation_of(objective) if hasattr(self.model, "point_clearance") else None
+        # The OMPL objective's measured distances, shared (none to share for a bare cost).
+        self.field = getattr(objective, "field", None) if self.inflation is not None else None
         #: The :class:`PathOptimizationResult` of the last call.
         self.last_result: PathOptimizationResult | None = None
         #: Why the last call left the path alone without running the swarm ("" when it ran).
@@ -182,14 +199,15 @@ class PSOPathOptimizer:
         if isinstance(model, SpaceInformationCollisionModel) and deadline is not None:
             options, reserve = self._size(xy, deadline)
             if options is None:
-                self.last_result = _unchanged(xy)
+                self.last_result = _unchanged(xy, self.inflation, model)
                 return self.last_result
             model.stop = lambda: time.perf_counter() >= deadline - reserve
         try:
             # Our world answers "blocked" after the deadline: the swarm's shortcuts test whole
             # views at once, and one view near a detailed polygon can outlast the time left.
             with refusing_motions_after(model, deadline):
-                self.last_result = optimize_path(xy, model, options, self.rng, terminate, deadline)
+                self.last_result = optimize_path(xy, model, options, self.rng, terminate, deadline,
+                                                 self.inflation, self.field)  # fmt: skip
         finally:
             if isinstance(model, SpaceInformationCollisionModel):
                 model.stop = None
@@ -224,7 +242,9 @@ SIMPLIFY_ATTEMPTS = 16
 SIMPLIFY_PATIENCE = 3
 
 
-def simplify_until(si: ob.SpaceInformation, path: og.PathGeometric, deadline: float) -> None:
+def simplify_until(
+    si: ob.SpaceInformation, path: og.PathGeometric, deadline: float, objective: Any = None
+) -> None:
     """OMPL's path simplifier on ``path``, in place, a few attempts at a time until ``deadline``
     (``time.perf_counter()`` seconds) or until it stops changing the path.
 
@@ -233,9 +253,12 @@ def simplify_until(si: ob.SpaceInformation, path: og.PathGeometric, deadline: fl
     that it took seconds (21 s past a 5 s budget on a 128 x 128 maze map). Its steps (vertex
     reduction, partial shortcuts, collapsing close vertices) take a number of attempts, so they
     run here in small batches with the deadline checked in between. B-spline smoothing, the last
-    step of ``simplifyMax``, is left out: it adds states and cannot stop early.
+    step of ``simplifyMax``, is left out: it adds states and cannot stop early. With an
+    ``objective`` its shortcuts weigh that objective's costs (a step may still raise them:
+    :func:`run_post` undoes a step that did).
     """
-    simplifier = og.PathSimplifier(si)
+    simplifier = og.PathSimplifier(si, None, objective) if objective is not None else (
+        og.PathSimplifier(si))  # fmt: skip
     steps = (simplifier.reduceVertices, simplifier.partialShortcutPath,
              simplifier.collapseCloseVertices)  # fmt: skip
     still = 0
@@ -258,13 +281,15 @@ def run_post(
     values: Mapping[str, Any] | None = None,
     world: Any = None,
     rng: np.random.Generator | None = None,
+    objective: Any = None,
 ) -> list[PostStep]:
     """Run the post-passes ``steps`` on ``path`` in place, in order, until ``deadline``
     (``time.perf_counter()`` seconds).
 
     OMPL's simplifier gets at most ``simplify_share`` of what is left when the swarm follows it;
     the swarm gets the rest. ``values`` holds the swarm's and :data:`POST_PARAMS`' parameters by
-    name (defaults for the missing ones).
+    name (defaults for the missing ones). With the problem's ``objective`` (an OMPL objective)
+    no step raises its cost: a step that did is undone.
     """
     steps = tuple(steps)
     values = dict(values or {})
@@ -273,6 +298,8 @@ def run_post(
     for i, step in enumerate(steps):
         t0 = time.perf_counter()
         before = float(path.length())
+        saved = path_to_array(path)
+        cost_before = path_cost(objective, path) if objective is not None else None
         left = max(deadline - t0, 0.0)
         if step == "simplify":
             share = post["simplify_share"] if "pso" in steps[i + 1 :] else 1.0
@@ -280,13 +307,29 @@ def run_post(
                 seconds = max(share * left, 1e-4)
                 # Our world also cuts a long batch short (it refuses motions after the time).
                 with refusing_motions_after(world or collision_model_for(si), t0 + seconds):
-                    simplify_until(si, path, t0 + seconds)
+                    simplify_until(si, path, t0 + seconds, objective)
         else:
             options = PathOptimizerOptions.from_values(values)
-            optimizer = PSOPathOptimizer(si, options=options, world=world, rng=rng)
+            optimizer = PSOPathOptimizer(si, options=options, world=world, rng=rng,
+                                         objective=objective)  # fmt: skip
             optimizer.optimize(path, left if left > 0 else 0.0)
-        out.append(PostStep(step, before, float(path.length()), time.perf_counter() - t0))
+        cost_after = path_cost(objective, path) if objective is not None else None
+        if cost_after is not None and cost_after > cost_before:
+            assign_path(si, path, saved)  # the step raised the objective: undone
+            cost_after = cost_before
+        out.append(PostStep(step, before, float(path.length()), time.perf_counter() - t0,
+                            cost_before, cost_after))  # fmt: skip
     return out
+
+
+def inflation_of(objective: Any) -> InflationCost | None:
+    """The :class:`~rrtpso_ompl.model.objective.InflationCost` behind an objective (ours, or the
+    cost itself), or None: the swarm then lowers the length."""
+    if isinstance(objective, InflationCost):
+        return objective if objective.active else None
+    if isinstance(objective, InflationObjective):
+        return objective.inflation
+    return None
 
 
 def _terminator(ptc_or_seconds: Any, deadline: float | None = None) -> Callable[[], bool] | None:
@@ -299,10 +342,11 @@ def _terminator(ptc_or_seconds: Any, deadline: float | None = None) -> Callable[
     return lambda: bool(ptc())
 
 
-def _unchanged(xy: np.ndarray) -> PathOptimizationResult:
+def _unchanged(xy: np.ndarray, inflation: InflationCost | None, world) -> PathOptimizationResult:
     """The result that hands the input back (the swarm did not run)."""
     p = np.asarray(xy, dtype=float).reshape(-1, 2)
     length = path_length_of(p)
+    cost = inflation.path_cost(world, p) if inflation is not None else length
     return PathOptimizationResult(path=p, length=length, input_length=length, improved=False,
-                                  history=np.empty(0), n_iterations=0, n_evaluations=0, rounds=0,
-                                  time=0.0)  # fmt: skip
+                                  cost=cost, input_cost=cost, history=np.empty(0), n_iterations=0,
+                                  n_evaluations=0, rounds=0, time=0.0)  # fmt: skip

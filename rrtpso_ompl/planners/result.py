@@ -110,6 +110,9 @@ class SolveResult:
         per iteration, the range used), as the planner's stats report them.
     clearance : float or None
         Smallest distance from the path to an obstacle, minus the robot radius (>= 0 when valid).
+    cost : float or None
+        The problem's objective ``J`` of ``path`` (problem units): its length plus the weighted
+        inflation cost (:mod:`rrtpso_ompl.model.objective`); the length without inflation.
     benchmark : BenchmarkRun
         The run as OMPL's Benchmark records it (planning versus simplification, in the planner's
         own terms).
@@ -127,6 +130,7 @@ class SolveResult:
     params: dict[str, Any] = field(default_factory=dict)
     stages: dict[str, Any] = field(default_factory=dict)
     clearance: float | None = None
+    cost: float | None = None
     benchmark: BenchmarkRun = field(default_factory=lambda: BenchmarkRun(time=0.0))
 
     def __post_init__(self) -> None:
@@ -159,6 +163,7 @@ class SolveResult:
             "time_limit": self.time_limit,
             "valid": self.valid,
             "clearance": self.clearance,
+            "cost": self.cost,
             "params": self.params,
             "stages": self.stages,
             "benchmark": self.benchmark.to_dict(),

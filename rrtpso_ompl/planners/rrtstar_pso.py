@@ -49,10 +49,11 @@ from .base import (
     refusing_motions_after,
 )
 from .corridor import search
+from .costroute import cost_route
 from .ompl_planners import RRTSTAR_PARAMS
 from .params import ParamSpec, ParamTable
 from .path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
-from .post import PSOPathOptimizer, simplify_until
+from .post import PSOPathOptimizer, inflation_of, simplify_until
 from .result import BenchmarkRun
 from .swarm import SWARM_PARAMS
 
@@ -115,12 +116,18 @@ RRTSTAR_PSO_PARAMS = (
 class RRTstarPSOStats(PlannerStats):
     """Per-stage figures of one RRTstarPSO solve (the ``stages`` of a solve result).
 
-    Lengths are in problem units, times in seconds. In OMPL's benchmark terms the corridor stage,
+    Lengths are in problem units, times in seconds; ``*_cost`` are the problem's objective (the
+    length plus the inflation cost, :mod:`rrtpso_ompl.model.objective`; the length without
+    one). In OMPL's benchmark terms the corridor stage,
     the RRT* stage and OMPL's simplifier are the planning, the swarm is the simplification.
     ``rrt_path`` is RRT*'s first path, ``seed_path`` the path the returned one was made from
-    (``seed_source`` says whose: ``"corridor"``, ``"RRTstar"`` or ``"BITstar"``; a later RRT*
-    path when the anytime loop found a shorter). ``corridor_*`` describe the corridor stage
-    (``corridor_cells``: its lattice's cells; ``corridor_reason``: why it has no path).
+    (``seed_source`` says whose: ``"corridor"``, ``"RRTstar"``, ``"BITstar"`` or
+    ``"costroute"``; a later RRT* path when the anytime loop found a shorter). ``corridor_*``
+    describe the corridor stage (``corridor_cells``: its lattice's cells; ``corridor_reason``:
+    why it has no path);
+    ``costroute_time`` the re-routing of the best candidate through the cheapest cells under an
+    inflation cost (:mod:`~rrtpso_ompl.planners.costroute`; its path is a candidate,
+    ``"costroute"``).
     ``range_used`` is the inner RRT*'s range, the one chosen for the world when the ``range``
     parameter is 0 (the parameter itself stays as the user set it).
     """
@@ -133,6 +140,7 @@ class RRTstarPSOStats(PlannerStats):
     corridor_reason: str = ""
     seed_source: str = ""
     seed_length: float | None = None
+    seed_cost: float | None = None
     rrt_length: float | None = None
     first_solution: str = "RRTstar"
     rrt_time: float = 0.0
@@ -143,7 +151,9 @@ class RRTstarPSOStats(PlannerStats):
     rrt_progress: list[tuple[float, float]] = field(default_factory=list)
     simplified_length: float | None = None
     simplify_time: float = 0.0
+    costroute_time: float = 0.0
     pso_length: float | None = None
+    pso_cost: float | None = None
     pso_time: float = 0.0
     pso_iterations: int = 0
     pso_evaluations: int = 0
@@ -175,6 +185,7 @@ class RRTstarPSOStats(PlannerStats):
             properties={
                 "corridor time": ("REAL", self.corridor_time),
                 "corridor length": ("REAL", self.corridor_length),
+                "costroute time": ("REAL", self.costroute_time),
                 "rrt iterations": ("INTEGER", self.rrt_iterations),
                 "pso iterations": ("INTEGER", self.pso_iterations),
                 "pso evaluations": ("INTEGER", self.pso_evaluations),
@@ -198,6 +209,11 @@ _CORRIDOR_NO_ROUTE_SHARE = 0.5
 #: Share of the budget kept back for handing the path over (the last checks, OMPL's path): the
 #: stages aim to be done by the rest.
 FINISH_RESERVE = 0.03
+
+#: RRT*'s share of the budget under an inflation cost when the corridor stage has a path.
+INFLATION_RRT_SHARE = 0.1
+#: ... and none when that share is under this many seconds (:meth:`RRTstarPSO._rrt_futile`).
+INFLATION_RRT_MIN = 0.05
 
 #: RRT*'s automatic range is at most this many times the median clearance of free points.
 RANGE_PER_CLEARANCE = 10.0
@@ -245,6 +261,7 @@ class RRTstarPSO(PythonPlanner):
         super().__init__(si, name, **params)
         self.inner = og.RRTstar(si)
         self._inner_ready = False
+        self._inflation = None  # the problem's inflation cost, read from the objective in solve
 
     def setup(self) -> None:
         super().setup()
@@ -282,19 +299,26 @@ class RRTstarPSO(PythonPlanner):
         stats = RRTstarPSOStats(range_used=self.inner.getRange())  # the one chosen when 0
         self.last_stats = stats
 
+        # The problem's inflation cost, when it has one (the swarm and the ranking lower it).
+        self._inflation = inflation_of(pdef.getOptimizationObjective())
+        if not isinstance(self._model, World):
+            self._inflation = None  # it needs our world's distances; the length then
         corridor = self._corridor(ptc, t0, stats)  # stage 0
-        self._run_rrtstar(ptc, t0, stats, fallback=corridor is None)  # stage 1
+        if not self._rrt_futile(corridor):
+            self._run_rrtstar(ptc, t0, stats, fallback=corridor is None)  # stage 1
         candidates = self._candidates(corridor, ptc, t0, stats)  # stage 2
         if not candidates:
             if pdef.hasSolution():  # RRT*'s tree never reached the goal
                 return ob.PlannerStatus(ob.PlannerStatus.APPROXIMATE_SOLUTION)
             return ob.PlannerStatus(ob.PlannerStatus.TIMEOUT)
-        source, seed, xy = min(candidates, key=lambda c: path_length(c[2]))
+        source, seed, xy = min(candidates, key=lambda c: self._cost(c[2]))
         stats.seed_source, stats.seed_path = source, seed.tolist()
         stats.seed_length = stats.simplified_length = path_length(xy)
+        stats.seed_cost = self._cost(xy)
         best = self._swarm(xy, stats, t0, ptc).path  # stage 3
         best = self._anytime(best, stats, t0, ptc)
         stats.pso_length = path_length(best)
+        stats.pso_cost = self._cost(best)
         stats.pso_waypoints = len(best)
 
         # Replace RRT*'s entry either way, so the solution is reported under this planner's name.
@@ -365,7 +389,25 @@ class RRTstarPSO(PythonPlanner):
             short = shortcut(corridor, self._model.segments_free, self._stop(ptc, t0), window=8)
             stats.simplify_time += time.perf_counter() - t1
             out.append(("corridor", corridor, short))
+        if self._inflation is not None and out:
+            # The shortest path hugs the walls: re-routed through the cheapest cells of a band
+            # round it (the costmap's way), it is a far better seed for the inflation cost.
+            t1 = time.perf_counter()
+            around = min(out, key=lambda c: self._cost(c[2]))[2]
+            end = self._finish_by(t0)  # half of what is left, the swarm gets the rest
+            routed = cost_route(self._model, self._inflation, around,
+                                None if end is None else t1 + 0.5 * max(end - t1, 0.0))  # fmt: skip
+            stats.costroute_time = time.perf_counter() - t1
+            if routed is not None:
+                out.append(("costroute", routed, routed))
         return out
+
+    def _cost(self, xy: np.ndarray) -> float:
+        """The problem's objective of waypoints ``xy``: the length, plus the inflation cost when
+        the problem has one."""
+        if self._inflation is None:
+            return path_length(xy)
+        return self._inflation.path_cost(self._model, xy)
 
     def _finish_by(self, t0: float) -> float | None:
         """When the stages must be done (``time.perf_counter()`` s): the end of the budget, less
@@ -396,12 +438,12 @@ class RRTstarPSO(PythonPlanner):
             seed = xy
             if self._values["simplify"] and not ptc():
                 xy = self._simplify(raw, xy, stats, ptc, t0)
-            if path_length(xy) >= stats.seed_length:
+            if self._cost(xy) >= stats.seed_cost:
                 continue  # still no better start than the one the swarm had
             again = self._swarm(xy, stats, t0, ptc)
-            if again.length < path_length(best):
+            if again.cost < self._cost(best):
                 best, stats.seed_path, stats.seed_source = again.path, seed.tolist(), "RRTstar"
-                stats.seed_length = path_length(xy)
+                stats.seed_length, stats.seed_cost = path_length(xy), self._cost(xy)
         return best
 
     def _simplify(self, raw: og.PathGeometric, xy: np.ndarray, stats: RRTstarPSOStats, ptc, t0):
@@ -419,11 +461,12 @@ class RRTstarPSO(PythonPlanner):
         if budget > 0:
             left = max(0.5 * (t0 + budget - t1), 1e-4)
             with refusing_motions_after(self._model, t1 + left):
-                simplify_until(self.getSpaceInformation(), simplified, t1 + left)
+                simplify_until(self.getSpaceInformation(), simplified, t1 + left,
+                               self.getProblemDefinition().getOptimizationObjective())  # fmt: skip
         else:
             og.PathSimplifier(self.getSpaceInformation()).simplifyMax(simplified)
         candidate = path_to_array(simplified)
-        better = path_length(candidate) < path_length(xy) and self._fine_valid(candidate, t0)
+        better = self._cost(candidate) < self._cost(xy) and self._fine_valid(candidate, t0)
         stats.simplify_time += time.perf_counter() - t1
         return candidate if better else xy
 
@@ -479,7 +522,11 @@ class RRTstarPSO(PythonPlanner):
         # The same post-pass any planner gets with "+pso" (one optimiser, not two).
         si = self.getSpaceInformation()
         options = PathOptimizerOptions.from_values(self._values)
-        optimizer = PSOPathOptimizer(si, options=options, world=self._model, rng=self._rng())
+        objective = self.getProblemDefinition().getOptimizationObjective()
+        if self._inflation is None or getattr(objective, "inflation", None) != self._inflation:
+            objective = self._inflation  # the swarm's own distances (or the length)
+        optimizer = PSOPathOptimizer(si, options=options, world=self._model, rng=self._rng(),
+                                     objective=objective)  # fmt: skip
         result = optimizer.optimize_array(xy, terminate, deadline)
         # Summed over the swarm runs of one solve (one, unless the anytime loop ran more).
         stats.pso_time += result.time
@@ -498,6 +545,8 @@ class RRTstarPSO(PythonPlanner):
         v = self._values
         if v["budget"] <= 0 or v["stall_fraction"] <= 0 or v["rrt_max_iterations"] > 0:
             return False
+        if self._inflation is not None and INFLATION_RRT_SHARE * v["budget"] < INFLATION_RRT_MIN:
+            return False  # RRT* cannot help in what is left (:meth:`_rrt_futile`)
         return not ptc() and time.perf_counter() < t0 + 0.98 * v["budget"]
 
     def _has_exact(self) -> bool:
@@ -538,6 +587,15 @@ class RRTstarPSO(PythonPlanner):
             ptc, ob.timedPlannerTerminationCondition(left)))  # fmt: skip
         stats.first_solution = "BITstar"
 
+    def _rrt_futile(self, corridor) -> bool:
+        """Under an inflation cost with the corridor stage's path in hand, RRT* is left out when
+        its share of the budget is under :data:`INFLATION_RRT_MIN` seconds: each of its motion
+        costs is a Python call that may first measure new distances, so in so little time it
+        adds a few vertices and overruns its share."""
+        budget = self._values["budget"]
+        return (self._inflation is not None and corridor is not None and budget > 0
+                and INFLATION_RRT_SHARE * budget < INFLATION_RRT_MIN)  # fmt: skip
+
     def _run_rrtstar(
         self,
         ptc: ob.PlannerTerminationCondition,
@@ -560,6 +618,10 @@ class RRTstarPSO(PythonPlanner):
         t_begin = time.perf_counter()
         # RRT*'s share of what the corridor stage left.
         share = values["rrt_time_fraction"]
+        if self._inflation is not None and not fallback:
+            # With the corridor's path in hand and every motion's cost a Python call (10-30
+            # times fewer vertices a second), the cost route and the swarm make better use of it.
+            share = min(share, INFLATION_RRT_SHARE)
         rrt_end = t_begin + share * max(t0 + budget - t_begin, 0.0) if budget > 0 else None
         if resume:  # grown on after a swarm run: until a stall again, or 70 % of what is left
             rrt_end = t_begin + 0.7 * max(t0 + budget - t_begin, 0.0)

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..model.geometry import path_length
+from ..model.objective import InflationCost
 from ..model.problem import Problem
 from ..model.world import World
 from ..validation import describe
@@ -194,13 +195,22 @@ def _post_passes(ctx: PlanningContext, request: PlannerRequest, run: _Run, simpl
     if request.post:
         path = ctx.ss.getProblemDefinition().getSolutionPath()
         deadline = run.t0 + request.time_limit
-        done = run_post(ctx.si, path, request.post, deadline, values=dict(request.post_params))
+        done = run_post(ctx.si, path, request.post, deadline, values=dict(request.post_params),
+                        objective=_inflation_objective(ctx))  # fmt: skip
         run.benchmark = _with_post(run.benchmark, done)
         run.spent += sum(d.time for d in done)
         run.stages["post"] = [d.to_dict() for d in done]
     elif simplify:
         run.benchmark, simplification = _simplify(ctx, run.benchmark, run.raw)
         run.stages.update(simplification)
+
+
+def _inflation_objective(ctx: PlanningContext) -> Any:
+    """The problem's objective when it is more than the length (None: the length)."""
+    from ..ompl_setup import InflationObjective
+
+    objective = ctx.ss.getProblemDefinition().getOptimizationObjective()
+    return objective if isinstance(objective, InflationObjective) else None
 
 
 def _validated_path(ctx: PlanningContext, code: Any) -> tuple[np.ndarray, str]:
@@ -241,6 +251,9 @@ def _result(
         params=_applied(instance, request.values),
         stages=run.stages,
         clearance=ctx.world.path_clearance(path) - ctx.world.robot_radius if len(path) else None,
+        cost=InflationCost.of(request.problem.robot).path_cost(ctx.world, path)
+        if len(path)
+        else None,
         benchmark=run.benchmark,
     )
 
@@ -259,12 +272,18 @@ def _simplify(
     ctx: PlanningContext, run: BenchmarkRun, raw: np.ndarray
 ) -> tuple[BenchmarkRun, dict[str, Any]]:
     """OMPL's simplifier after the planner, as in OMPL's Benchmark (timed separately)."""
-    from ..ompl_setup import path_to_array
+    from ..ompl_setup import assign_path, path_to_array
+    from ..ompl_setup.objective import path_cost
 
     t1 = time.perf_counter()
+    path = ctx.ss.getProblemDefinition().getSolutionPath()
+    objective = _inflation_objective(ctx)
+    before = path_to_array(path), path_cost(objective, path) if objective else None
     ctx.ss.simplifySolution()
+    if objective is not None and path_cost(objective, path) > before[1]:
+        assign_path(ctx.si, path, before[0])  # the simplifier raised the objective: undone
     seconds = time.perf_counter() - t1
-    length = path_length(path_to_array(ctx.ss.getProblemDefinition().getSolutionPath()))
+    length = path_length(path_to_array(path))
     own = run.simplification_time or 0.0  # a planner's own simplification stage comes first
     run = BenchmarkRun(
         time=run.time,

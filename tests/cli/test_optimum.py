@@ -36,3 +36,74 @@ def test_cli_bad_file_exit_2(tmp_path):
     assert proc.returncode == 2
     assert str(bad) in proc.stderr and "goal" in proc.stderr and "Traceback" not in proc.stderr
     assert not out.exists()
+
+
+#: A wall across x = 5 with a door 0.8 m wide; the robot's inflation (1 m) reaches across it.
+DOOR = """\
+name: door
+units: m
+bounds: [[0, 0], [10, 10]]
+start: [1, 2]
+goal: [9, 2]
+robot: {radius: 0.2%s}
+obstacles:
+  - {type: rectangle, min: [4.9, -1], max: [5.1, 4.6]}
+  - {type: rectangle, min: [4.9, 5.4], max: [5.1, 11]}
+"""
+
+
+def test_cost_writes_the_grid_reference_of_the_objective(tmp_path):
+    from rrtpso_ompl.model import World, load_problem
+    from rrtpso_ompl.model.objective import InflationCost
+
+    problem = tmp_path / "door.yaml"
+    problem.write_text(DOOR % ", inflation_radius: 1.0")
+    out, png = tmp_path / "ref.json", tmp_path / "ref.png"
+    proc = subprocess.run([*rrtpso_exe(), "optimum", str(problem), "--cost", "--resolution",
+                           "0.1", "--json", str(out), "--plot", str(png)],
+                          capture_output=True, text=True)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "grid reference J=" in proc.stderr and "h=0.1," in proc.stderr
+    data = json.loads(out.read_text())
+    assert list(data)[:3] == ["length", "path", "cost"]
+    loaded = load_problem(problem)
+    world = World.from_problem(loaded)
+    path = np.array(data["path"])
+    assert world.path_valid(path)
+    assert data["cost"] == pytest.approx(InflationCost.of(loaded.robot).path_cost(world, path))
+    assert data["grid"]["resolution"] == pytest.approx(0.1) and data["grid"]["edges"] > 0
+    assert data["cost"] <= data["grid"]["cost"]
+    assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_cost_without_inflation_is_the_exact_shortest_path(tmp_path):
+    problem = tmp_path / "door.yaml"
+    problem.write_text(DOOR % "")
+    out = tmp_path / "opt.json"
+    proc = subprocess.run([*rrtpso_exe(), "optimum", str(problem), "--cost", "--json", str(out)],
+                          capture_output=True, text=True)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "no inflation: J is the length" in proc.stderr
+    data = json.loads(out.read_text())
+    assert list(data)[:3] == ["length", "path", "cost"] and data["cost"] == data["length"]
+    assert data["exact"] is True and data["pieces"]
+
+
+@pytest.mark.parametrize(
+    "flags,needle",
+    [
+        (["--resolution", "0.1"], "--resolution: only with --cost"),
+        (["--cost", "--resolution", "0"], "--resolution: must be a positive number"),
+        (["--cost", "--resolution", "0.001"], "at most 2,000,000"),
+    ],
+)
+def test_cost_bad_resolution_exit_2_without_output(tmp_path, flags, needle):
+    problem = tmp_path / "door.yaml"
+    problem.write_text(DOOR % ", inflation_radius: 1.0")
+    out = tmp_path / "ref.json"
+    proc = subprocess.run([*rrtpso_exe(), "optimum", str(problem), *flags, "--json", str(out)],
+                          capture_output=True, text=True)  # fmt: skip
+    assert proc.returncode == 2
+    assert needle in proc.stderr and "Traceback" not in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
+    assert not out.exists()

@@ -87,6 +87,7 @@ BAD_INPUT = {
     "c1-plus-c2": (["--param", "c1=3", "--param", "c2=1.5"], "c1"),
     "excluded-planner": (["--planner", "AORRTC"], "unavailable"),
     "plot-unknown-suffix": (["--plot", "out.xyz"], "--plot"),
+    "plot-clearance-unknown-suffix": (["--plot-clearance", "out.xyz"], "--plot-clearance"),
 }
 
 
@@ -96,7 +97,7 @@ def test_bad_flags_exit_2_without_output(circle_file, tmp_path, flags, needle):
     proc = run("solve", str(circle_file), *flags, "--json", str(out))
     assert proc.returncode == 2
     assert needle in proc.stderr
-    if "--plot" not in flags:  # errors about the problem's planning name the problem file
+    if not any(f.startswith("--plot") for f in flags):  # planning errors name the problem
         assert circle_file.name in proc.stderr
     assert "Traceback" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1

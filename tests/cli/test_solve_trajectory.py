@@ -110,3 +110,60 @@ def test_missing_drive_parameters_are_bad_input(tmp_path):
     proc = subprocess.run([*rrtpso_exe(), "solve", str(f), "--trajectory", str(out)],
                           capture_output=True, text=True, timeout=60)  # fmt: skip
     assert proc.returncode == 2 and "robot.speed" in proc.stderr and not out.exists()
+
+
+#: A wall across x = 5 with a door 0.8 m wide; inflation 1 m; the drive's keys.
+DOOR = {
+    "name": "door",
+    "units": "m",
+    "bounds": [[0, 0], [10, 10]],
+    "start": [1, 2],
+    "goal": [9, 2],
+    "robot": {"radius": 0.2, "inflation_radius": 1.0, "wheel_radius": 0.05, "track_width": 0.3,
+              "speed": 0.5, "sample_time": 0.1},
+    "obstacles": [
+        {"type": "rectangle", "min": [4.9, -1], "max": [5.1, 4.6]},
+        {"type": "rectangle", "min": [4.9, 5.4], "max": [5.1, 11]},
+    ],
+}  # fmt: skip
+
+
+def test_slow_near_obstacles_slows_through_the_door_and_draws_the_clearance(tmp_path):
+    problem = tmp_path / "door.yaml"
+    problem.write_text(yaml.safe_dump(DOOR))
+    runs = {}
+    for slow in (False, True):
+        csv_out, js = tmp_path / f"t{slow}.csv", tmp_path / f"r{slow}.json"
+        flags = ["--slow-near-obstacles", "--plot-clearance", str(tmp_path / "c.png")] * slow
+        proc = subprocess.run(
+            [*rrtpso_exe(), "solve", str(problem), "--time", "0.3", "--seed", "1",
+             "--trajectory", str(csv_out), "--json", str(js), *flags],
+            capture_output=True, text=True, timeout=120,
+        )  # fmt: skip
+        assert proc.returncode == 0, proc.stderr
+        with csv_out.open() as fh:
+            runs[slow] = columns(list(csv.reader(fh)))
+        assert json.loads(js.read_text())["kinematics"]["slow_near_obstacles"] is slow
+    at_door = {k: c["v"][np.abs(c["x"] - 5.0) < 0.1].max() for k, c in runs.items()}
+    assert at_door[False] == pytest.approx(0.5) and at_door[True] <= 0.3 * 0.5 + 1e-9
+    assert runs[True]["t"][-1] > runs[False]["t"][-1]
+    assert np.allclose([runs[True]["x"][-1], runs[True]["y"][-1]], DOOR["goal"])
+    assert (tmp_path / "c.png").read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize(
+    "robot,flags,needle",
+    [
+        ({"inflation_radius": None}, ["--trajectory", "t.csv"], "robot.inflation_radius"),
+        ({}, [], "--slow-near-obstacles: only with --trajectory or --plot-velocities"),
+    ],
+)
+def test_slow_near_obstacles_refusals_exit_2_before_planning(tmp_path, robot, flags, needle):
+    doc = {**DOOR, "robot": {k: v for k, v in {**DOOR["robot"], **robot}.items() if v}}
+    problem = tmp_path / "door.yaml"
+    problem.write_text(yaml.safe_dump(doc))
+    proc = subprocess.run([*rrtpso_exe(), "solve", str(problem), "--slow-near-obstacles",
+                           *flags, "--json", str(tmp_path / "r.json")],
+                          capture_output=True, text=True, cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 2 and needle in proc.stderr and "Traceback" not in proc.stderr
+    assert not (tmp_path / "r.json").exists() and not (tmp_path / "t.csv").exists()

@@ -17,7 +17,7 @@ from rrtpso_ompl.planners.result import BenchmarkRun, SolveResult
 #: The keys of a solved row, in the order the results file has written them since issue 22.
 SOLVED_KEYS = ["file", "planner", "seed", "run", "budget", "source", "inputs_sha256", "problem",
                "status", "solved", "length", "time", "path", "ompl_status", "time_limit", "valid",
-               "clearance", "params", "stages", "benchmark", "wall", "error", "optimum",
+               "clearance", "cost", "params", "stages", "benchmark", "wall", "error", "optimum",
                "ratio"]  # fmt: skip
 #: The keys of an error row, in order.
 ERROR_KEYS = ["file", "planner", "seed", "run", "budget", "source", "inputs_sha256", "problem",

@@ -10,6 +10,7 @@ import pytest
 from helpers import BOUNDS, PAPER_ROBOT, arc_curve
 
 from rrtpso_ompl.kinematics import TrajectoryError, reference_curve, time_parametrize
+from rrtpso_ompl.model.problem import Robot
 from rrtpso_ompl.model.world import World
 from rrtpso_ompl.validation import MAX_STEPS
 
@@ -56,3 +57,29 @@ def test_a_trajectory_has_at_most_max_steps_samples():
     assert len(time_parametrize(curve, fine).t) <= MAX_STEPS + 1
     with pytest.raises(TrajectoryError, match=r"robot\.sample_time .* at most 1,000,000"):
         time_parametrize(curve, replace(PAPER_ROBOT, sample_time=1e-6))
+
+
+@pytest.mark.parametrize(
+    "path,profile",
+    [
+        # The polyline fallback of a straight path, at rest at both ends with "limits".
+        ([[1.0, 5.0], [9.0, 5.0]], "limits"),
+        # Two turning waypoints in a row: at rest at both ends of the segment between them.
+        ([[1.0, 2.0], [3.0, 4.5], [5.0, 5.2], [7.0, 5.5], [9.0, 8.0]], "constant"),
+        ([[1.0, 2.0], [3.0, 4.5], [5.0, 5.2], [7.0, 5.5], [9.0, 8.0]], "limits"),
+    ],
+)
+def test_a_segment_between_two_rests_is_driven_not_jumped(path, profile):
+    """A segment whose both ends are at rest used to be crossed in no time: the robot jumped
+    (8 m in one 0.1 s step, straight to the goal) instead of speeding up and braking."""
+    robot = Robot(radius=0.2, wheel_radius=0.05, track_width=0.3, speed=0.5, sample_time=0.1,
+                  max_accel=0.5 if profile == "limits" else None)  # fmt: skip
+    p = np.array(path)
+    curve = reference_curve(p, World(((0.0, 0.0), (10.0, 10.0))), smooth=False)
+    traj = time_parametrize(curve, robot, profile)
+    step = np.hypot(np.diff(traj.x), np.diff(traj.y)) / robot.sample_time
+    assert step.max() <= robot.speed + 1e-9
+    assert traj.t[-1] >= curve.length / robot.speed
+    np.testing.assert_allclose([traj.x[-1], traj.y[-1]], p[-1])
+    if robot.max_accel:
+        assert np.abs(np.diff(traj.v)).max() / robot.sample_time <= robot.max_accel + 1e-6

@@ -17,7 +17,7 @@ from rrtpso_ompl.planners.registry import PlannerEntry
 
 #: Every key ``rrtpso solve --json`` wrote before the verdicts were one (the contract's first).
 JSON_KEYS = ["problem", "planner", "status", "solved", "length", "time", "seed", "path",
-             "ompl_status", "time_limit", "valid", "clearance", "params", "stages",
+             "ompl_status", "time_limit", "valid", "clearance", "cost", "params", "stages",
              "benchmark"]  # fmt: skip
 
 
