@@ -103,43 +103,17 @@ def problem_files(which: str, seeds, folder: Path, only=None) -> list[tuple[str,
     return out
 
 
-def run_one(path: Path, planner: str, budget: float, seed: int, params: dict) -> dict:
-    """One ``solve`` in a forked child (OMPL seeded once in it); its row."""
+def in_child(work, failed: dict) -> dict:
+    """``work()`` (a row) in a forked child, so that OMPL is seeded once in it as in ``rrtpso
+    solve``; an exception is ``failed`` with its ``error``, a dead child says so."""
     r, w = os.pipe()
     pid = os.fork()
     if pid == 0:  # pragma: no cover - the child
         os.close(r)
         try:
-            from rrtpso_ompl.model import World, load_problem
-            from rrtpso_ompl.ompl_setup import set_ompl_log_level
-            from rrtpso_ompl.planners import solve
-
-            set_ompl_log_level(0)
-            problem = load_problem(path)
-            world = World.from_problem(problem)
-            res = solve(
-                problem,
-                planner,
-                time_limit=budget,
-                seed=seed,
-                params=params if planner == "RRTstarPSO" else None,
-                world=world,
-            )
-            valid = bool(res.solved and world.path_valid(__import__("numpy").array(res.path)))
-            row = {
-                "solved": bool(res.solved),
-                "valid": valid,
-                "length": res.length,
-                "time": res.time,
-            }
+            row = work()
         except Exception as exc:  # a failed run is a row, not the end of the benchmark
-            row = {
-                "solved": False,
-                "valid": False,
-                "length": None,
-                "time": None,
-                "error": f"{type(exc).__name__}: {exc}",
-            }
+            row = {**failed, "error": f"{type(exc).__name__}: {exc}"}
         os.write(w, json.dumps(row).encode())
         os._exit(0)
     os.close(w)
@@ -147,6 +121,26 @@ def run_one(path: Path, planner: str, budget: float, seed: int, params: dict) ->
         text = f.read()
     os.waitpid(pid, 0)
     return json.loads(text) if text else {"solved": False, "error": "the child died"}
+
+
+def run_one(path: Path, planner: str, budget: float, seed: int, params: dict) -> dict:
+    """One ``solve`` in a child process of its own; its row."""
+
+    def work() -> dict:
+        from rrtpso_ompl.model import World, load_problem
+        from rrtpso_ompl.ompl_setup import set_ompl_log_level
+        from rrtpso_ompl.planners import solve
+
+        set_ompl_log_level(0)
+        problem = load_problem(path)
+        world = World.from_problem(problem)
+        res = solve(problem, planner, time_limit=budget, seed=seed,
+                    params=params if planner == "RRTstarPSO" else None, world=world)  # fmt: skip
+        valid = bool(res.solved and world.path_valid(__import__("numpy").array(res.path)))
+        return {"solved": bool(res.solved), "valid": valid, "length": res.length,
+                "time": res.time}  # fmt: skip
+
+    return in_child(work, {"solved": False, "valid": False, "length": None, "time": None})
 
 
 def percentile(values: list[float], q: float) -> float:

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import platform
 import statistics
 import sys
@@ -36,7 +35,7 @@ import yaml
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from families import TUNING_FILES, percentile  # noqa: E402
+from families import TUNING_FILES, in_child, percentile  # noqa: E402
 
 #: Generated families: ``rrtpso generate`` kind, its options, and the inflation (radius, factor)
 #: in the family's units. Rooms with doors 1.6-3.9 m (maps) and 6.25-10 units (shapes): many
@@ -125,37 +124,28 @@ def measure(path: Path, reference: bool = True) -> dict:
 
 
 def run_one(path: Path, planner: str, budget: float, seed: int) -> dict:
-    """One ``solve`` in a forked child (OMPL seeded once in it); its row."""
-    r, w = os.pipe()
-    pid = os.fork()
-    if pid == 0:  # pragma: no cover - the child
-        os.close(r)
-        try:
-            import numpy as np
+    """One ``solve`` in a child process of its own; its row."""
 
-            from rrtpso_ompl.model import World, load_problem
-            from rrtpso_ompl.model.objective import InflationCost
-            from rrtpso_ompl.ompl_setup import set_ompl_log_level
-            from rrtpso_ompl.planners import solve
+    def work() -> dict:
+        import numpy as np
 
-            set_ompl_log_level(0)
-            problem = load_problem(path)
-            world = World.from_problem(problem)
-            res = solve(problem, planner, time_limit=budget, seed=seed, world=world)
-            p = np.asarray(res.path, dtype=float).reshape(-1, 2)
-            row = {"solved": bool(res.solved), "valid": bool(res.solved and world.path_valid(p)),
-                   "length": res.length, "cost": res.cost, "time": res.time}  # fmt: skip
-            if res.solved:
-                row["near"] = InflationCost.of(problem.robot).near_share(world, p)
-        except Exception as exc:  # a failed run is a row, not the end of the benchmark
-            row = {"solved": False, "error": f"{type(exc).__name__}: {exc}"}
-        os.write(w, json.dumps(row).encode())
-        os._exit(0)
-    os.close(w)
-    with os.fdopen(r) as f:
-        text = f.read()
-    os.waitpid(pid, 0)
-    return json.loads(text) if text else {"solved": False, "error": "the child died"}
+        from rrtpso_ompl.model import World, load_problem
+        from rrtpso_ompl.model.objective import InflationCost
+        from rrtpso_ompl.ompl_setup import set_ompl_log_level
+        from rrtpso_ompl.planners import solve
+
+        set_ompl_log_level(0)
+        problem = load_problem(path)
+        world = World.from_problem(problem)
+        res = solve(problem, planner, time_limit=budget, seed=seed, world=world)
+        p = np.asarray(res.path, dtype=float).reshape(-1, 2)
+        row = {"solved": bool(res.solved), "valid": bool(res.solved and world.path_valid(p)),
+               "length": res.length, "cost": res.cost, "time": res.time}  # fmt: skip
+        if res.solved:
+            row["near"] = InflationCost.of(problem.robot).near_share(world, p)
+        return row
+
+    return in_child(work, {"solved": False})
 
 
 def _cell(values: list[float], fmt: str = "{:.3f}") -> str:

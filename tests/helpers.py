@@ -244,3 +244,14 @@ def install_plugin(tmp_path: Path, name: str, source: str, group: str,
                     "--no-build-isolation", "--target", str(target), str(pkg)],
                    check=True, capture_output=True)  # fmt: skip
     return {"PYTHONPATH": str(target), "PATH": str(Path(sys.executable).parent)}
+
+
+#: A wall at x = 4.8..5.2 with a door 0.8 wide at y = 4.6..5.4 (robot radius 0.2, inflation
+#: radius 0.6: the door is narrower than 2 x 0.6 but wider than 2 x 0.2), and a pillar.
+INFLATED_DOOR = {
+    "bounds": [[0, 0], [10, 10]], "start": [1, 8], "goal": [9, 2],
+    "robot": {"radius": 0.2, "inflation_radius": 0.6, "cost_scaling_factor": 3.0},
+    "obstacles": [{"type": "rectangle", "min": [4.8, 0], "max": [5.2, 4.6]},
+                  {"type": "rectangle", "min": [4.8, 5.4], "max": [5.2, 10]},
+                  {"type": "circle", "center": [7.5, 3.5], "radius": 0.5}],
+}  # fmt: skip

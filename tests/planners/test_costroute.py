@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers import PROBLEMS
+from helpers import INFLATED_DOOR, PROBLEMS
 
 from rrtpso_ompl.groundtruth import shortest_path
 from rrtpso_ompl.model import World, load_problem
@@ -12,13 +12,7 @@ from rrtpso_ompl.model.objective import InflationCost
 from rrtpso_ompl.model.problem import problem_from_dict
 from rrtpso_ompl.planners.costroute import cost_route, drop_waypoints
 
-DOOR = {
-    "bounds": [[0, 0], [10, 10]], "start": [1, 8], "goal": [9, 2],
-    "robot": {"radius": 0.2, "inflation_radius": 0.6, "cost_scaling_factor": 3.0},
-    "obstacles": [{"type": "rectangle", "min": [4.8, 0], "max": [5.2, 4.6]},
-                  {"type": "rectangle", "min": [4.8, 5.4], "max": [5.2, 10]},
-                  {"type": "circle", "center": [7.5, 3.5], "radius": 0.5}],
-}  # fmt: skip
+DOOR = INFLATED_DOOR
 
 
 def _setup(problem):

@@ -8,6 +8,7 @@ import time
 
 import numpy as np
 import pytest
+from helpers import INFLATED_DOOR
 
 from rrtpso_ompl.model import World
 from rrtpso_ompl.model.objective import InflationCost
@@ -17,15 +18,9 @@ from rrtpso_ompl.planners import solve
 from rrtpso_ompl.planners.path_optimizer import optimize_path
 from rrtpso_ompl.planners.post import run_post
 
-#: A wall at x = 4.8..5.2 with a door 0.8 wide at y = 4.6..5.4 (robot radius 0.2, inflation
-#: radius 0.6: the door is narrower than 2 x 0.6 but wider than 2 x 0.2), and a pillar.
-DOOR = {
-    "bounds": [[0, 0], [10, 10]], "start": [1, 8], "goal": [9, 2],
-    "robot": {"radius": 0.2, "inflation_radius": 0.6, "cost_scaling_factor": 3.0},
-    "obstacles": [{"type": "rectangle", "min": [4.8, 0], "max": [5.2, 4.6]},
-                  {"type": "rectangle", "min": [4.8, 5.4], "max": [5.2, 10]},
-                  {"type": "circle", "center": [7.5, 3.5], "radius": 0.5}],
-}  # fmt: skip
+DOOR = INFLATED_DOOR
+
+
 @pytest.fixture(scope="module")
 def door():
     problem = problem_from_dict(DOOR)
