@@ -440,21 +440,24 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
     ax.set_title(title)
     world_legend(ax, key)
     if history:
-        _draw_pso_history(axes[0, 1], history, problem.units)
+        inflated = bool(problem.robot.inflation_radius
+                        and problem.robot.inflation_radius > problem.robot.radius)  # fmt: skip
+        _draw_pso_history(axes[0, 1], history, problem.units, inflated)
     fit_layout(fig)
     return fig
 
 
-def _draw_pso_history(bx: Axes, history: Any, units: str) -> None:
+def _draw_pso_history(bx: Axes, history: Any, units: str, inflated: bool = False) -> None:
     """Panel (b) of :func:`plot_solution`: the swarm's best cost per iteration, over all its
-    rounds."""
+    rounds (with an inflation cost, the objective J's)."""
     h = np.asarray(history, dtype=float)
     bx.plot(np.arange(len(h)), h, color=PATH_COLOUR)
     bx.xaxis.set_major_locator(ticker.MaxNLocator(integer=True))
     bx.set_xlabel("PSO iteration (all rounds)")
     # The swarm's best is always collision-free, so its cost is the path length plus the
     # turning penalty (smoothness_weight, 0 by default): a length.
-    bx.set_ylabel(f"best cost: length + turning penalty [{units or 'length units'}]")
+    what = "J = length + w x inflation cost" if inflated else "length + turning penalty"
+    bx.set_ylabel(f"best cost: {what} [{units or 'length units'}]")
     bx.set_title("PSO best cost per iteration")
     bx.grid(alpha=0.3)
 
