@@ -29,6 +29,7 @@ from __future__ import annotations
 from ompl import base as ob
 
 from ..model.objective import ClearanceField, InflationCost
+from .convert import path_to_array
 
 __all__ = ["InflationObjective", "objective_for", "path_cost"]
 
@@ -73,14 +74,8 @@ class InflationObjective(ob.OptimizationObjective):
     def exact_cost(self, path) -> float:
         """``J`` of a path (an ``og.PathGeometric`` or ``(n, 2)`` waypoints) with exact
         distances."""
-        xy = path if hasattr(path, "shape") else _waypoints(path)
+        xy = path if hasattr(path, "shape") else path_to_array(path)
         return self.inflation.path_cost(self.world, xy)
-
-
-def _waypoints(path):
-    from .convert import path_to_array
-
-    return path_to_array(path)
 
 
 def path_cost(objective: ob.OptimizationObjective, path) -> float:

@@ -209,8 +209,7 @@ def _inflation_objective(ctx: PlanningContext) -> Any:
     """The problem's objective when it is more than the length (None: the length)."""
     from ..ompl_setup import InflationObjective
 
-    objective = ctx.ss.getProblemDefinition().getOptimizationObjective()
-    return objective if isinstance(objective, InflationObjective) else None
+    return ctx.objective if isinstance(ctx.objective, InflationObjective) else None
 
 
 def _validated_path(ctx: PlanningContext, code: Any) -> tuple[np.ndarray, str]:
