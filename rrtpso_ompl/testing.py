@@ -355,7 +355,7 @@ def check_planner(
     budget : float
         Seconds per solve.
     seed : int
-        OMPL's seed (taken once per process) and the planner's.
+        OMPL's seed (applied before the solve) and the planner's.
     registry : PlannerRegistry, optional
         Where to look a name up; the default registry when omitted.
 

@@ -174,8 +174,8 @@ class ReplanningManager:
         self.sr = problem.robot.radius
         # Slack for turning in place on a detour: one half turn in all (verified, not trusted).
         self.turn_slack = math.pi / turn_rate if turn_rate else 0.0
-        # Detours must not reseed OMPL (once per process): planners that take a seed get one as
-        # a parameter instead.
+        # Detours do not reseed OMPL (that would restart its sequence at every replan, so every
+        # detour would sample alike): planners that take a seed get one as a parameter instead.
         self._seed_param = default_registry().get(options.planner).takes("seed")
         # What a solve costs beyond its own budget (set-up, verification), s; measured per call.
         self._overrun = 0.005

@@ -1,7 +1,7 @@
 """Batch solving: many problem files x planners x runs, in parallel, streamed to JSON lines.
 
-Every run gets an OMPL of its own, seeded before any of its random generators exists (OMPL takes
-its seed once per process): the local executor's warm workers fork one child per run
+Every run gets a process of its own, which seeds OMPL before it builds anything: the local
+executor's warm workers fork one child per run
 (:mod:`rrtpso_ompl.harness.workers`), after loading the run's problem once per worker; the
 Dask executor forks a process per run from a warm fork server. So each row is reproducible from
 its seed, whichever worker ran it, and a run that crashes is an error row, not the end of the

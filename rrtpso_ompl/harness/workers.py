@@ -1,9 +1,9 @@
 """Running tasks in parallel, each with a fresh OMPL, without paying for a fresh Python each time.
 
-OMPL takes its seed once per process, before any of its random generators exists, and a process
-forked after OMPL was used repeats its parent's random numbers. So every run needs an OMPL of its
-own. Starting a whole Python for it costs about half a second (numpy, scipy, shapely and OMPL
-imports). Instead:
+Every run gets a process of its own: a crash inside OMPL (a segmentation fault, an abort), the
+kernel's out-of-memory killer or a run that ignores its deadline then costs one row, not the
+batch, and no run inherits another's memory or OMPL state. Starting a whole Python for each run
+costs about half a second (numpy, scipy, shapely and OMPL imports). Instead:
 
 - a **warm worker** is a spawned process that has imported everything and loaded the problems it
   was given, but has never created an OMPL object;

@@ -41,7 +41,7 @@ import functools
 import itertools
 import math
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 
 import numpy as np
@@ -57,7 +57,8 @@ from .problem import Circle, Polygon, Problem, clearance_threshold, touch_tolera
 from .raster import Lattice, MapRaster
 from .spatial import Grid
 
-__all__ = ["World", "clearance_threshold"]  # the rule lives in problem (the loader shares it)
+# clearance_threshold: the rule lives in problem (the loader shares it).
+__all__ = ["MarkingStopped", "World", "clearance_threshold"]
 
 Bounds = tuple[tuple[float, float], tuple[float, float]]
 
@@ -66,6 +67,16 @@ Bounds = tuple[tuple[float, float], tuple[float, float]]
 SMALL_WORLD = 24
 #: Most (segment, obstacle) pairs one vectorised step evaluates at once (memory bound).
 _PAIR_CHUNK = 1_000_000
+#: (Cell, item) pairs a lattice marking measures between two looks at its stop condition: about
+#: 7 ms of work, so a marking stopped by a deadline ends within that of it.
+_MARK_CHUNK = 262_144
+
+
+class MarkingStopped(Exception):
+    """A lattice marking was stopped by the condition of :meth:`World.marking_stops` (a
+    caller's deadline): the cells are not known, so nothing is returned."""
+
+
 #: Kinds of the items in the index, in the order of their ids: circles, boxes, the edges of the
 #: polygons, the polygons' interiors.
 _CIRCLE, _BOX, _EDGE, _INTERIOR = 0, 1, 2, 3
@@ -135,6 +146,8 @@ class World:
         #: ``time.perf_counter()`` after which :meth:`motion_free` and :meth:`segments_free`
         #: answer "blocked" unchecked (None: never); see :meth:`refusing_motions_after`.
         self.refuse_after: float | None = None
+        #: Checked between chunks of a lattice marking; see :meth:`marking_stops`.
+        self.mark_stop: Callable[[], bool] | None = None
         self._prepare_polygons()
         #: Ids of the index's items: circles, boxes, polygon edges, polygon interiors.
         self._first_edge = self._n_circles + self._n_boxes
@@ -216,6 +229,25 @@ class World:
             yield
         finally:
             self.refuse_after = saved
+
+    @contextmanager
+    def marking_stops(self, stop: Callable[[], bool] | None) -> Iterator[None]:
+        """While the block runs, a lattice marking (:meth:`free_cells`, :meth:`centres_free`)
+        raises :class:`MarkingStopped` once ``stop()`` is true (None changes nothing).
+
+        Marking costs what the obstacles' detail costs: a polygon of 100,000 vertices makes a
+        lattice of a few thousand cells take a second, more than a real-time budget. The
+        marking looks at ``stop`` every :data:`_MARK_CHUNK` measured pairs, so a deadline holds
+        whatever the obstacles."""
+        worlds = [self] if self._non_raster is self else [self, self._non_raster]
+        saved = [w.mark_stop for w in worlds]
+        for w in worlds:
+            w.mark_stop = stop
+        try:
+            yield
+        finally:
+            for w, old in zip(worlds, saved, strict=True):
+                w.mark_stop = old
 
     def with_robot_radius(self, robot_radius: float) -> World:
         """The same obstacles for another robot radius."""
@@ -358,11 +390,13 @@ class World:
         (ox, oy), h = lat.origin, lat.h
         if ids is None:
             ids = np.arange(len(counts))
-        ends = np.searchsorted(np.cumsum(counts), np.arange(0, counts.sum(), _PAIR_CHUNK))
+        ends = np.searchsorted(np.cumsum(counts), np.arange(0, counts.sum(), _MARK_CHUNK))
         cuts = np.unique(np.concatenate([ends, [len(counts)]]))
         for a, b in itertools.pairwise(np.concatenate([[0], cuts])):
             if a >= b:
                 continue
+            if self.mark_stop is not None and self.mark_stop():
+                raise MarkingStopped
             c = counts[a:b]
             which = np.repeat(np.arange(a, b), c)
             k = np.arange(c.sum()) - np.repeat(np.cumsum(c) - c, c)
@@ -807,14 +841,28 @@ class World:
             reach *= 4.0
         return float(self.segment_distance(a, b).min())
 
-    def local_model(self, seg_lo: np.ndarray, seg_hi: np.ndarray) -> LocalViolation:
+    def local_model(self, seg_lo: np.ndarray, seg_hi: np.ndarray,
+                    deadline: float | None = None) -> LocalViolation | None:  # fmt: skip
         """A violation model for paths whose segment ``s`` lies in the box ``seg_lo[s]..seg_hi[s]``.
 
         Only obstacles within the robot radius of a segment's box can touch that segment, so the
         model checks just those (exact for every path that respects the boxes, and much cheaper
         in clutter). Used by the PSO, which confines each waypoint to a box per round.
+
+        Its cost grows with the index's registrations in the boxes (a microsecond or so each:
+        boxes over a polygon of 100,000 vertices hold hundreds of thousands), and it cannot be
+        cut short: with a ``deadline`` (``time.perf_counter()`` seconds) it is built only when
+        that many registrations, at the rate measured on this machine's earlier builds, end in
+        time; else None.
         """
-        return LocalViolation(self, np.asarray(seg_lo, float), np.asarray(seg_hi, float))
+        seg_lo, seg_hi = np.asarray(seg_lo, float), np.asarray(seg_hi, float)
+        pairs = int(self._grid.registrations_in_boxes(seg_lo, seg_hi).sum()) if len(seg_lo) else 0
+        t = time.perf_counter()
+        if deadline is not None and t + pairs * _LOCAL_BUILD.seconds_per_pair > deadline:
+            return None
+        model = LocalViolation(self, seg_lo, seg_hi)
+        _LOCAL_BUILD.measured(pairs, time.perf_counter() - t)
+        return model
 
     # ------------------------------------------------------------------------------------------
     # Pairs of (segment, obstacle) and their distances
@@ -903,6 +951,23 @@ class World:
         blocked by that edge anyway."""
         inside = shapely.intersects_xy(self._shapes[poly], p[:, 0], p[:, 1])
         return np.where(inside, 0.0, np.inf)
+
+
+class _BuildRate:
+    """Seconds a :class:`LocalViolation` takes per registration of the index in its boxes: a
+    prior on the slow side (1-1.6 µs measured on the reference machine for large builds), then
+    what this process measures on builds large enough to time."""
+
+    def __init__(self, prior: float = 2e-6, timed: int = 20_000) -> None:
+        self.seconds_per_pair = prior
+        self.timed = timed
+
+    def measured(self, pairs: int, seconds: float) -> None:
+        if pairs >= self.timed:
+            self.seconds_per_pair = 0.5 * (self.seconds_per_pair + seconds / pairs)
+
+
+_LOCAL_BUILD = _BuildRate()
 
 
 class LocalViolation:

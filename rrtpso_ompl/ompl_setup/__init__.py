@@ -7,8 +7,8 @@
   objective every planner optimises (:mod:`.objective`);
 - :func:`path_to_array`, :func:`array_to_path`, :func:`assign_path`: paths as numpy arrays
   and back (:mod:`.convert`);
-- :func:`seed_ompl`, :func:`set_ompl_log_level`: OMPL's process-wide seed, once per process
-  before any OMPL object exists, and its log level (:mod:`.process`).
+- :func:`seed_ompl`, :func:`set_ompl_log_level`: OMPL's process-wide seed, applied before each
+  seeded solve builds its OMPL objects, and its log level (:mod:`.process`).
 """
 
 from .context import (

@@ -1,46 +1,45 @@
-"""OMPL's process-wide state: its random seed (once per process) and its log level (warnings
-from the moment this package loads OMPL, unless asked for more)."""
+"""OMPL's process-wide state: its random seed (applied before each seeded solve) and its log
+level (warnings from the moment this package loads OMPL, unless asked for more)."""
 
 from __future__ import annotations
-
-import logging
 
 from ompl import util as ou
 
 __all__ = ["seed_ompl", "set_ompl_log_level"]
 
-log = logging.getLogger(__name__)
-
-_seeded: int | None = None
-
 
 def seed_ompl(seed: int | None) -> bool:
-    """Seed OMPL's global RNG, once per process, before any OMPL object samples.
+    """Seed OMPL's random numbers: every OMPL generator made from now on (a planner's, a
+    sampler's) draws its own seed from a sequence that ``seed`` starts.
 
-    OMPL derives every planner's and sampler's seed from one process-wide generator, and refuses a
-    new seed once that generator has started. So the first call wins; later calls with another
-    seed return False (and log a warning) instead of silently pretending to reseed.
+    OMPL derives each generator's seed from one process-wide seed generator. Its
+    ``RNG::setSeed`` restarts that sequence whenever it is called, and only complains ("Random
+    number generation already started") because generators that exist already keep their state.
+    A solve builds its planner, samplers and space information afresh after this call, so a solve
+    with a seed gives the same path in a fresh process and after any number of other solves in
+    this one (``tests/ompl_setup/test_process.py``); the complaint is muted.
+
+    OMPL refuses seed 0 (it takes 1 in a fresh process and ignores 0 afterwards), so 0 is
+    applied as 1 in every case: seeds 0 and 1 give the same runs.
+
+    Parameters
+    ----------
+    seed : int or None
+        In ``[0, 2**32 - 1]``; None leaves OMPL's sequence where it is (an unseeded run).
 
     Returns
     -------
     bool
-        Whether OMPL now runs with ``seed``.
+        Whether a seed was applied.
     """
-    global _seeded
     if seed is None:
-        return _seeded is None
-    if _seeded is None:
-        ou.RNG.setSeed(int(seed))
-        _seeded = int(seed)
-        return True
-    if _seeded != seed:
-        log.warning(
-            "OMPL was already seeded with %d in this process; seed %d cannot take effect "
-            "(run each seed in its own process for reproducible results)",
-            _seeded,
-            seed,
-        )
         return False
+    level = ou.getLogLevel()
+    ou.setLogLevel(ou.LOG_NONE)
+    try:
+        ou.RNG.setSeed(max(int(seed), 1))
+    finally:
+        ou.setLogLevel(level)
     return True
 
 

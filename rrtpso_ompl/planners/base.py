@@ -30,6 +30,7 @@ from ompl import util as ou
 
 from ..model.problem import touch_tolerance
 from ..model.raster import Lattice
+from ..model.world import MarkingStopped
 from ..validation import MAX_SECONDS, SEED_MAX
 from .params import ParamSpec, ParamTable
 from .result import BenchmarkRun
@@ -106,6 +107,8 @@ class PlannerStats:
 #: when the swarm checks its candidates: an optimiser searches for exactly the gaps a coarse
 #: discrete check leaves, so it must look closer than the planner did.
 FINE_RESOLUTION = 0.1
+#: A lattice marking through a user's checker looks at its stop condition every this many cells.
+_MARK_STOP_EVERY = 64
 
 
 class SpaceInformationCollisionModel:
@@ -149,6 +152,8 @@ class SpaceInformationCollisionModel:
         resolution = si.getStateValidityCheckingResolution() * si.getMaximumExtent()
         self.step = max(fine * resolution, 1e-12)
         self.stop: Any = None
+        #: Looked at every few cells of a lattice marking; see :meth:`marking_stops`.
+        self.mark_stop: Any = None
         self.length_checked = 0.0
         self.check_time = 0.0
         self._state = si.allocState()
@@ -230,15 +235,34 @@ class SpaceInformationCollisionModel:
         return self.centres_free(lat, within)
 
     def centres_free(self, lat: Lattice, within: np.ndarray | None = None) -> np.ndarray:
-        """Cells whose centre the checker accepts (only those in ``within``, when given)."""
-        st, valid = self._state, self.si.isValid
+        """Cells whose centre the checker accepts (only those in ``within``, when given).
+
+        Raises
+        ------
+        MarkingStopped
+            When the condition of :meth:`marking_stops` fires first.
+        """
+        st, valid, stop = self._state, self.si.isValid, self.mark_stop
         asked = np.ones(lat.n_cells, dtype=bool) if within is None else within.ravel()
         free = np.zeros(lat.n_cells, dtype=bool)
         centres = lat.centres()
-        for k in np.flatnonzero(asked).tolist():
+        for n, k in enumerate(np.flatnonzero(asked).tolist()):
+            if stop is not None and n % _MARK_STOP_EVERY == 0 and stop():
+                raise MarkingStopped
             st[0], st[1] = float(centres[k, 0]), float(centres[k, 1])
             free[k] = valid(st)
         return free.reshape(lat.nx, lat.ny)
+
+    @contextlib.contextmanager
+    def marking_stops(self, stop: Any) -> Iterator[None]:
+        """As :meth:`World.marking_stops <rrtpso_ompl.model.World.marking_stops>`: within the
+        block a lattice marking raises :class:`~rrtpso_ompl.model.world.MarkingStopped` once
+        ``stop()`` is true (the user's checker may take a millisecond a state)."""
+        saved, self.mark_stop = self.mark_stop, stop
+        try:
+            yield
+        finally:
+            self.mark_stop = saved
 
 
 def collision_model_for(si: ob.SpaceInformation) -> Any:

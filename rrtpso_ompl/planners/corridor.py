@@ -27,6 +27,7 @@ map of 65,000 cells.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import itertools
 import math
@@ -41,6 +42,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from ..model.geometry import path_length, shortcut
 from ..model.raster import Lattice
+from ..model.world import MarkingStopped
 
 #: Lattice cells the corridor stage builds, searches and funnels per second, on the safe side
 #: (measured on the reference machine: 2-3 million on maps, fewer among many shapes).
@@ -60,6 +62,9 @@ DIRECT_CELLS_PER_SECOND = 1_200_000
 CENTRE_CELLS_PER_SECOND = 600_000
 #: Cells of the small lattice on which the cost of marking cells among shapes is measured.
 MARKING_PROBE_CELLS = 1_600
+#: The share of the stage's time the probe may take: obstacles so detailed that marking the
+#: probe's cells takes longer leave no time for a lattice worth routing on (the stage gives up).
+MARKING_PROBE_SHARE = 0.1
 #: Among shapes, the share of the stage's time for the bands of wholly free cells; the rest is
 #: kept for :func:`centre_route` in case they hold no route.
 SHAPE_BAND_SHARE = 0.5
@@ -901,6 +906,10 @@ def search(
     With no route yet, the search may go on until ``no_route_seconds`` (nothing is left for the
     later stages to refine meanwhile): a map's whole fine lattice if it fits, then, for free
     space too thin for any wholly free fine cell, :func:`centre_route`.
+
+    Marking a lattice's cells stops at the deadline too (:meth:`World.marking_stops
+    <rrtpso_ompl.model.World.marking_stops>`): a marking cut short gives no cells, and the
+    stage ends with the best path it had.
     """
     t0 = time.perf_counter()
     end = None if seconds is None else t0 + seconds
@@ -909,7 +918,27 @@ def search(
     out_of_time = _Deadline(end, terminate)
     if end is not None and no_route_seconds is not None:
         out_of_time.grace_end = max(end, t0 + no_route_seconds)
+    with _marking_stops(model, out_of_time):
+        try:
+            result = _search(model, start, goal, seconds, max_cells, alternatives,
+                             no_route_seconds, out_of_time, t0, stages)  # fmt: skip
+        except MarkingStopped:
+            result = CorridorResult(None, reason="out of time marking the lattice's cells")
+    return dataclasses.replace(result, time=time.perf_counter() - t0, stages=stages)
 
+
+def _marking_stops(model, stop):
+    """``model.marking_stops(stop)`` where the model has it (the World, the space information's
+    adapter), else nothing."""
+    marking_stops = getattr(model, "marking_stops", None)
+    return contextlib.nullcontext() if marking_stops is None else marking_stops(stop)
+
+
+def _search(model, start, goal, seconds, max_cells, alternatives, no_route_seconds, out_of_time,
+            t0, stages) -> CorridorResult:  # fmt: skip
+    """:func:`search`'s steps (a marking cut short raises :class:`MarkingStopped`)."""
+    end = out_of_time.end
+    terminate = out_of_time.terminate
     left = out_of_time.left
     on_map = getattr(model, "raster", None) is not None
     # Among shapes the wholly free cells may miss gaps narrower than a cell (a dense field of
@@ -918,7 +947,12 @@ def search(
              else _Deadline(t0 + SHAPE_BAND_SHARE * seconds, terminate))  # fmt: skip
     # Among shapes the cost of marking a cell grows with the obstacles' detail (a polygon of
     # 10,000 vertices marks 100,000 cells a second, a few circles millions): measured first.
-    rate = CELLS_PER_SECOND if on_map or end is None else _marking_rate(model)
+    rate = CELLS_PER_SECOND
+    if not on_map and end is not None:
+        rate = _marking_rate(model, seconds)
+        if rate is None:
+            return CorridorResult(None, reason="marking cells is too slow for the time (the "
+                                  "obstacles are too detailed)")  # fmt: skip
     result, fine_cells, route_cells = _coarse_tries(
         model, start, goal, max_cells, alternatives, out_of_time, first, t0, stages, rate
     )
@@ -933,15 +967,26 @@ def search(
         thin = centre_route(model, start, goal, max(cells, 4096), out_of_time)
         if thin.path is not None:
             result = thin
-    return dataclasses.replace(result, time=time.perf_counter() - t0, stages=stages)
+    return result
 
 
-def _marking_rate(model) -> float:
+def _marking_rate(model, seconds: float) -> float | None:
     """Lattice cells per second ``model`` marks (its free cell centres), measured on a small
-    lattice; at most :data:`CELLS_PER_SECOND`."""
+    lattice; at most :data:`CELLS_PER_SECOND`. None when the probe takes more than
+    :data:`MARKING_PROBE_SHARE` of ``seconds`` (it is stopped there)."""
     probe = model.lattice(MARKING_PROBE_CELLS)
     t = time.perf_counter()
-    model.centres_free(probe)
+    end = t + MARKING_PROBE_SHARE * seconds
+    outer = getattr(model, "mark_stop", None)
+
+    def stop() -> bool:
+        return time.perf_counter() >= end or bool(outer is not None and outer())
+
+    try:
+        with _marking_stops(model, stop):
+            model.centres_free(probe)
+    except MarkingStopped:
+        return None
     return min(CELLS_PER_SECOND, probe.n_cells / max(time.perf_counter() - t, 1e-6))
 
 
@@ -1066,13 +1111,17 @@ def _corridors(model, coarse: Lattice, opened, fine_band, start, goal, alternati
         mask = ndimage.binary_dilation(mask, iterations=grow)
         rows, cols = np.nonzero(mask)
         r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
-        box, free, k = fine_band(r0, r1, c0, c1, mask[r0:r1, c0:c1])
-        near = np.repeat(np.repeat(mask[r0:r1, c0:c1], k, axis=0), k, axis=1)
-        result = _route_and_funnel(model, box, free & near, start, goal, 0, terminate, t0, stages)
-        if result.path is None and not terminate():
-            # The corridor's gaps are narrower than wholly free fine cells: through the centres
-            # of the fine cells that are free, every segment checked.
-            result = centre_route(model, start, goal, 0, terminate, box, near)
+        try:
+            box, free, k = fine_band(r0, r1, c0, c1, mask[r0:r1, c0:c1])
+            near = np.repeat(np.repeat(mask[r0:r1, c0:c1], k, axis=0), k, axis=1)
+            result = _route_and_funnel(model, box, free & near, start, goal, 0, terminate, t0,
+                                       stages)  # fmt: skip
+            if result.path is None and not terminate():
+                # The corridor's gaps are narrower than wholly free fine cells: through the
+                # centres of the fine cells that are free, every segment checked.
+                result = centre_route(model, start, goal, 0, terminate, box, near)
+        except MarkingStopped:
+            break  # out of time in this corridor: the best of those before it
         if result.path is not None and (best is None or result.length < best.length):
             best = result
     if best is None:

@@ -306,15 +306,16 @@ def _search_boxes(path: np.ndarray, world: World, fraction: float):
     return lo, hi, seg_len
 
 
-def _violation_within(world: World, pt_lo: np.ndarray, pt_hi: np.ndarray):
-    """The world's violation for segments whose end points stay in the boxes ``pt_lo[k]``..
-    ``pt_hi[k]`` (consecutive points, ``(S + 1, 2)``): culled to the obstacles near each
-    segment's box when the world can (exact for such segments), else the full check."""
+def _violation_within(world: World, seg_lo: np.ndarray, seg_hi: np.ndarray,
+                      deadline: float | None):  # fmt: skip
+    """The world's violation for segments that stay in the boxes ``seg_lo[s]..seg_hi[s]``:
+    culled to the obstacles near each box when the world can (exact for such segments), else
+    the full check. None when building the culled model would end after ``deadline``
+    (:meth:`~rrtpso_ompl.model.World.local_model`): no time for a swarm round."""
     if not hasattr(world, "local_model"):
-        return None
-    seg_lo = np.minimum(pt_lo[:-1], pt_lo[1:])
-    seg_hi = np.maximum(pt_hi[:-1], pt_hi[1:])
-    return world.local_model(seg_lo, seg_hi).violation
+        return world.segment_violation
+    local = world.local_model(seg_lo, seg_hi, deadline)
+    return None if local is None else local.violation
 
 
 def _pso_round(
@@ -336,8 +337,13 @@ def _pso_round(
     # close neighbours must not be thrown across them.
     local = np.minimum(seg_len[:-1], seg_len[1:])
     sigma = np.repeat(options.init_spread * np.maximum(local, world.tol), 2)
-    violation = _violation_within(world, np.vstack([seed_path[:1], lo, seed_path[-1:]]),
-                                  np.vstack([seed_path[:1], hi, seed_path[-1:]]))  # fmt: skip
+    pt_lo = np.vstack([seed_path[:1], lo, seed_path[-1:]])
+    pt_hi = np.vstack([seed_path[:1], hi, seed_path[-1:]])
+    violation = _violation_within(world, np.minimum(pt_lo[:-1], pt_lo[1:]),
+                                  np.maximum(pt_hi[:-1], pt_hi[1:]), deadline)  # fmt: skip
+    if violation is None:
+        return seed_path, _unstarted(interior.reshape(-1), _cost_of(cost_model, seed_path),
+                                     time.perf_counter())  # fmt: skip
     round_cost = PathCost(cost_model.start, cost_model.goal, world, cost_model.smoothness_weight,
                           violation, cost_model.objective, cost_model.field)  # fmt: skip
 
@@ -415,7 +421,8 @@ def _swarm(terms, offset, lo, hi, options, rng, init, seg_len, terminate, deadli
     )
 
 
-def _window_boxes(seed_path: np.ndarray, world, options: PathOptimizerOptions, offset: int):
+def _window_boxes(seed_path: np.ndarray, world, options: PathOptimizerOptions, offset: int,
+                  deadline: float | None = None):  # fmt: skip
     """The windows of one round (:func:`_windows`, ``-1`` for an empty slot) and what their
     swarm needs: each slot's waypoint index (an empty slot's: its window's closing fixed
     waypoint), the search box of each slot ``(K, W, 2)`` (an empty slot's is that waypoint),
@@ -439,8 +446,7 @@ def _window_boxes(seed_path: np.ndarray, world, options: PathOptimizerOptions, o
     # Segment boxes of every chain, for the culled exact check.
     seg_lo = np.minimum(chain_lo[:, :-1], chain_lo[:, 1:]).reshape(-1, 2)
     seg_hi = np.maximum(chain_hi[:, :-1], chain_hi[:, 1:]).reshape(-1, 2)
-    violation = (world.local_model(seg_lo, seg_hi).violation if hasattr(world, "local_model")
-                 else world.segment_violation)  # fmt: skip
+    violation = _violation_within(world, seg_lo, seg_hi, deadline)
     return win, slot_idx, lo, hi, before, after, seg_len, violation
 
 
@@ -465,8 +471,11 @@ def _window_round(
     world = cost_model.world
     width = options.window
     win, slot_idx, lo, hi, before, after, seg_len, violation = _window_boxes(
-        seed_path, world, options, offset
+        seed_path, world, options, offset, deadline
     )
+    if violation is None:  # no time to build the culled check: the seed as it is
+        x0 = seed_path[1:-1].reshape(-1)
+        return seed_path, _unstarted(x0, _cost_of(cost_model, seed_path), time.perf_counter())
     real = win >= 0
     n_win = len(win)
 

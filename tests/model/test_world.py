@@ -603,6 +603,63 @@ def test_after_its_deadline_the_world_refuses_motions_unchecked():
     assert world.motion_free(10, 10, 20, 10) and world.refuse_after is None
 
 
+def _counting_stop(fire_at: int):
+    """A stop condition that fires at its ``fire_at``-th look (and counts them)."""
+    looks = []
+
+    def stop() -> bool:
+        looks.append(1)
+        return len(looks) >= fire_at
+
+    return stop, looks
+
+
+def test_a_lattice_marking_stops_when_its_condition_fires():
+    """Marking a lattice among the 20,000 edges of a gear looks at its stop condition between
+    chunks and raises MarkingStopped when it fires; outside the block nothing stops it."""
+    from rrtpso_ompl.model.raster import Lattice
+    from rrtpso_ompl.model.world import MarkingStopped
+
+    world = World(BOUNDS, [], [_gear(20_000)], 1.0)
+    lat = Lattice.over(world.bounds, 0.25)  # 160,000 cells, millions of (cell, edge) pairs
+    stop, looks = _counting_stop(3)
+    with world.marking_stops(stop), pytest.raises(MarkingStopped):
+        world.centres_free(lat)
+    assert len(looks) == 3 and world.mark_stop is None
+    small = Lattice.over(world.bounds, 5.0)
+    with world.marking_stops(lambda: False):
+        np.testing.assert_array_equal(world.centres_free(small), _brute(world).centres_free(small))
+
+
+def test_the_culled_model_is_not_built_when_it_would_end_after_the_deadline():
+    """Its cost is known before it is built (the index's registrations in the boxes): with a
+    deadline already past, None; with time, the model (whatever the machine's speed)."""
+    import time
+
+    world = World(BOUNDS, [], [_gear(20_000)], 1.0)
+    seg_lo, seg_hi = np.array([[25.0, 25.0]]), np.array([[75.0, 75.0]])
+    assert world.local_model(seg_lo, seg_hi, deadline=time.perf_counter() - 1.0) is None
+    assert world.local_model(seg_lo, seg_hi, deadline=time.perf_counter() + 1e6) is not None
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_registrations_in_boxes_count_what_the_index_holds_there(seed):
+    """The summed-area count equals the registrations of the cells each box meets, and bounds
+    the unique pairs ``pairs_in_boxes`` returns."""
+    world = _crowded_world(seed, 1.0)
+    grid = world._grid
+    rng = np.random.default_rng(seed)
+    lo = rng.uniform(-10, 100, (50, 2))
+    hi = lo + rng.uniform(0, 60, (50, 2))
+    counts = grid.registrations_in_boxes(lo, hi)
+    per_cell = np.diff(grid.offsets).reshape(grid.ny, grid.nx)
+    i0, i1, j0, j1 = grid._ranges(np.hstack([lo, hi]))
+    brute = [per_cell[j0[q] : j1[q] + 1, i0[q] : i1[q] + 1].sum() for q in range(50)]
+    np.testing.assert_array_equal(counts, brute)
+    query, _ = grid.pairs_in_boxes(lo, hi)
+    assert np.all(np.bincount(query, minlength=50) <= counts)
+
+
 def test_the_round_off_allowance_is_relative_at_every_scale():
     tiny = ((0.0, 0.0), (1e-6, 1e-6))
     assert World(tiny, [], [], 0.0).tol == pytest.approx(1e-15)

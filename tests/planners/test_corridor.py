@@ -169,3 +169,38 @@ def test_a_disc_robot_on_a_map_is_pulled_round_the_door_jambs(radius):
     assert res.path is not None and world.path_valid(res.path)
     exact = _optimum(world, start, goal)
     assert exact * (1 - 1e-9) <= res.length <= exact * 1.002
+
+
+def _detailed_world() -> World:
+    """A gear of 20,000 vertices across the straight line: marking a lattice among its edges
+    is slow enough to matter at a real-time budget."""
+    k = np.arange(20_000)
+    rad = np.where(k % 2, 23.0, 20.0)
+    ang = 2 * np.pi * k / len(k)
+    gear = np.column_stack([50 + rad * np.cos(ang), 50 + rad * np.sin(ang)])
+    return World(((0.0, 0.0), (100.0, 100.0)), [], [gear], 1.0)
+
+
+def test_the_corridor_stage_stops_marking_cells_when_terminated():
+    """The stage's termination condition reaches into a lattice marking: fired at its fifth
+    look (whatever the clock says), the stage ends without a path and says why."""
+    from rrtpso_ompl.planners.corridor import search
+
+    looks = []
+
+    def terminate() -> bool:
+        looks.append(1)
+        return len(looks) >= 5
+
+    result = search(_detailed_world(), (5.0, 5.0), (95.0, 95.0), 1e6, terminate=terminate)
+    assert result.path is None and result.reason == "out of time marking the lattice's cells"
+    assert len(looks) == 5
+
+
+def test_obstacles_too_detailed_to_mark_in_time_end_the_stage_at_once():
+    """The probe that measures the cost of marking is cut at its share of the time: with none
+    (a budget of 0 s) the stage gives up before any lattice."""
+    from rrtpso_ompl.planners.corridor import search
+
+    result = search(_detailed_world(), (5.0, 5.0), (95.0, 95.0), 0.0)
+    assert result.path is None and "too slow" in result.reason and result.lattice is None

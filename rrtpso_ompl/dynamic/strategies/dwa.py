@@ -68,7 +68,7 @@ class DWA:
         if len(path) >= 2:
             params = dict(options.params)
             if seed is not None and default_registry().get(options.planner).takes("seed"):
-                # OMPL is seeded once per process: the guide's planner takes the run's seed.
+                # The guide's planner takes the run's seed (OMPL is not reseeded here).
                 params.setdefault("seed", seed)
             guide = guide_path(problem, path, options.planner, budget, params)
         return simulate_dwa(problem, guide, self.params, options, seed, progress)
