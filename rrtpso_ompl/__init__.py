@@ -29,6 +29,7 @@ from .errors import (
     ProblemError,
     RrtpsoError,
     UnknownPlannerError,
+    UnsupportedSpaceError,
 )
 from .model import Problem, World, load_problem, problem_from_dict
 
@@ -55,6 +56,7 @@ __all__ = [
     "RrtpsoError",
     "SolveResult",
     "UnknownPlannerError",
+    "UnsupportedSpaceError",
     "World",
     "__version__",
     "default_registry",

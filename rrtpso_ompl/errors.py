@@ -24,6 +24,7 @@ __all__ = [
     "ProblemError",
     "RrtpsoError",
     "UnknownPlannerError",
+    "UnsupportedSpaceError",
     "UsageError",
     "did_you_mean",
 ]
@@ -133,6 +134,12 @@ class UnknownPlannerError(PlannerError, KeyError):
 
     def __reduce__(self):
         return (type(self), (self.name, self.known, self.reason, self.origin))
+
+
+class UnsupportedSpaceError(PlannerError, ValueError):
+    """A planner or path optimiser of this package was given an OMPL state space it does not plan
+    in (for now: anything but ``ob.RealVectorStateSpace(2)``). The message names the space and
+    what is supported; OMPL's own planners plan in such spaces."""
 
 
 class UsageError(RrtpsoError):

@@ -9,7 +9,8 @@ OMPL, one property per check:
 :func:`check_solves`      an exact path within the budget (a planner that never finds one
                           fails: no check passes by skipping)
 :func:`check_valid_path`  the planner's own path (before any check of the harness) is valid by
-                          the exact world check and runs from the start to the goal
+                          the exact world check and runs from the start to the goal (also
+                          after an expired termination condition, if it reports one)
 :func:`check_cost_never_rises`
                           the best-cost samples never increase, and the returned path is no
                           longer than the planner's own first path (RRTstarPSO: its RRT* path)
@@ -25,6 +26,12 @@ OMPL, one property per check:
 :func:`check_benchmark_run`
                           the stats' run in OMPL's terms is well formed: its times and lengths
                           add up to the solve's, its properties are typed, it survives JSON
+:func:`check_other_spaces`
+                          never a wrong answer in a user's own ``og.SimpleSetup`` on spaces the
+                          planner may not support (R^3, R^6, SE(2), Reeds-Shepp): it
+                          refuses (an exception before ``solve``, or a status without a path),
+                          or every path it leaves starts at the start, is valid by the user's
+                          checker along every motion and, if exact, ends in the goal
 ========================  =================================================================
 
 Each check is a plain function ``check(entry_or_name, *, problem=None, budget=BUDGET, seed=1,
@@ -72,12 +79,15 @@ __all__ = [
     "CHECKS",
     "DEADLINE_FACTOR",
     "DEADLINE_SLACK",
+    "OTHER_SPACES",
+    "OTHER_SPACES_BUDGET",
     "SIMPLE_PROBLEM",
     "TINY_BUDGET",
     "check_benchmark_run",
     "check_clear_and_solve_again",
     "check_cost_never_rises",
     "check_deadline",
+    "check_other_spaces",
     "check_parameters",
     "check_planner",
     "check_solves",
@@ -108,6 +118,16 @@ DEADLINE_FACTOR = 1.5
 DEADLINE_SLACK = 0.2
 #: Round-off allowed when comparing lengths and costs (relative).
 _RTOL = 1e-9
+#: The spaces of :func:`check_other_spaces`: a user's own ``og.SimpleSetup`` in each. Not
+#: Dubins: there OMPL's own BKPIECE1, LBKPIECE1, KPIECE1, PRM and PRMstar return paths that
+#: OMPL's own ``PathGeometric.check()`` rejects (measured: up to 10 of 10 runs; they check some
+#: motions in the other direction, or end a motion part-way, which on a Dubins curve is another
+#: curve), so the check would report OMPL's fault, not the planner's under test.
+OTHER_SPACES = ("R^3", "R^6", "SE(2)", "Reeds-Shepp")
+#: Seconds per solve in :func:`check_other_spaces`: OMPL's planners find a path in each of its
+#: spaces in milliseconds; one that finds none in time passes all the same (the property is
+#: "never a wrong answer", not speed).
+OTHER_SPACES_BUDGET = 0.1
 
 
 @functools.cache
@@ -150,6 +170,8 @@ def check_valid_path(
         which = ("first solve", "solve after clear()")[i]
         assert status == "Exact solution", f"{case.name}: {which}: no exact path ({status})"
         _check_path(case, xy, which)
+    if direct.statuses[2] == "Exact solution":  # no time at all is no excuse for a wrong path
+        _check_path(case, direct.paths[2], "solve with an expired termination condition")
 
 
 def check_cost_never_rises(
@@ -323,6 +345,37 @@ def check_benchmark_run(
     json.dumps(result.to_dict())  # raises for a value JSON cannot hold (stages included)
 
 
+def check_other_spaces(
+    entry: PlannerEntry | str,
+    *,
+    problem: Problem | None = None,
+    budget: float = BUDGET,
+    seed: int = 1,
+    registry: PlannerRegistry | None = None,
+) -> None:
+    """Never a wrong answer in a user's own ``og.SimpleSetup`` on a space the planner may not
+    support: each of :data:`OTHER_SPACES`, bounds ``[0, 10]`` on every axis (SE(2): ``x``,
+    ``y``), a ball of radius 2 at the centre across the straight line from start
+    ``(1, ..., 1)`` to goal ``(9, ..., 9)`` (SE(2): yaw 0 at both), a Python validity checker
+    and :data:`OTHER_SPACES_BUDGET` seconds.
+
+    The planner may refuse: an exception from its construction or ``setup()`` (before any
+    solve), or a status with no path in the problem definition. An exception from ``solve``
+    fails (it would end a whole OMPL Benchmark). Every path the problem definition holds must
+    start at the start and be valid at each of its states and along each motion, by the user's
+    checker on states from the space's own ``interpolate`` at the space's resolution (the states
+    OMPL's own motion validators check, so a planner OMPL accepts passes by property); an exact
+    one must end in the goal (``goal.isSatisfied``), and an exact status needs an exact path.
+
+    The objective's cost threshold is infinite, so optimizing planners stop at their first path
+    (this checks answers, not their quality). ``problem`` and ``budget`` are not used (the
+    planner's parameters are those it gets for the simple problem, at this budget).
+    """
+    case = _case(entry, problem, budget, seed, registry)
+    failures = [f for kind in OTHER_SPACES if (f := _other_space_failure(case, kind))]
+    assert not failures, "\n".join(failures)
+
+
 #: Every check, in the order :func:`check_planner` runs them.
 CHECKS: tuple[Callable[..., None], ...] = (
     check_solves,
@@ -332,6 +385,7 @@ CHECKS: tuple[Callable[..., None], ...] = (
     check_clear_and_solve_again,
     check_parameters,
     check_benchmark_run,
+    check_other_spaces,
 )
 
 
@@ -535,6 +589,139 @@ def _direct(case: _Case) -> _Direct:
         return _Direct(tuple(statuses), tuple(paths), tuple(times))
 
     return _memo("direct", case, run)
+
+
+@dataclass(frozen=True)
+class _Scene:
+    """A space of :func:`check_other_spaces` with its ball and a user's Python checker.
+
+    ``dim`` coordinates are bounded by ``[0, 10]`` and measured from the ball's centre (SE(2)
+    and Reeds-Shepp, turning radius 1: ``x`` and ``y``; the yaw is free)."""
+
+    kind: str
+    space: Any
+    dim: int
+    se2: bool
+
+    @classmethod
+    def make(cls, kind: str) -> _Scene:
+        from ompl import base as ob
+
+        if kind.startswith("R^"):
+            n = int(kind[2:])
+            return cls(kind, ob.RealVectorStateSpace(n), n, False)
+        space = ob.SE2StateSpace() if kind == "SE(2)" else ob.ReedsSheppStateSpace(1.0)
+        return cls(kind, space, 2, True)
+
+    def bound(self) -> None:
+        from ompl import base as ob
+
+        bounds = ob.RealVectorBounds(self.dim)
+        bounds.setLow(0.0)
+        bounds.setHigh(10.0)
+        self.space.setBounds(bounds)
+
+    def coords(self, state: Any) -> list[float]:
+        """The state's coordinates (copied: OMPL's states are borrowed)."""
+        if self.se2:
+            return [state.getX(), state.getY(), state.getYaw()]
+        return [state[i] for i in range(self.dim)]
+
+    def state(self, value: float) -> Any:
+        """A state with every bounded coordinate ``value`` (and yaw 0)."""
+        s = self.space.allocState()
+        if self.se2:
+            s.setXY(value, value)
+            s.setYaw(0.0)
+        else:
+            for i in range(self.dim):
+                s[i] = value
+        return s
+
+    def valid(self, state: Any) -> bool:
+        """The user's checker: inside the bounds and outside the ball of radius 2 at 5."""
+        xs = (state.getX(), state.getY()) if self.se2 else [state[i] for i in range(self.dim)]
+        inside = all(0.0 <= x <= 10.0 for x in xs)
+        return inside and sum((x - 5.0) ** 2 for x in xs) > 4.0
+
+
+def _other_space_failure(case: _Case, kind: str) -> str | None:
+    """The planner in a user's own setup of ``kind``: what it got wrong, or None."""
+    from ompl import base as ob
+    from ompl import geometric as og
+
+    from .ompl_setup import seed_ompl
+
+    name, where = case.name, f"{case.name} in a user's {kind} SimpleSetup"
+    request = resolve(case.problem, name, time_limit=OTHER_SPACES_BUDGET, seed=case.seed,
+                      registry=case.registry)  # fmt: skip
+    seed_ompl(request.seed)
+    scene = _Scene.make(kind)
+    scene.bound()
+    ss = og.SimpleSetup(scene.space)
+    ss.setStateValidityChecker(scene.valid)
+    start, goal = scene.state(1.0), scene.state(9.0)
+    ss.setStartAndGoalStates(start, goal)
+    si = ss.getSpaceInformation()
+    objective = ob.PathLengthOptimizationObjective(si)
+    objective.setCostThreshold(ob.Cost(math.inf))  # any path will do: stop at the first
+    ss.setOptimizationObjective(objective)
+    try:
+        ss.setPlanner(request.entry.make(si, request.values))
+        ss.setup()
+    except Exception:  # refused before any solve: no answer, so no wrong one
+        return None
+    try:
+        status = ss.solve(ob.timedPlannerTerminationCondition(OTHER_SPACES_BUDGET))
+    except Exception as exc:
+        return (f"{where}: solve() raised {exc!r} (refuse at setup(), or return a failed "
+                f"status: an exception out of solve() ends a whole OMPL Benchmark)")  # fmt: skip
+    pdef = ss.getProblemDefinition()
+    said_exact = status.getStatus() == ob.PlannerStatus.EXACT_SOLUTION
+    if said_exact and not pdef.hasExactSolution():
+        return f"{where}: reported {str(status)!r}, but holds no exact path"
+    if not pdef.hasSolution():
+        return None
+    exact = not pdef.hasApproximateSolution()
+    path = pdef.getSolutionPath()
+    wrong = _other_path_wrong(scene, si, pdef, path, start, exact)
+    if wrong is None:
+        return None
+    what = "exact" if exact else "approximate"
+    return f"{where}: reported {str(status)!r} with a wrong {what} path: {wrong}"
+
+
+def _other_path_wrong(
+    scene: _Scene, si: Any, pdef: Any, path: Any, start: Any, exact: bool
+) -> str | None:
+    """What is wrong with a path of :func:`check_other_spaces`, or None."""
+    space = scene.space
+    states = path.getStates()
+    if not states:
+        return "it has no states"
+    tol = 1e-9 * max(si.getMaximumExtent(), 1.0)
+    if space.distance(states[0], start) > tol:
+        return (f"it starts at {_fmt(scene.coords(states[0]))}, not at the start "
+                f"{_fmt(scene.coords(start))}")  # fmt: skip
+    if exact and not pdef.getGoal().isSatisfied(states[-1]):
+        return f"it ends at {_fmt(scene.coords(states[-1]))}, which is not in the goal"
+    for i, s in enumerate(states):
+        if not scene.valid(s):
+            return f"its state {i}, {_fmt(scene.coords(s))}, is invalid by the user's checker"
+    probe = space.allocState()
+    for i, (a, b) in enumerate(itertools.pairwise(states)):
+        n = space.validSegmentCount(a, b)
+        for j in range(1, n):
+            space.interpolate(a, b, j / n, probe)
+            if not scene.valid(probe):
+                return (f"its motion {i} from {_fmt(scene.coords(a))} to "
+                        f"{_fmt(scene.coords(b))} passes through {_fmt(scene.coords(probe))}, "
+                        f"invalid by the user's checker")  # fmt: skip
+    return None
+
+
+def _fmt(xs: Iterable[float]) -> str:
+    return "(" + ", ".join(f"{x:.4g}" for x in xs) + ")"
 
 
 def _check_path(case: _Case, xy: np.ndarray, which: str) -> None:

@@ -7,6 +7,8 @@
   objective every planner optimises (:mod:`.objective`);
 - :func:`path_to_array`, :func:`array_to_path`, :func:`assign_path`: paths as numpy arrays
   and back (:mod:`.convert`);
+- :func:`plane_space_problem`, :func:`require_plane_space`: the one state space this package's
+  planners plan in, ``ob.RealVectorStateSpace(2)``, and why another is refused (:mod:`.space`);
 - :func:`seed_ompl`, :func:`set_ompl_log_level`: OMPL's process-wide seed, applied before each
   seeded solve builds its OMPL objects, and its log level (:mod:`.process`).
 """
@@ -20,17 +22,22 @@ from .context import (
 from .convert import array_to_path, assign_path, path_to_array
 from .objective import InflationObjective, objective_for
 from .process import seed_ompl, set_ompl_log_level
+from .space import PLANE_SPACE, describe_space, plane_space_problem, require_plane_space
 
 __all__ = [
+    "PLANE_SPACE",
     "ExactMotionValidator",
     "InflationObjective",
     "PlanningContext",
     "WorldValidityChecker",
     "array_to_path",
     "assign_path",
+    "describe_space",
     "make_context",
     "objective_for",
     "path_to_array",
+    "plane_space_problem",
+    "require_plane_space",
     "seed_ompl",
     "set_ompl_log_level",
 ]

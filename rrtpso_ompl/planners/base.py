@@ -12,6 +12,10 @@
   slower adapter over ``si.checkMotion`` so the planner works in any ``SimpleSetup``.
 * A numpy ``Generator`` seeded either by the ``seed`` parameter or from OMPL's own RNG, so that
   ``ompl.util.RNG.setSeed`` alone makes a whole run reproducible.
+* The plane only, for now: in any state space but ``ob.RealVectorStateSpace(2)`` the planner
+  refuses (the reason in ``planner.unsupported``, logged at ``setup()`` and at each ``solve()``,
+  which returns ``ABORT`` and adds no path), never reading a state as two coordinates
+  (:mod:`rrtpso_ompl.ompl_setup.space`).
 """
 
 from __future__ import annotations
@@ -28,9 +32,11 @@ import numpy as np
 from ompl import base as ob
 from ompl import util as ou
 
+from ..errors import UnsupportedSpaceError
 from ..model.problem import touch_tolerance
 from ..model.raster import Lattice
 from ..model.world import MarkingStopped
+from ..ompl_setup.space import plane_space_problem, require_plane_space
 from ..validation import MAX_SECONDS, SEED_MAX
 from .params import ParamSpec, ParamTable
 from .result import BenchmarkRun
@@ -144,6 +150,7 @@ class SpaceInformationCollisionModel:
     """
 
     def __init__(self, si: ob.SpaceInformation, fine: float = FINE_RESOLUTION) -> None:
+        require_plane_space(si, "SpaceInformationCollisionModel")  # it writes st[0], st[1]
         self.si = si
         bounds = si.getStateSpace().getBounds()
         self.bounds = ((bounds.low[0], bounds.low[1]), (bounds.high[0], bounds.high[1]))
@@ -298,7 +305,20 @@ class PythonPlanner(ob.Planner):
 
     Subclasses define ``PARAMS`` (a :class:`~rrtpso_ompl.planners.params.ParamTable`) and
     implement ``_solve(ptc)`` returning an ``ob.PlannerStatus``; the statistics of the last solve
-    (a :class:`PlannerStats`) go to ``self.last_stats``.
+    (a :class:`PlannerStats`) go to ``self.last_stats``. ``_solve`` is only called in the plane
+    (``ob.RealVectorStateSpace(2)``): a subclass's ``setup`` does nothing of its own when
+    :attr:`unsupported` is set.
+
+    Attributes
+    ----------
+    unsupported : str or None
+        Why the planner does not plan in the space information's state space (one sentence
+        naming the space), or None in the plane. Then ``setup()`` logs it as an error and every
+        ``solve()`` logs it and returns ``ob.PlannerStatus.ABORT`` ("the planner did not find a
+        solution for some other reason": nothing crashed, and the problem is not infeasible),
+        without adding a path to the problem definition. No exception: one raised in ``setup``
+        or ``solve`` would escape ``ss.solve()`` and end a whole OMPL Benchmark of several
+        planners.
     """
 
     PARAMS: ParamTable = ParamTable()
@@ -309,6 +329,11 @@ class PythonPlanner(ob.Planner):
         self.set_params(**params)
         self._ompl_rng: ou.RNG | None = None
         self.last_stats: PlannerStats | None = None
+        problem = plane_space_problem(si)
+        self.unsupported: str | None = None if problem is None else (
+            f"{name} refuses to plan: {problem}; OMPL's own planners (e.g. og.RRTstar) plan "
+            f"in it")  # fmt: skip
+        self._refusal_told = False  # setup() has just logged it (solve() does not repeat it)
 
     # -- parameters (scikit-learn's get_params / set_params) -----------------------------------
     def get_params(self) -> dict[str, Any]:
@@ -335,6 +360,15 @@ class PythonPlanner(ob.Planner):
         self._values[name] = value
 
     # -- lifecycle -----------------------------------------------------------------------------
+    def setup(self) -> None:
+        """OMPL's set-up; in a space the planner does not plan in, one error line saying why
+        (:attr:`unsupported`). Subclasses call it first and return when :attr:`unsupported` is
+        set."""
+        super().setup()
+        if self.unsupported is not None:
+            log.error("%s", self.unsupported)
+            self._refusal_told = True
+
     def clear(self) -> None:
         super().clear()
         self.last_stats = None
@@ -348,6 +382,11 @@ class PythonPlanner(ob.Planner):
         if self.getProblemDefinition() is None:
             log.error("%s: no problem definition: call setProblemDefinition() (or use "
                       "og.SimpleSetup) before solve()", self.getName())  # fmt: skip
+            return ob.PlannerStatus(ob.PlannerStatus.ABORT)
+        if self.unsupported is not None:
+            if not self._refusal_told:  # said once per solve, not twice after ss.solve's setup
+                log.error("%s", self.unsupported)
+            self._refusal_told = False
             return ob.PlannerStatus(ob.PlannerStatus.ABORT)
         try:
             return self._solve(ptc)
@@ -364,11 +403,25 @@ class PythonPlanner(ob.Planner):
 
         Uses the PlannerInputStates (never ``pdef.getStartState``, which frees OMPL's own state
         when the Python wrapper dies) and restarts it, since OMPL consumes starts between solves.
+
+        Raises
+        ------
+        UnsupportedSpaceError
+            Outside the plane (:attr:`unsupported`; ``solve`` refuses before this is reached):
+            a state is never read as two coordinates of something else.
         """
+        if self.unsupported is not None:
+            raise UnsupportedSpaceError(self.unsupported)
         pis = self.getPlannerInputStates()
         pis.restart()
         s = pis.nextStart()
         g = pis.nextGoal(ptc)
+        for state in (s, g):
+            if state is not None and not isinstance(state, ob.RealVectorStateType):
+                raise UnsupportedSpaceError(
+                    f"{self.getName()}: a state of type {type(state).__name__}, not a 2-D real "
+                    f"vector: this package's planners plan only in ob.RealVectorStateSpace(2)"
+                )
         start = None if s is None else (s[0], s[1])
         goal = None if g is None else (g[0], g[1])
         return start, goal

@@ -85,7 +85,8 @@ class ExactPlanner(PythonPlanner):
     ----------
     si : ompl.base.SpaceInformation
         A 2-D real vector space whose validity checker carries the world (as
-        :func:`~rrtpso_ompl.ompl_setup.make_context` builds it).
+        :func:`~rrtpso_ompl.ompl_setup.make_context` builds it); in any other space it refuses
+        (:class:`~rrtpso_ompl.planners.base.PythonPlanner`).
     name : str
         Planner name.
     **params

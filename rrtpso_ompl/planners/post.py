@@ -31,6 +31,7 @@ from ..model.geometry import path_length as path_length_of
 from ..model.objective import InflationCost
 from ..ompl_setup import InflationObjective, assign_path, path_to_array
 from ..ompl_setup.objective import path_cost
+from ..ompl_setup.space import require_plane_space
 from .base import SpaceInformationCollisionModel, collision_model_for, refusing_motions_after
 from .path_optimizer import PathOptimizationResult, PathOptimizerOptions, optimize_path
 from .request import POST_PARAMS, POST_STEPS, parse_steps, split_spec
@@ -85,7 +86,8 @@ class PSOPathOptimizer:
     Parameters
     ----------
     si : ompl.base.SpaceInformation
-        A 2-D real vector space with the user's validity checker (and motion validator).
+        A 2-D real vector space (``ob.RealVectorStateSpace(2)``) with the user's validity checker
+        (and motion validator).
     options : PathOptimizerOptions, optional
         The swarm's and the optimiser's parameters (defaults when omitted); or pass them by name
         in ``params``.
@@ -100,6 +102,13 @@ class PSOPathOptimizer:
         :class:`~rrtpso_ompl.model.objective.InflationCost` itself), else the length.
     **params
         Parameters by name (``swarm_size=40, ...``), as :data:`PathOptimizerOptions` declares.
+
+    Raises
+    ------
+    UnsupportedSpaceError
+        When ``si``'s space is not ``ob.RealVectorStateSpace(2)`` (SE(2), Dubins, ``R^3``, ...):
+        the swarm moves waypoints in the plane, so it refuses here, at construction, rather than
+        hand back a path of the wrong space. OMPL's ``og.PathSimplifier`` works in any space.
 
     Examples
     --------
@@ -120,6 +129,7 @@ class PSOPathOptimizer:
     ) -> None:
         if options is not None and params:
             raise TypeError("give the options or parameters by name, not both")
+        require_plane_space(si, "PSOPathOptimizer")
         self.si = si
         self.options = options or PathOptimizerOptions()
         self.set_params(**params)
@@ -289,7 +299,8 @@ def run_post(
     OMPL's simplifier gets at most ``simplify_share`` of what is left when the swarm follows it;
     the swarm gets the rest. ``values`` holds the swarm's and :data:`POST_PARAMS`' parameters by
     name (defaults for the missing ones). With the problem's ``objective`` (an OMPL objective)
-    no step raises its cost: a step that did is undone.
+    no step raises its cost: a step that did is undone. ``simplify`` works in any state space;
+    ``pso`` only in the plane (:class:`PSOPathOptimizer` raises ``UnsupportedSpaceError``).
     """
     steps = tuple(steps)
     values = dict(values or {})
@@ -298,15 +309,17 @@ def run_post(
     for i, step in enumerate(steps):
         t0 = time.perf_counter()
         before = float(path.length())
-        saved = path_to_array(path)
+        saved = og.PathGeometric(path)  # a copy, of whatever space (not read as coordinates)
         cost_before = path_cost(objective, path) if objective is not None else None
         left = max(deadline - t0, 0.0)
         if step == "simplify":
             share = post["simplify_share"] if "pso" in steps[i + 1 :] else 1.0
             if left > 0:
                 seconds = max(share * left, 1e-4)
-                # Our world also cuts a long batch short (it refuses motions after the time).
-                with refusing_motions_after(world or collision_model_for(si), t0 + seconds):
+                # Our world also cuts a long batch short (it refuses motions after the time);
+                # a user's checker, in any space, is OMPL's to call.
+                ours = world or getattr(si.getStateValidityChecker(), "world", None)
+                with refusing_motions_after(ours, t0 + seconds):
                     simplify_until(si, path, t0 + seconds, objective)
         else:
             options = PathOptimizerOptions.from_values(values)
@@ -315,11 +328,18 @@ def run_post(
             optimizer.optimize(path, left if left > 0 else 0.0)
         cost_after = path_cost(objective, path) if objective is not None else None
         if cost_after is not None and cost_after > cost_before:
-            assign_path(si, path, saved)  # the step raised the objective: undone
+            _restore(path, saved)  # the step raised the objective: undone
             cost_after = cost_before
         out.append(PostStep(step, before, float(path.length()), time.perf_counter() - t0,
                             cost_before, cost_after))  # fmt: skip
     return out
+
+
+def _restore(path: og.PathGeometric, saved: og.PathGeometric) -> None:
+    """Put the states of ``saved`` back into ``path``, in place (``append`` copies each)."""
+    path.clear()
+    for state in saved.getStates():
+        path.append(state)
 
 
 def inflation_of(objective: Any) -> InflationCost | None:

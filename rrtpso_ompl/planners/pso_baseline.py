@@ -85,7 +85,8 @@ class PSOPlanner(PythonPlanner):
     Parameters
     ----------
     si : ompl.base.SpaceInformation
-        A 2-D real vector space (see :class:`~rrtpso_ompl.planners.RRTstarPSO`).
+        A 2-D real vector space; in any other it refuses (see
+        :class:`~rrtpso_ompl.planners.RRTstarPSO`).
     name : str
         Planner name.
     **params

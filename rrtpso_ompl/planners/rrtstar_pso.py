@@ -246,7 +246,9 @@ class RRTstarPSO(PythonPlanner):
     Parameters
     ----------
     si : ompl.base.SpaceInformation
-        A 2-D real vector space. When its validity checker carries a ``world`` (as built by
+        A 2-D real vector space (``ob.RealVectorStateSpace(2)``): in any other space the planner
+        refuses, saying why (``planner.unsupported``, logged; ``solve`` returns ``ABORT``). When
+        its validity checker carries a ``world`` (as built by
         :func:`rrtpso_ompl.ompl_setup.make_context`), candidate paths are checked in vectorised
         form; otherwise each segment goes through ``si.checkMotion``.
     name : str
@@ -265,6 +267,8 @@ class RRTstarPSO(PythonPlanner):
 
     def setup(self) -> None:
         super().setup()
+        if self.unsupported is not None:
+            return  # not the plane: solve() refuses (logged), nothing to set up
         self.inner.setProblemDefinition(self.getProblemDefinition())
         for name in _INNER:
             getattr(self.inner, self.PARAMS[name].setter)(self._values[name])

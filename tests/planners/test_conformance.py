@@ -25,6 +25,7 @@ from rrtpso_ompl.testing import (
     check_clear_and_solve_again,
     check_cost_never_rises,
     check_deadline,
+    check_other_spaces,
     check_parameters,
     check_planner,
     check_solves,
@@ -189,8 +190,127 @@ def test_a_planner_that_takes_a_value_out_of_range_is_caught():
         check_parameters(SLOPPY, problem=OPEN, budget=FAST)
 
 
+class Hasty(Line):
+    """OMPL's RRTConnect, but the straight line when the condition has already fired."""
+
+    def __init__(self, si, name="Hasty"):
+        super().__init__(si, name)
+        self.inner = og.RRTConnect(si)
+
+    def setup(self):
+        super().setup()
+        self.inner.setProblemDefinition(self.getProblemDefinition())
+        self.inner.setup()
+
+    def clear(self):
+        super().clear()
+        self.inner.clear()
+
+    def solve(self, ptc):
+        return super().solve(ptc) if ptc() else self.inner.solve(ptc)
+
+
+class TwoCoordinates(Line):
+    """Issue 32's RRTstarPSO: reads two coordinates of each state and makes a path of new
+    states with those two set (the others at 8.739), in any real vector space."""
+
+    def solve(self, ptc):
+        pis = self.getPlannerInputStates()
+        pis.restart()
+        start, goal = pis.nextStart(), pis.nextGoal(ptc)
+        si = self.getSpaceInformation()
+        if not isinstance(start, ob.RealVectorStateType):
+            return ob.PlannerStatus(ob.PlannerStatus.CRASH)
+        path = og.PathGeometric(si)
+        for x, y in ((start[0], start[1]), (goal[0], goal[1])):
+            state = si.allocState()
+            for i in range(si.getStateDimension()):
+                state[i] = 8.739
+            state[0], state[1] = x, y
+            path.append(state)
+        self.getProblemDefinition().addSolutionPath(path, False, 0.0, self.getName())
+        return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
+
+
+class Boaster(Line):
+    """Says "Exact solution" and leaves no path."""
+
+    def solve(self, ptc):
+        return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
+
+
+class Raiser(Line):
+    """Raises out of solve in any space but the plane."""
+
+    def solve(self, ptc):
+        if self.getSpaceInformation().getStateDimension() != 2:
+            raise TypeError("'SE2StateType' object is not subscriptable")
+        return super().solve(ptc)
+
+
+class SetupRefuser(Line):
+    """Refuses every space but R^2 with an exception from setup(), before any solve."""
+
+    def setup(self):
+        if not isinstance(self.getSpaceInformation().getStateSpace(), ob.RealVectorStateSpace):
+            raise ValueError("SetupRefuser plans in R^n only")
+        if self.getSpaceInformation().getStateDimension() != 2:
+            raise ValueError("SetupRefuser plans in R^2 only")
+        super().setup()
+
+
+def test_a_wrong_path_after_an_expired_condition_is_caught():
+    hasty = _entry("Hasty", Hasty)
+    check_solves(hasty, budget=BUDGET)  # a real path while it has time
+    with pytest.raises(AssertionError, match="solve with an expired termination condition: the "
+                                             "path collides"):  # fmt: skip
+        check_valid_path(hasty, budget=BUDGET)
+
+
+def test_a_path_that_does_not_join_start_and_goal_in_another_space_is_caught():
+    with pytest.raises(AssertionError) as exc:
+        check_other_spaces(_entry("TwoCoordinates", TwoCoordinates))
+    lines = str(exc.value).splitlines()
+    assert lines[0] == ("TwoCoordinates in a user's R^3 SimpleSetup: reported 'Exact solution' "
+                        "with a wrong exact path: it starts at (1, 1, 8.739), not at the start "
+                        "(1, 1, 1)")  # fmt: skip
+    assert lines[1].startswith("TwoCoordinates in a user's R^6 SimpleSetup: reported 'Exact ")
+    assert len(lines) == 2  # a crash status in SE(2) and Reeds-Shepp is a refusal
+
+
+def test_a_straight_line_through_the_ball_is_caught_in_every_other_space():
+    with pytest.raises(AssertionError) as exc:
+        check_other_spaces(LINE)
+    lines = str(exc.value).splitlines()
+    assert len(lines) == 4
+    assert lines[0].startswith("Line in a user's R^3 SimpleSetup: reported 'Exact solution' with "
+                               "a wrong exact path: its motion 0 from (1, 1, 1) to (9, 9, 9) "
+                               "passes through (")  # fmt: skip
+    assert lines[0].endswith("invalid by the user's checker")
+    assert lines[2].startswith("Line in a user's SE(2) SimpleSetup: ")
+
+
+def test_an_exact_status_without_a_path_is_caught():
+    with pytest.raises(
+        AssertionError,
+        match=r"Boaster in a user's R\^3 SimpleSetup: reported "
+        r"'Exact solution', but holds no exact path",
+    ):
+        check_other_spaces(_entry("Boaster", Boaster))
+
+
+def test_an_exception_out_of_solve_is_caught_and_one_out_of_setup_is_a_refusal():
+    with pytest.raises(
+        AssertionError,
+        match=r"Raiser in a user's R\^3 SimpleSetup: solve\(\) "
+        r"raised TypeError\(",
+    ):
+        check_other_spaces(_entry("Raiser", Raiser))
+    check_other_spaces(_entry("SetupRefuser", SetupRefuser))  # passes: no answer, no wrong one
+
+
 def test_the_kit_lists_each_check_once_and_ids_read_as_planner_and_check():
-    assert len({c.__name__ for c in CHECKS}) == len(CHECKS) == 7
+    assert len({c.__name__ for c in CHECKS}) == len(CHECKS) == 8
     mark = parametrize_with_checks(["RRTConnect"], budget=FAST)
     ids = mark.kwargs["ids"]
     assert ids[0] == "RRTConnect-check_solves" and len(ids) == len(CHECKS)

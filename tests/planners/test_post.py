@@ -8,6 +8,7 @@ import json
 import math
 import sqlite3
 import subprocess
+import time
 
 import numpy as np
 import pytest
@@ -15,7 +16,7 @@ from helpers import PROBLEMS, SINGLE_CIRCLE, rrtpso_exe
 from ompl import base as ob
 from ompl import geometric as og
 
-from rrtpso_ompl.errors import ParameterError
+from rrtpso_ompl.errors import ParameterError, UnsupportedSpaceError
 from rrtpso_ompl.model import World, load_problem
 from rrtpso_ompl.model.problem import problem_from_dict
 from rrtpso_ompl.ompl_setup import array_to_path, make_context, path_to_array
@@ -27,6 +28,7 @@ from rrtpso_ompl.planners import (
     split_spec,
 )
 from rrtpso_ompl.planners.base import SpaceInformationCollisionModel
+from rrtpso_ompl.planners.post import run_post
 
 
 def test_specs_name_a_planner_and_its_post_passes():
@@ -128,6 +130,90 @@ def test_nothing_to_gain_leaves_the_path_alone():
     assert path_to_array(straight).tolist() == [[0.1, 0.1], [0.1, 0.9]]
     with pytest.raises(ParameterError, match="swarm_sizes"):
         PSOPathOptimizer(si, swarm_sizes=3)
+
+
+def _se2_path(points):
+    """An SE(2) space over [0, 10]^2 with a checker that accepts everything, and a path."""
+    space = ob.SE2StateSpace()
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(0.0)
+    bounds.setHigh(10.0)
+    space.setBounds(bounds)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(lambda state: True)
+    si.setup()
+    path = og.PathGeometric(si)
+    for x, y, yaw in points:
+        state = space.allocState()
+        state.setXY(x, y)
+        state.setYaw(yaw)
+        path.append(state)
+    return si, path
+
+
+def _poses(path):
+    return [(s.getX(), s.getY(), s.getYaw()) for s in path.getStates()]
+
+
+DETOUR = [(1.0, 1.0, 0.0), (5.0, 8.0, 0.5), (9.0, 1.0, 0.0)]
+
+
+def test_the_optimizer_refuses_a_space_other_than_the_plane_at_construction():
+    """The swarm moves waypoints in the plane: given SE(2) (or R^3) it says so at once, instead
+    of reading two coordinates of each state (issue 32)."""
+    si, path = _se2_path(DETOUR)
+    with pytest.raises(
+        UnsupportedSpaceError,
+        match=r"^PSOPathOptimizer: the state space .*"
+        r"\(ob\.SE2StateSpace, 3 dimensions\) is not ob\.RealVectorStateSpace\(2\)",
+    ):
+        PSOPathOptimizer(si)
+    assert _poses(path) == DETOUR
+    space = ob.RealVectorStateSpace(3)
+    space.setBounds(0.0, 1.0)
+    with pytest.raises(UnsupportedSpaceError, match=r"RealVectorStateSpace\(3\)"):
+        PSOPathOptimizer(ob.SpaceInformation(space), rng=np.random.default_rng(0))
+
+
+class LongerIsCheaper(ob.OptimizationObjective):
+    """An objective that any shortcut raises (each motion costs minus its length)."""
+
+    def __init__(self, si):
+        super().__init__(si)
+        self.si = si
+
+    def stateCost(self, state):
+        return ob.Cost(0.0)
+
+    def motionCost(self, a, b):
+        return ob.Cost(-self.si.distance(a, b))
+
+
+def test_the_simplify_post_pass_works_in_any_space_and_the_swarm_refuses_there():
+    """``run_post``: OMPL's simplifier in SE(2) (a step that raises the objective is undone, its
+    states put back as they were), and the swarm refused before it touches the path."""
+    si, path = _se2_path(DETOUR)
+    (step,) = run_post(si, path, ["simplify"], time.perf_counter() + 1.0,
+                       objective=LongerIsCheaper(si))  # fmt: skip
+    assert _poses(path) == DETOUR  # the shortcut raised the objective: undone, exactly
+    assert step.cost_after == step.cost_before
+    (step,) = run_post(si, path, ["simplify"], time.perf_counter() + 1.0)
+    assert _poses(path) == [DETOUR[0], DETOUR[-1]] and step.length_after < step.length_before
+    with pytest.raises(UnsupportedSpaceError, match="PSOPathOptimizer"):
+        run_post(si, path, ["pso"], time.perf_counter() + 1.0)
+    assert _poses(path) == [DETOUR[0], DETOUR[-1]]
+
+
+def test_an_undone_simplify_step_puts_a_plane_path_back_exactly():
+    ss, _, _ = foreign_setup()
+    si = ss.getSpaceInformation()
+    xy = np.array([[0.1, 0.1], [0.15, 0.25], [0.2, 0.1]])  # clear of the square
+    path = array_to_path(si, xy)
+    (step,) = run_post(si, path, ["simplify"], time.perf_counter() + 1.0,
+                       objective=LongerIsCheaper(si))  # fmt: skip
+    assert np.array_equal(path_to_array(path), xy) and step.cost_after == step.cost_before
+    run_post(si, path, ["simplify"], time.perf_counter() + 1.0)  # no objective: shortened
+    assert path_to_array(path).tolist() == [[0.1, 0.1], [0.2, 0.1]]
 
 
 def test_rrtstarpso_and_the_post_pass_share_one_optimiser(monkeypatch):
