@@ -4,7 +4,11 @@ and JSON holds only what JSON can.
 Where a result goes decides how it is written (:func:`publish`):
 
 - a new file, or an existing regular file: written to a temporary file beside it and renamed
-  over it, so a reader never sees half a file; an existing file keeps its permissions;
+  over it (linked, when nothing is there), so a reader never sees half a file; an existing file
+  keeps its permissions;
+- never over a results file of this program or a file another process holds locked (a running
+  batch): those are looked at again just before the rename, under a shared lock held across it
+  (:func:`rrtpso_ompl.ownership.inspected`), and refused with an ``OutputError``;
 - a symbolic link: written through to its target (by the rules for the target), the link stays;
 - a fifo, a character device or ``-`` (standard output): streamed directly, since renaming over
   them would replace the fifo (its reader would get nothing) or the device node.
@@ -39,6 +43,7 @@ from typing import Any
 import numpy as np
 
 from .errors import OutputError
+from .ownership import ABSENT, MOVED, inspected
 
 __all__ = [
     "STDOUT",
@@ -48,6 +53,7 @@ __all__ = [
     "guard_standard_streams",
     "is_stream",
     "json_line",
+    "link_new",
     "make_folders",
     "name_max",
     "os_reason",
@@ -185,14 +191,49 @@ def publish(tmp: str | Path, path: str | Path) -> None:
             shutil.copyfileobj(src, dst)
         Path(tmp).unlink(missing_ok=True)
         return
+    for _ in range(_PUBLISH_ATTEMPTS):
+        with inspected(target) as found:
+            if found == MOVED:
+                continue  # renamed over while we looked: look at the new file
+            if found == ABSENT:
+                _chmod_new(tmp)
+                if link_new(tmp, target):
+                    return
+                continue  # made meanwhile (by a batch?): look at it
+            if found is not None:  # a results file, or one being written: never replaced
+                raise OutputError(str(path), f"it is {found.what}; it is left as it is")
+            # Held under a shared lock: a batch cannot take the file until it is replaced.
+            os.chmod(tmp, stat.S_IMODE(os.stat(target).st_mode))  # it keeps its permissions
+            os.replace(tmp, target)
+            return
+    raise OutputError(str(path), "other processes keep creating and removing it")
+
+
+#: Looks at a target that other processes keep creating, replacing or removing.
+_PUBLISH_ATTEMPTS = 10
+
+
+def _chmod_new(tmp: str | Path) -> None:
+    """Give ``tmp`` the permissions any new file gets (mkstemp's files are owner-only)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)
+
+
+def link_new(tmp: str | Path, target: Path) -> bool:
+    """Put ``tmp`` at ``target`` only if nothing is there (a hard link, then ``tmp`` removed:
+    a rename would replace a file made meanwhile, such as a batch's new results file). False
+    when something is there now; a file system without hard links gets a rename."""
     try:
-        mode = stat.S_IMODE(os.stat(target).st_mode)  # an existing file keeps its permissions
-    except FileNotFoundError:
-        umask = os.umask(0)
-        os.umask(umask)
-        mode = 0o666 & ~umask  # what any new file gets (mkstemp's files are owner-only)
-    os.chmod(tmp, mode)
-    os.replace(tmp, target)
+        os.link(tmp, target)
+    except FileExistsError:
+        return False
+    except OSError:  # no hard links here (FAT, some network file systems): rename
+        os.replace(tmp, target)
+        return True
+    with contextlib.suppress(OSError):
+        os.unlink(tmp)
+    return True
 
 
 @contextmanager

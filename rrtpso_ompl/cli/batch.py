@@ -61,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
     check_run_options(args)
     planners = planner_list(args.planner, "RRTstarPSO")
     params = check_planners(planners, args.param, "--planner")
-    check_outputs([Output("--out", args.out)], batch_inputs(args.inputs))
+    check_outputs([Output("--out", args.out, "results")], batch_inputs(args.inputs))
     tasks = make_tasks(
         args.inputs,
         planners,

@@ -64,7 +64,12 @@ def _budgets(text: str) -> list[float]:
         raise UsageError(f"--time: every budget must be a positive number of seconds: {text}")
     for t in times:
         check_positive_seconds(t, "--time")
-    return times
+    unique = list(dict.fromkeys(times))
+    for t in unique:
+        if times.count(t) > 1:
+            note(f"rrtpso: --time: the budget {t:g} s is given {times.count(t)} times; it is run "
+                 "once")  # fmt: skip
+    return unique
 
 
 def run(args: argparse.Namespace) -> int:
@@ -79,9 +84,11 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     inputs = batch_inputs(args.inputs)
     check_outputs([Output("--out", args.out, "folder")], inputs)
-    # No input may be one of the files the bench writes into the folder.
+    # No input may be one of the files the bench writes into the folder (which ones it may
+    # replace there, run_bench decides).
     written = ["runs.jsonl", *OUTPUT_FILES]
-    check_outputs([Output(f"--out ({name})", str(out / name)) for name in written], inputs)
+    check_outputs([Output(f"--out ({name})", str(out / name)) for name in written], inputs,
+                  own_folder=True)  # fmt: skip
     with RunProgress("bench", "runs") as bar:
         result = run_bench(
             args.inputs,

@@ -189,8 +189,10 @@ class Output:
         How the command line names it (``--json``).
     path : str or None
         Where; None when not asked for. ``-`` is standard output (text outputs only).
-    kind : {"text", "image", "gif", "folder", "bag"}
-        What is written there (``bag``: a ROS 2 bag, one MCAP file or a bag directory).
+    kind : {"text", "image", "gif", "folder", "bag", "results"}
+        What is written there (``bag``: a ROS 2 bag, one MCAP file or a bag directory;
+        ``results``: a batch's results file, appended to: its own checks decide about the rows
+        it holds and its lock, :class:`~rrtpso_ompl.harness.results_file.ResultsFile`).
     """
 
     flag: str
@@ -198,7 +200,9 @@ class Output:
     kind: str = "text"
 
 
-def check_outputs(outputs: Sequence[Output], inputs: Sequence[str | Path] = ()) -> None:
+def check_outputs(
+    outputs: Sequence[Output], inputs: Sequence[str | Path] = (), *, own_folder: bool = False
+) -> None:
     """Refuse outputs that cannot be written, before any time is spent planning.
 
     Refused: an empty name; standard output (``-``) for an image or folder, for two outputs, or
@@ -208,12 +212,18 @@ def check_outputs(outputs: Sequence[Output], inputs: Sequence[str | Path] = ()) 
     an image suffix matplotlib cannot write; an output that is one of the inputs (it would be
     destroyed: pass every file a problem reads, :attr:`~rrtpso_ompl.model.Problem.inputs`) or the
     same file as another output (one would be lost); a ROS 2 bag over anything but an MCAP
-    file (``.mcap``) or an empty folder.
+    file (``.mcap``) or an empty folder; a file of this program that holds runs
+    (:func:`rrtpso_ompl.ownership.describe`: a results file, finished or being written, a bench
+    folder's files), which only its own command continues (``results`` outputs: a bench's files
+    are refused there, the rest is the results file's to judge). ``own_folder``: the outputs are
+    a bench's files in its own folder, which the bench checks itself.
     """
     given = [o for o in outputs if o.path is not None]
     targets: dict[str, str] = {}
     for out in given:
         _check_one(out)
+        if not own_folder:
+            _check_not_ours(out)
         key = STDOUT if out.path == STDOUT else os.path.realpath(out.path)
         if key in targets:
             where = "standard output" if key == STDOUT else f"the same file '{out.path}'"
@@ -227,12 +237,30 @@ def check_outputs(outputs: Sequence[Output], inputs: Sequence[str | Path] = ()) 
                 )
 
 
+def _check_not_ours(out: Output) -> None:
+    """Refuse an output that would replace a file of this program holding runs (see
+    :func:`check_outputs`)."""
+    if out.path == STDOUT or out.kind == "folder" or is_stream(out.path):
+        return
+    from ..ownership import describe
+
+    owned = describe(out.path)
+    if owned is None or (out.kind == "results" and owned.kind != "bench"):
+        return
+    if out.kind == "results":
+        raise UsageError(f"{out.flag}: '{out.path}' is {owned.what}; a batch does not write into "
+                         "a bench's folder: continue it with rrtpso bench --resume, or choose "
+                         "another file")  # fmt: skip
+    raise UsageError(f"{out.flag}: '{out.path}' is {owned.what}; it is not replaced: choose "
+                     "another file")  # fmt: skip
+
+
 def _check_one(out: Output) -> None:
     path, flag = out.path, out.flag
     if not path or not path.strip():
         raise UsageError(f"{flag}: give a file name (got an empty one)")
     if path == STDOUT:
-        if out.kind != "text":
+        if out.kind not in ("text", "results"):
             raise UsageError(f"{flag}: '-' (standard output) is only for text outputs")
         if stdout_closed():
             raise UsageError(f"{flag}: standard output is closed; nothing can be written there")
@@ -450,7 +478,11 @@ def planner_list(values: list[str] | None, default: str) -> list[str]:
     names = [n.strip() for v in (values or [default]) for n in v.split(",") if n.strip()]
     if not names:
         raise UsageError("--planner: name at least one planner (see 'rrtpso planners')")
-    return list(dict.fromkeys(names))
+    unique = list(dict.fromkeys(names))
+    for name in unique:
+        if names.count(name) > 1:
+            note(f"rrtpso: --planner: {name} is given {names.count(name)} times; it is run once")
+    return unique
 
 
 def check_run_options(args: argparse.Namespace) -> None:
@@ -485,7 +517,7 @@ def run_keywords(args: argparse.Namespace, bar: RunProgress) -> dict[str, Any]:
     of :func:`add_run_options`, with ``bar`` reporting the runs as they start and finish."""
     return {"jobs": args.jobs, "resume": args.resume, "overwrite": args.overwrite,
             "executor": args.executor, "scheduler": args.scheduler,
-            "progress": bar.row, "on_start": bar.started}  # fmt: skip
+            "progress": bar.row, "on_start": bar.started, "notice": note}  # fmt: skip
 
 
 def report_errors(errors: Iterable[str]) -> None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import os
+from pathlib import Path
 from typing import Any
 
 from ..errors import GenerationError, UsageError
@@ -83,6 +84,46 @@ def _value(value: Any) -> str:
     return " ".join(map(str, value)) if isinstance(value, tuple) else str(value)
 
 
+#: Bytes of an existing output read to tell what it is.
+_HEAD_BYTES = 4096
+#: How files that no problem or map is begin, and what they are.
+_MAGIC = ((b"SQLite format 3\0", "an SQLite database"), (b"\x89PNG", "a PNG image"),
+          (b"%PDF", "a PDF document"), (b"PK\x03\x04", "a ZIP archive"))  # fmt: skip
+
+
+def _check_replaceable(path: Path) -> None:
+    """``--overwrite`` replaces what ``generate`` could have written, a problem or map YAML file
+    (text) or a map image, and any other text: a file that is recognisably something else (an
+    SQLite database such as a bench's, a PNG image, a PDF, a ZIP archive; binary data where a
+    YAML file goes) is refused, unread beyond its first :data:`_HEAD_BYTES` (a fifo is never
+    opened)."""
+    from ..model.yamlfile import open_input
+
+    try:
+        with open_input(path) as fh:
+            head = fh.read(_HEAD_BYTES)
+    except (OSError, ValueError):
+        return  # not a regular file, or unreadable: the output checks said what they could
+    what = next((w for magic, w in _MAGIC if head.startswith(magic)), None)
+    if what is None and path.suffix.lower() != ".pgm" and not _is_text(head):
+        what = "binary data"  # a map image is binary; a problem or map YAML file is text
+    if what is None:
+        return
+    raise UsageError(f"--out: '{path}' is {what}, not a problem or map file generate writes; "
+                     "--overwrite does not replace it: choose another file")  # fmt: skip
+
+
+def _is_text(head: bytes) -> bool:
+    """Whether the beginning of a file is UTF-8 text (a character cut at the end allowed)."""
+    if b"\0" in head:
+        return False
+    try:
+        head.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        return exc.start >= len(head) - 3 and len(head) == _HEAD_BYTES
+    return True
+
+
 def run(args: argparse.Namespace) -> int:
     from ..groundtruth import generate_to_file
     from ..groundtruth.generate import GENERATORS
@@ -98,8 +139,11 @@ def run(args: argparse.Namespace) -> int:
     paths = kind.output_paths(args.out) if args.out != "-" else [args.out]
     check_outputs([Output("--out", str(p)) for p in paths])
     for p in paths:
-        if os.path.lexists(p) and not args.overwrite and not is_stream(p):
+        if not os.path.lexists(p) or is_stream(p):
+            continue
+        if not args.overwrite:
             raise UsageError(f"--out: '{p}' exists; pass --overwrite to replace it")
+        _check_replaceable(p)
     try:
         path = generate_to_file(args.kind, args.seed, args.out, **options)
     except (GenerationError, ValueError) as exc:

@@ -65,7 +65,7 @@ from ..model.problem import problem_from_dict
 from ..model.problem_file import round_floats, write_problem
 from ..model.raster import Lattice
 from ..model.world import World
-from ..outputs import make_folders, remove_folders
+from ..outputs import make_folders, publish, remove_folders
 from ..planners.params import Rule, declared, param
 from .generate import GeneratorOptions, _round_up, generate_command, register_kind
 
@@ -233,15 +233,9 @@ def _check_writable_place(path: Path) -> None:
 
 def _publish(tmp: Path, target: Path) -> None:
     """Rename a finished file into place with the permissions a new file gets (or the old
-    file's)."""
-    try:
-        mode = stat.S_IMODE(os.stat(target).st_mode)
-    except FileNotFoundError:
-        umask = os.umask(0)
-        os.umask(umask)
-        mode = 0o666 & ~umask
-    os.chmod(tmp, mode)
-    os.replace(tmp, target)
+    file's), never over a results file or a file being written
+    (:func:`~rrtpso_ompl.outputs.publish`)."""
+    publish(tmp, target)
 
 
 # ----------------------------------------------------------------------------------------------

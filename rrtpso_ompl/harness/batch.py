@@ -13,8 +13,11 @@ by the parent as they finish, one whole line per write, to a locked results file
 
 from __future__ import annotations
 
+import errno
 import glob
 import hashlib
+import os
+import stat
 import time
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -46,7 +49,9 @@ class Task:
     """One solve: a problem file, a planner, a seed. Plain data, so it pickles to any worker.
 
     ``error`` carries an input problem found before solving (a missing file, a glob that matched
-    nothing): the task then only reports it.
+    nothing): the task then only reports it. ``settings`` is what else makes the run's result
+    (:func:`run_settings`; worked out from ``planner``, ``params`` and ``simplify`` when not
+    given): part of the run's identity.
     """
 
     file: str
@@ -61,13 +66,37 @@ class Task:
     error: str | None = None
     source: str | None = None
     digest: str | None = None
+    settings: Mapping[str, Any] | None = None
+
+    def __post_init__(self) -> None:
+        if self.settings is None:
+            settings = run_settings(self.planner, self.params, self.simplify)
+            object.__setattr__(self, "settings", settings)
 
     @property
     def key(self) -> RunKey:
         """The identity of the task's run, that of its row
         (:attr:`~rrtpso_ompl.harness.record.RunRecord.key`: the problem file resolved, however
-        it was spelled): how resuming finds the runs done."""
-        return RunKey.of(self.file, self.planner, self.seed, self.time_limit, source=self.source)
+        it was spelled, and the settings): how resuming finds the runs done."""
+        return RunKey.of(self.file, self.planner, self.seed, self.time_limit, source=self.source,
+                         settings=self.settings)  # fmt: skip
+
+
+def run_settings(planner: str, params: Mapping[str, Any], simplify: bool) -> dict[str, Any]:
+    """What makes a run's result besides its problem, planner, seed and budget (a row's
+    ``settings``): ``params``, the caller's parameters converted by their declarations (so that
+    ``range=5`` and ``range=5.0`` are one setting; as given when the planner cannot take them:
+    the run is an error row then), ``simplify`` and ``version``, this package's."""
+    from .. import __version__
+    from ..planners.request import resolve
+
+    try:
+        request = resolve(None, planner, params=dict(params))
+        given = {**request.params, **request.post_params}
+    except (RrtpsoError, ValueError, TypeError):
+        given = {k: str(v) for k, v in params.items()}
+    return {"params": dict(sorted(given.items())), "simplify": bool(simplify),
+            "version": __version__}  # fmt: skip
 
 
 def expand_inputs(items: Sequence[str]) -> list[tuple[str, str | None]]:
@@ -91,18 +120,16 @@ def expand_inputs(items: Sequence[str]) -> list[tuple[str, str | None]]:
 
     for item in items:
         p = Path(item)
-        if p.is_dir():  # a folder's map_server maps belong to its problems: not tasks
-            found = sorted(
-                str(f)
-                for f in p.rglob("*")
-                if f.suffix in PROBLEM_SUFFIXES and f.is_file() and not is_map_yaml(f)
-            )
+        if p.is_dir():
+            found = folder_problems(p)
             if not found:
                 add(item, "directory holds no .yaml problem files")
-            for f in found:
-                add(f)
+            for f, error in found:
+                add(f, error)
         elif p.exists():
             add(item)
+        elif os.path.lexists(item):  # a link to nothing, or a loop of links
+            add(item, _not_a_problem(p))
         elif glob.has_magic(item):
             matches = sorted(glob.glob(item, recursive=True))
             if not matches:
@@ -112,6 +139,52 @@ def expand_inputs(items: Sequence[str]) -> list[tuple[str, str | None]]:
         else:
             add(item, "no such file or directory")
     return out
+
+
+def folder_problems(folder: Path) -> list[tuple[str, str | None]]:
+    """The problem files in ``folder`` and its subfolders (links to folders are not followed),
+    sorted, as ``(path, error)``.
+
+    A folder's map_server maps belong to its problems and are left out. Whatever else is named
+    like a problem file but is not a regular file (a fifo, a socket, a link to nothing, a
+    directory named ``x.yaml``) comes with the reason it is none, never opened; so does a
+    subfolder that cannot be read: each becomes an error row, none is skipped without a word.
+    """
+    out: list[tuple[str, str | None]] = []
+
+    def unreadable(exc: OSError) -> None:
+        where = exc.filename or str(folder)
+        out.append((str(where), f"cannot read this folder: {exc.strerror or exc}"))
+
+    for root, dirs, files in os.walk(folder, onerror=unreadable):
+        dirs.sort()
+        for name in dirs + files:
+            if Path(name).suffix not in PROBLEM_SUFFIXES:
+                continue
+            path = Path(root, name)
+            try:
+                regular = stat.S_ISREG(os.stat(path).st_mode)
+            except OSError:
+                regular = False
+            if not regular:
+                out.append((str(path), _not_a_problem(path)))
+            elif not is_map_yaml(path):
+                out.append((str(path), None))
+    return sorted(out)
+
+
+def _not_a_problem(path: Path) -> str:
+    """Why ``path``, named like a problem file, is not one (it is not a regular file)."""
+    from ..model.yamlfile import file_kind
+
+    try:
+        return f"is {file_kind(os.stat(path).st_mode)}, not a problem file"
+    except OSError as exc:
+        if os.path.islink(path):
+            if exc.errno == errno.ELOOP:
+                return "is a symbolic link loop, not a problem file"
+            return f"is a symbolic link to '{os.readlink(path)}', which does not exist"
+        return f"cannot be looked at: {exc.strerror or exc}"
 
 
 def make_tasks(
@@ -125,7 +198,8 @@ def make_tasks(
     keep_path: bool = True,
     progress: bool = False,
 ) -> list[Task]:
-    """The tasks of a batch: every file x planner x run, run ``r`` seeded with ``seed + r``.
+    """The tasks of a batch: every file x planner x run, run ``r`` seeded with ``seed + r`` (a
+    file or planner named twice counts once).
 
     ``params`` maps a planner name to its parameters; ``simplify`` may be a function of the
     planner name.
@@ -136,8 +210,14 @@ def make_tasks(
         For more than :data:`~rrtpso_ompl.validation.MAX_RUNS` tasks.
     """
     inputs = expand_inputs(items)
+    planners = list(dict.fromkeys(planners))  # a planner named twice runs once
     check_task_count(runs, len(planners), len(inputs))
     tasks = []
+    settings = {}
+    for planner in planners:  # once per planner, not per task
+        given = dict((params or {}).get(planner, {}))
+        how = simplify(planner) if callable(simplify) else simplify
+        settings[planner] = run_settings(planner, given, how)
     for path, error in inputs:
         source = resolved_source(path) if error is None else None
         digest = inputs_digest(path) if error is None else None
@@ -157,6 +237,7 @@ def make_tasks(
                         error=error,
                         source=source,
                         digest=digest,
+                        settings=settings[planner],
                     )
                 )
     return tasks
@@ -260,8 +341,8 @@ def run_task(task: Task) -> RunRecord:
 def _base_row(task: Task) -> dict[str, Any]:
     """The keys a task gives its row, whatever the solve returns."""
     return {"file": task.file, "planner": task.planner, "seed": task.seed, "run": task.run,
-            "budget": task.time_limit, "source": task.key.source,
-            "inputs_sha256": task.digest}  # fmt: skip
+            "budget": task.time_limit, "settings": dict(task.settings or {}),
+            "source": task.key.source, "inputs_sha256": task.digest}  # fmt: skip
 
 
 def error_row(task: Task, message: str) -> RunRecord:
@@ -350,6 +431,7 @@ def run_batch(
     progress: Callable[[RunRecord], None] | None = None,
     on_start: Callable[[int, int], None] | None = None,
     optimum: bool = True,
+    notice: Callable[[str], None] | None = None,
 ) -> list[RunRecord]:
     """Run ``tasks`` and stream their rows to ``out`` (JSON lines) as they finish.
 
@@ -373,6 +455,11 @@ def run_batch(
         Called with each finished row.
     on_start : callable, optional
         Called as ``on_start(n_to_run, n_skipped)`` before the first task starts.
+    notice : callable, optional
+        Called with a message for the user when resuming finds rows that are not these runs'
+        although they look alike: rows of other settings (:func:`run_settings`; they stay in the
+        file, are not returned, and these runs are new), and rows of a problem file whose
+        content changed since (run again).
     optimum : bool
         Add ``optimum`` (the exact shortest length, :mod:`rrtpso_ompl.groundtruth.optimum`,
         computed once per file in this process) and ``ratio`` (``length / optimum``, null unless
@@ -381,7 +468,9 @@ def run_batch(
     Returns
     -------
     list of RunRecord
-        One row per run (the kept ones and the new ones).
+        One row per run (the kept ones and the new ones): the rows of other settings than the
+        tasks' of the same problem, planner and budget are left out. A task given twice runs
+        once.
 
     Raises
     ------
@@ -389,11 +478,19 @@ def run_batch(
         When ``out`` is being written by another batch, holds rows and neither ``resume`` nor
         ``overwrite`` is given, or is not a results file of this package.
     """
-    tasks = list(tasks)
+    unique: dict[RunKey, Task] = {}
+    for t in tasks:  # a task given twice runs once
+        unique.setdefault(t.key, t)
+    tasks = list(unique.values())
     results_of = _executor(executor, jobs, scheduler)  # checked before the file is touched
     with ResultsFile(out, resume=resume, overwrite=overwrite) as results:
         kept = [r for r in results.kept if not r.is_error]
         todo = _still_to_run(tasks, kept)
+        other = _other_settings(tasks, kept)
+        for message in _resume_notes(str(out), tasks, kept, other):
+            if notice is not None:
+                notice(message)
+        kept = [r for r in kept if id(r) not in other]
         if on_start is not None:
             on_start(len(todo), len(tasks) - len(todo))
         new = _record(results_of(todo), results, _Optima() if optimum else None, progress)
@@ -418,6 +515,84 @@ def _still_to_run(tasks: list[Task], kept: list[RunRecord]) -> list[Task]:
     """The tasks whose run none of the ``kept`` rows (a resumed file's) already is."""
     done = {r.key: r.inputs_sha256 for r in kept}
     return [t for t in tasks if not _done(t, done)]
+
+
+def _other_settings(tasks: list[Task], kept: list[RunRecord]) -> dict[int, Task]:
+    """The kept rows of a configuration (problem, planner, budget) of the tasks but of other
+    settings (or of unknown ones: an earlier version's rows), by ``id``, each with a task of its
+    configuration: they are not these runs, whatever their seeds."""
+    ours: dict[tuple[Any, ...], Task] = {}
+    settings: dict[tuple[Any, ...], set[str | None]] = {}
+    for t in tasks:
+        ours.setdefault(t.key.configuration, t)
+        settings.setdefault(t.key.configuration, set()).add(t.key.settings)
+    other = {}
+    for r in kept:
+        config = r.key.configuration
+        if config in ours and r.key.settings not in settings[config]:
+            other[id(r)] = ours[config]
+    return other
+
+
+#: Most kinds of other settings a resumed batch names (one line each).
+_MAX_NOTES = 5
+
+
+def _resume_notes(out: str, tasks: list[Task], kept: list[RunRecord],
+                  other: Mapping[int, Task]) -> list[str]:  # fmt: skip
+    """What the user is told when resuming finds rows that are not these runs: rows of other
+    settings, one line per kind of difference, and rows of a problem whose content changed."""
+    groups: dict[tuple[str, str], int] = {}
+    for r in kept:
+        if id(r) in other:
+            diff = _settings_difference(r.settings, other[id(r)].settings or {})
+            groups[diff] = groups.get(diff, 0) + 1
+    notes = [
+        f"rrtpso: {out}: {_count(n)} of other settings ({there}; these runs: {here}) "
+        f"{'stays' if n == 1 else 'stay'} in the file and {'is' if n == 1 else 'are'} not "
+        "counted; these runs are new"
+        for (there, here), n in list(groups.items())[:_MAX_NOTES]
+    ]
+    if len(groups) > _MAX_NOTES:
+        rest = sum(list(groups.values())[_MAX_NOTES:])
+        notes.append(f"rrtpso: {out}: and {_count(rest)} of other settings besides")
+    digests = {t.key: t.digest for t in tasks}
+    changed = sum(1 for r in kept if r.key in digests and digests[r.key] and r.inputs_sha256
+                  and r.inputs_sha256 != digests[r.key])  # fmt: skip
+    if changed:
+        notes.append(f"rrtpso: {out}: {_count(changed)} of a problem file (or map) that changed "
+                     "since; these runs run again")  # fmt: skip
+    return notes
+
+
+def _count(n: int) -> str:
+    return f"{n} row" if n == 1 else f"{n} rows"
+
+
+def _settings_difference(there: Mapping[str, Any] | None, here: Mapping[str, Any]
+                         ) -> tuple[str, str]:  # fmt: skip
+    """The settings of a row and of a task, in words, only where they differ."""
+    if there is None:
+        return "none recorded: an earlier version wrote them", _settings_words(here, list(here))
+    keys = [k for k in dict.fromkeys((*there, *here)) if there.get(k) != here.get(k)]
+    return _settings_words(there, keys), _settings_words(here, keys)
+
+
+def _settings_words(settings: Mapping[str, Any], keys: Sequence[str]) -> str:
+    """``range=5.0, simplify, version 0.1.0``: the ``keys`` of ``settings`` in words."""
+    words = []
+    for key in keys:
+        value = settings.get(key)
+        if key == "params":
+            given = value or {}
+            words.append(", ".join(f"{k}={v}" for k, v in given.items()) or "default parameters")
+        elif key == "simplify":
+            words.append("OMPL's simplifier" if value else "no simplifier")
+        elif key == "version":
+            words.append(f"version {value}")
+        else:
+            words.append(f"{key}={value}")
+    return ", ".join(words) or "the same"
 
 
 def _record(

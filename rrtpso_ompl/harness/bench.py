@@ -48,6 +48,7 @@ from typing import Any
 
 from ..errors import UsageError
 from ..outputs import atomic_path, make_folders, remove_folders, write_text_atomic
+from ..ownership import BENCH_FILES, BENCH_LOG_MARK, RUNS_FILE, describe, is_bench_log
 from .batch import Task, check_task_count, expand_inputs, make_tasks, run_batch
 from .ompl_log import Experiment, PlannerRuns, build_database, write_log
 from .record import RunRecord
@@ -102,12 +103,15 @@ def bench_tasks(
     params: Mapping[str, Mapping[str, Any]] | None = None,
     simplify: bool | None = None,
 ) -> list[Task]:
-    """Every problem x budget x planner x run (run ``r`` seeded ``seed + r`` at every budget).
+    """Every problem x budget x planner x run (run ``r`` seeded ``seed + r`` at every budget);
+    a budget or planner named twice counts once.
 
     ``simplify`` None follows each planner's registry entry (OMPL's planners are simplified, as
     in OMPL's Benchmark); True or False applies to every planner.
     """
     how = _simplified_in_benchmarks if simplify is None else simplify
+    times = list(dict.fromkeys(float(t) for t in times))  # a budget named twice runs once
+    planners = list(dict.fromkeys(planners))
     check_task_count(runs, len(planners), len(expand_inputs(items)), len(times))
     tasks = []
     for budget in times:
@@ -174,6 +178,7 @@ def run_bench(
     command: str | None = None,
     simplify: bool | None = None,
     overwrite: bool = False,
+    notice: Callable[[str], None] | None = None,
 ) -> BenchResult:
     """Run a benchmark and write its results to ``out_dir`` (see the module docstring).
 
@@ -189,7 +194,7 @@ def run_bench(
         Runs per problem, budget and planner.
     times : sequence of float
         Time budgets, seconds; one experiment per problem and budget.
-    seed, params, jobs, executor, scheduler, resume, overwrite, progress, on_start
+    seed, params, jobs, executor, scheduler, resume, overwrite, progress, on_start, notice
         As for :func:`~rrtpso_ompl.harness.run_batch` and
         :func:`~rrtpso_ompl.harness.make_tasks` (``resume`` and ``overwrite`` apply to the
         folder: without either, one that holds an earlier bench is refused).
@@ -209,10 +214,12 @@ def run_bench(
         When the folder holds files of this bench's names that no bench wrote, another bench is
         writing it, or it holds an earlier bench and neither ``resume`` nor ``overwrite`` is given.
     """
+    planners = list(dict.fromkeys(planners))  # one block per planner in the logs
     tasks = bench_tasks(items, planners, runs, times, seed, params, simplify)  # checked first
     out = Path(out_dir)
     batch = dict(jobs=jobs, resume=resume, overwrite=overwrite, executor=executor,
-                 scheduler=scheduler, progress=progress, on_start=on_start)  # fmt: skip
+                 scheduler=scheduler, progress=progress, on_start=on_start,
+                 notice=notice)  # fmt: skip
     return _write_outputs(_run_in_folder(tasks, out, batch), out, planners, runs, seed, command)
 
 
@@ -222,7 +229,7 @@ def _run_in_folder(tasks: list[Task], out: Path, batch: dict[str, Any]) -> list[
     _check_out_dir(out)
     made = make_folders(out)
     try:
-        return run_batch(tasks, out / "runs.jsonl", **batch)
+        return run_batch(tasks, out / RUNS_FILE, **batch)
     except BaseException:
         remove_folders(made)
         raise
@@ -251,14 +258,21 @@ def _write_outputs(
 
 
 #: The files a bench writes into its folder besides runs.jsonl and the logs.
-OUTPUT_FILES = ("benchmark.db", "report.md", "report.csv", "ratio.png", "success.png")
+OUTPUT_FILES = BENCH_FILES
 #: The line of a log's setup block that says this harness wrote it.
-_HARNESS = "harness: rrtpso bench (one process per run, exact collision checks)"
+_HARNESS = BENCH_LOG_MARK
 
 
 def _check_out_dir(out: Path) -> None:
-    """Refuse a folder whose output files were not written by a bench (no runs.jsonl)."""
-    if (out / "runs.jsonl").exists():
+    """Refuse a folder whose output files were not written by a bench (no runs.jsonl), or one
+    of whose output files is a results file (a batch's, named like a bench's file): the bench
+    would replace it at the end."""
+    for name in OUTPUT_FILES:
+        owned = describe(out / name)
+        if owned is not None and owned.kind in ("results", "locked"):
+            raise UsageError(f"--out {out}: its {name} is {owned.what}; a bench would replace "
+                             "it: choose another folder")  # fmt: skip
+    if (out / RUNS_FILE).exists():
         return  # an earlier bench: run_batch decides (resume, overwrite, or refuse)
     foreign = [name for name in OUTPUT_FILES if (out / name).exists()]
     if foreign:
@@ -269,12 +283,7 @@ def _check_out_dir(out: Path) -> None:
 
 
 def _is_our_log(path: Path) -> bool:
-    try:
-        with path.open(encoding="utf-8", errors="replace") as fh:
-            head = fh.read(4096)
-    except OSError:
-        return False
-    return head.startswith("rrtpso-ompl version") and _HARNESS in head
+    return is_bench_log(path)
 
 
 def _our_logs(out: Path) -> list[Path]:

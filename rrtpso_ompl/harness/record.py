@@ -9,25 +9,24 @@ attributes. The JSON keys, their order and their meaning are the results-file fo
 rows written by earlier versions (without the keys added since) are read back.
 
 A run's identity is :attr:`RunRecord.key`, a :class:`RunKey`: the problem file resolved, the
-planner, the seed and the budget. A batch task has the same identity
+planner, the seed, the budget and the settings (the caller's parameters, OMPL's simplifier, the
+package's version). A batch task has the same identity
 (:attr:`~rrtpso_ompl.harness.batch.Task.key`), which is how ``--resume`` finds the runs done.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import json
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
+from ..ownership import ROW_KEYS
 from ..planners.result import BenchmarkRun
 
-__all__ = ["ROW_KEYS", "RunKey", "RunRecord", "resolved_source"]
-
-#: Keys every row has (error rows and rows of every earlier version included): what makes a
-#: JSON line recognisably a row of this package.
-ROW_KEYS = ("file", "planner", "seed", "run", "status")
+__all__ = ["ROW_KEYS", "RunKey", "RunRecord", "resolved_source", "settings_key"]
 
 
 def resolved_source(file: str) -> str:
@@ -38,25 +37,46 @@ def resolved_source(file: str) -> str:
         return file
 
 
+def settings_key(settings: Mapping[str, Any] | None) -> str | None:
+    """The settings of a run as canonical JSON (sorted keys, compact): equal settings give
+    equal text however they were built (a tuple or a list, keys in any order). None stays None
+    (a row written before rows had ``settings``: not known)."""
+    if settings is None:
+        return None
+    return json.dumps(settings, sort_keys=True, separators=(",", ":"), default=str)
+
+
 class RunKey(NamedTuple):
-    """What identifies a run: the same problem file, planner, seed and budget is the same run.
+    """What identifies a run: the same problem file, planner, seed, budget and settings is the
+    same run.
 
     ``source`` is the problem file resolved (:func:`resolved_source`), so that ``probs/p.yaml``
     and ``/abs/probs/p.yaml`` name the same run; ``budget`` is the time limit asked for (None:
-    the file's own).
+    the file's own); ``settings`` is :func:`settings_key` of everything else that changes the
+    result (the caller's parameters, OMPL's simplifier, this package's version), None when not
+    known (rows written before rows had it: they are the run of no task).
     """
 
     source: str
     planner: str
     seed: int
     budget: float | None
+    settings: str | None = None
 
     @classmethod
     def of(cls, file: str, planner: str, seed: int, budget: float | None,
-           source: str | None = None) -> RunKey:  # fmt: skip
+           source: str | None = None, settings: Mapping[str, Any] | None = None
+           ) -> RunKey:  # fmt: skip
         """The key of a run of ``file``; ``source`` when already resolved (else resolved here,
         relative to the working directory: rows written before rows had ``source``)."""
-        return cls(resolved_source(file) if source is None else source, planner, seed, budget)
+        where = resolved_source(file) if source is None else source
+        return cls(where, planner, seed, budget, settings_key(settings))
+
+    @property
+    def configuration(self) -> tuple[str, str, float | None]:
+        """The problem, planner and budget: the runs of one configuration, whatever their seed
+        and settings (a resumed batch finds rows of other settings by it)."""
+        return (self.source, self.planner, self.budget)
 
 
 #: The keys a solve adds to a row (``rrtpso solve --json``'s beyond the first ones, and the
@@ -98,6 +118,11 @@ class RunRecord:
         The run's index, from 0.
     budget : float or None
         The time limit asked for, seconds (None: the file's ``planner.time_limit``).
+    settings : dict or None
+        What else makes the run's result (part of its identity, :class:`RunKey`): ``params``,
+        the parameters the caller gave (converted, by name: the problem file's own count through
+        ``inputs_sha256``), ``simplify``, whether OMPL's simplifier followed the planner, and
+        ``version``, this package's. None in rows written before it existed.
     source : str or None
         ``file`` resolved (absolute, links followed); None in rows written before it existed.
     inputs_sha256 : str or None
@@ -153,6 +178,7 @@ class RunRecord:
     seed: int
     run: int
     budget: float | None = None
+    settings: dict[str, Any] | None = None
     source: str | None = None
     inputs_sha256: str | None = None
     problem: str | None = None
@@ -181,7 +207,8 @@ class RunRecord:
     def key(self) -> RunKey:
         """The run's identity (:class:`RunKey`): the last row of a key in a results file counts,
         and ``--resume`` skips the tasks whose key has a row."""
-        return RunKey.of(self.file, self.planner, self.seed, self.budget, source=self.source)
+        return RunKey.of(self.file, self.planner, self.seed, self.budget, source=self.source,
+                         settings=self.settings)  # fmt: skip
 
     # -- derived ---------------------------------------------------------------------------------
     @property
@@ -262,7 +289,7 @@ class RunRecord:
     def from_solve(cls, base: Mapping[str, Any], solve: Mapping[str, Any], wall: float
                    ) -> RunRecord:  # fmt: skip
         """The record of a finished solve: ``base`` (the task's keys: ``file, planner, seed,
-        run, budget, source, inputs_sha256``) over ``solve`` (a
+        run, budget, settings, source, inputs_sha256``) over ``solve`` (a
         :meth:`~rrtpso_ompl.planners.result.SolveResult.to_dict`), with its ``wall`` time."""
         return cls.from_json({**solve, **base, "wall": wall, "error": None})
 

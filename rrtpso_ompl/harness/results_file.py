@@ -40,7 +40,8 @@ from ..outputs import (
     remove_folders,
     stdout_closed,
 )
-from .record import ROW_KEYS, RunKey, RunRecord, resolved_source
+from ..ownership import ROW_KEYS, ROW_START, is_row
+from .record import RunKey, RunRecord, resolved_source
 
 try:  # advisory locks; absent on Windows, where a second writer is not detected
     import fcntl
@@ -58,16 +59,8 @@ __all__ = [
     "resolved_source",
 ]
 
-#: How every row's line begins (:meth:`RunRecord.to_json` puts ``file`` first): an unterminated
-#: last line is a row cut short only when it begins so, or is a beginning of this.
-ROW_START = b'{"file": '
 #: Attempts at opening and locking the file while other batches create and remove it.
 _OPEN_ATTEMPTS = 10
-
-
-def is_row(obj: Any) -> bool:
-    """Whether a parsed JSON line is a row of this package's batches."""
-    return isinstance(obj, dict) and all(k in obj for k in ROW_KEYS)
 
 
 def is_torn_row(tail: bytes) -> bool:

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import shutil
+
 import pytest
 from helpers import PROBLEMS
 
@@ -92,3 +95,108 @@ def test_the_old_evaluation_package_still_imports_and_warns():
 
     assert shortest_path is new and old.run_batch is run_batch
     assert any(issubclass(w.category, DeprecationWarning) for w in caught)
+
+
+# -- issue 32: nothing skipped, duplicated or mixed without a word ------------------------------
+def test_a_folder_names_every_entry_that_looks_like_a_problem_and_is_none(folder, tmp_path):
+    """A fifo, a socket, a link to nothing, a loop of links and a directory named like a problem
+    file each come with the reason they are not one (an error row each); none is opened, and a
+    map_server map beside the problems is still no task."""
+    import os
+    import socket
+
+    os.mkfifo(folder / "fifo.yaml")
+    (folder / "dangling.yaml").symlink_to("nowhere.yaml")
+    (folder / "loop.yml").symlink_to("loop.yml")
+    (folder / "dir.yaml").mkdir()
+    shutil.copy(PROBLEMS / "static" / "single_circle.yaml", folder / "dir.yaml" / "inner.yaml")
+    (folder / "m_map.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")
+    sock = socket.socket(socket.AF_UNIX)
+    sock.bind(str(folder / "sock.yaml"))
+    try:
+        found = dict(expand_inputs([str(folder)]))
+    finally:
+        sock.close()
+    assert found[str(folder / "fifo.yaml")] == "is a fifo (named pipe), not a problem file"
+    assert found[str(folder / "sock.yaml")] == "is a socket, not a problem file"
+    assert found[str(folder / "dangling.yaml")] == (
+        "is a symbolic link to 'nowhere.yaml', which does not exist"
+    )
+    assert found[str(folder / "loop.yml")] == "is a symbolic link loop, not a problem file"
+    assert found[str(folder / "dir.yaml")] == "is a directory, not a problem file"
+    assert found[str(folder / "dir.yaml" / "inner.yaml")] is None  # its problems are searched
+    assert str(folder / "m_map.yaml") not in found
+    assert [found[str(folder / f)] for f in ("a_circle.yaml", "b_passage.yaml")] == [None, None]
+    # Named on their own, they are error rows too.
+    assert dict(expand_inputs([str(folder / "dangling.yaml")]))[str(folder / "dangling.yaml")]
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root reads every folder")
+def test_a_folder_that_cannot_be_read_is_an_error_row(folder):
+    locked = folder / "locked"
+    locked.mkdir()
+    shutil.copy(PROBLEMS / "static" / "single_circle.yaml", locked / "p.yaml")
+    locked.chmod(0)
+    try:
+        found = dict(expand_inputs([str(folder)]))
+    finally:
+        locked.chmod(0o755)
+    assert "cannot read this folder: Permission denied" in found[str(locked)]
+
+
+def test_a_task_given_twice_runs_once_and_budgets_and_planners_count_once(tmp_path):
+    from rrtpso_ompl.harness.bench import bench_tasks
+
+    tasks = make_tasks([str(tmp_path / "missing.yaml")], ["RRTConnect", "RRTConnect"], runs=2)
+    assert len(tasks) == 2  # the planner named twice counts once
+    rows = run_batch(tasks + tasks, tmp_path / "r.jsonl", optimum=False)
+    assert len(rows) == 2 and len((tmp_path / "r.jsonl").read_text().splitlines()) == 2
+    problem = str(PROBLEMS / "static" / "single_circle.yaml")
+    tasks = bench_tasks([problem], ["RRTConnect", "RRTConnect"], 1, [0.1, 0.1, 0.2])
+    assert sorted(t.time_limit for t in tasks) == [0.1, 0.2]
+
+
+def test_settings_are_converted_so_that_one_setting_is_one_run():
+    problem = str(PROBLEMS / "static" / "single_circle.yaml")
+
+    def key(params, simplify=False):
+        (task,) = make_tasks([problem], ["RRTConnect"], params={"RRTConnect": params},
+                             simplify=simplify)  # fmt: skip
+        return task.key
+
+    assert key({"range": "5"}) == key({"range": 5.0}) == key({"range": "5.0"})
+    assert key({"range": "5"}) != key({}) != key({}, simplify=True)
+    (task,) = make_tasks([problem], ["RRTConnect"], params={"RRTConnect": {"range": "5"}})
+    assert task.settings["params"] == {"range": 5.0} and task.settings["simplify"] is False
+    from rrtpso_ompl import __version__
+
+    assert task.settings["version"] == __version__
+
+
+@pytest.mark.slow
+def test_resuming_with_other_settings_runs_the_tasks_and_says_so(tmp_path):
+    """A row of the same problem, planner, seed and budget but other parameters is not the
+    task's run: it stays in the file, is not returned (a report would mix two configurations),
+    and the notice names the difference."""
+    problem = str(PROBLEMS / "static" / "single_circle.yaml")
+    (task,) = make_tasks([problem], ["RRTConnect"], time_limit=0.1,
+                         params={"RRTConnect": {"range": "5"}})  # fmt: skip
+    (plain,) = make_tasks([problem], ["RRTConnect"], time_limit=0.1)
+    out = tmp_path / "r.jsonl"
+    first = run_batch([plain], out)
+    notes, seen = [], []
+    rows = run_batch([task], out, resume=True, notice=notes.append,
+                     on_start=lambda n, skipped: seen.append((n, skipped)))  # fmt: skip
+    assert seen == [(1, 0)] and len(rows) == 1 and rows[0].settings["params"] == {"range": 5.0}
+    assert notes == [
+        f"rrtpso: {out}: 1 row of other settings (default parameters; these runs: "
+        "range=5.0) stays in the file and is not counted; these runs are new"
+    ]
+    assert read_rows(out)[0] == first[0] and len(read_rows(out)) == 2
+    # The same settings spelled another way are the rows done.
+    (again,) = make_tasks([problem], ["RRTConnect"], time_limit=0.1,
+                          params={"RRTConnect": {"range": 5}})  # fmt: skip
+    seen.clear()
+    rows = run_batch([again], out, resume=True,
+                     on_start=lambda n, skipped: seen.append((n, skipped)))  # fmt: skip
+    assert seen == [(0, 1)] and len(rows) == 1

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -9,19 +10,20 @@ import pytest
 from helpers import PROBLEMS
 
 from rrtpso_ompl.harness.batch import Task, _base_row, error_row, make_tasks, run_batch
-from rrtpso_ompl.harness.record import RunKey, RunRecord
+from rrtpso_ompl.harness.record import RunKey, RunRecord, settings_key
 from rrtpso_ompl.harness.results_file import ResultsFile, read_rows
 from rrtpso_ompl.outputs import json_line
 from rrtpso_ompl.planners.result import BenchmarkRun, SolveResult
 
-#: The keys of a solved row, in the order the results file has written them since issue 22.
-SOLVED_KEYS = ["file", "planner", "seed", "run", "budget", "source", "inputs_sha256", "problem",
-               "status", "solved", "length", "time", "path", "ompl_status", "time_limit", "valid",
-               "clearance", "cost", "params", "stages", "benchmark", "wall", "error", "optimum",
-               "ratio"]  # fmt: skip
+#: The keys of a solved row, in the order the results file has written them since issue 22
+#: (``settings`` since issue 32).
+SOLVED_KEYS = ["file", "planner", "seed", "run", "budget", "settings", "source", "inputs_sha256",
+               "problem", "status", "solved", "length", "time", "path", "ompl_status", "time_limit",
+               "valid", "clearance", "cost", "params", "stages", "benchmark", "wall", "error",
+               "optimum", "ratio"]  # fmt: skip
 #: The keys of an error row, in order.
-ERROR_KEYS = ["file", "planner", "seed", "run", "budget", "source", "inputs_sha256", "problem",
-              "status", "solved", "length", "time", "path", "error", "optimum",
+ERROR_KEYS = ["file", "planner", "seed", "run", "budget", "settings", "source", "inputs_sha256",
+              "problem", "status", "solved", "length", "time", "path", "error", "optimum",
               "ratio"]  # fmt: skip
 #: A row as ``rrtpso batch`` wrote it before rows had budget, source, inputs_sha256, the optimum
 #: and the benchmark record (the first results-file format).
@@ -50,13 +52,15 @@ def _result() -> SolveResult:
 
 
 def _legacy_row(task: Task, result: SolveResult, wall: float, optimum: float) -> dict:
-    """A solved row as the batch built it before the record existed (``run_task`` of issue 22)."""
+    """A solved row as the batch built it before the record existed (``run_task`` of issue 22,
+    with the ``settings`` of issue 32)."""
     base = {
         "file": task.file,
         "planner": task.planner,
         "seed": task.seed,
         "run": task.run,
         "budget": task.time_limit,
+        "settings": dict(task.settings),
         "source": task.key.source,
         "inputs_sha256": task.digest,
     }
@@ -94,30 +98,40 @@ def test_an_error_row_has_no_solve_keys_and_optional_keys_stay_out(tmp_path):
     assert record.path is None and "path" not in record.to_json()
 
 
-def test_an_old_row_is_read_and_keeps_its_identity(tmp_path, monkeypatch):
+@pytest.mark.slow
+def test_an_old_row_is_read_and_its_settings_are_unknown(tmp_path, monkeypatch):
     """A row of the first format lacks the keys added since: it is read, resolved from its
-    ``file`` (relative to the working directory) and found by the task of the same run."""
+    ``file`` (relative to the working directory); without ``settings`` it is the run of no task
+    (what it ran with is not known), and resuming says so."""
     monkeypatch.chdir(PROBLEMS.parent)
     record = RunRecord.from_json(OLD_ROW)
     assert record.source is None and record.budget is None and record.benchmark is None
+    assert record.settings is None
     assert record.key == RunKey(str(PROBLEMS / "static" / "single_circle.yaml"), "RRTConnect", 2,
-                                None)  # fmt: skip
+                                None, None)  # fmt: skip
     assert record.effective_budget == 0.1  # the file's, as the solve ran it
     assert record.benchmark_run == BenchmarkRun(time=0.1)
     # Written again, it has today's keys (the missing ones null) and nothing is lost.
     again = record.to_json()
     assert [k for k in SOLVED_KEYS if k in again] == list(again)
     assert all(again[k] == v for k, v in OLD_ROW.items())
-    # The batch resumes it: the task of the same run, however spelled, is done.
-    out = tmp_path / "old.jsonl"
-    out.write_text(json.dumps(OLD_ROW) + "\n")
+    # The task of the same problem (however spelled), planner, seed and budget is another run:
+    # same configuration, unknown settings; resuming names the row and runs the task.
     tasks = make_tasks([str(PROBLEMS / "static" / "single_circle.yaml")], ["RRTConnect"], runs=2,
                        seed=1)  # fmt: skip
-    assert tasks[1].key == record.key
-    seen = []
-    rows = run_batch(tasks[1:], out, resume=True, on_start=lambda n, k: seen.append((n, k)))
-    assert seen == [(0, 1)] and rows == [record]
-    assert read_rows(out) == [record]
+    assert tasks[1].key.configuration == record.key.configuration
+    assert tasks[1].key != record.key and tasks[1].key.settings is not None
+    out = tmp_path / "old.jsonl"
+    out.write_text(json.dumps(OLD_ROW) + "\n")
+    assert read_rows(out) == [record]  # read as it was
+    seen, notes = [], []
+    rows = run_batch(tasks[1:], out, resume=True, on_start=lambda n, k: seen.append((n, k)),
+                     notice=notes.append)  # fmt: skip
+    assert seen == [(1, 0)] and [r.key for r in rows] == [tasks[1].key]
+    (note,) = notes
+    assert f"{out}: 1 row of other settings (none recorded: an earlier version wrote them" in note
+    assert note.endswith("these runs are new")
+    assert read_rows(out)[0] == record and len(read_rows(out)) == 2  # it stays in the file
 
 
 def test_unknown_keys_are_kept_and_a_row_needs_its_identity():
@@ -137,10 +151,17 @@ def test_task_and_row_have_one_identity(tmp_path, monkeypatch):
     (tmp_path / "link.yaml").symlink_to(problem)
     monkeypatch.chdir(tmp_path)
     (task,) = make_tasks(["p.yaml"], ["RRT"], seed=4, time_limit=0.5)
-    assert error_row(task, "x").key == task.key == RunKey(str(problem), "RRT", 4, 0.5)
-    linked = RunRecord(file="link.yaml", planner="RRT", seed=4, run=0, budget=0.5, status="none")
+    settings = settings_key(task.settings)
+    assert error_row(task, "x").key == task.key == RunKey(str(problem), "RRT", 4, 0.5, settings)
+    linked = RunRecord(file="link.yaml", planner="RRT", seed=4, run=0, budget=0.5, status="none",
+                       settings=dict(task.settings))  # fmt: skip
     assert linked.key == task.key
-    assert RunRecord(file="p.yaml", planner="RRT", seed=4, run=0, budget=1.0).key != task.key
+    assert RunRecord(file="p.yaml", planner="RRT", seed=4, run=0, budget=1.0,
+                     settings=dict(task.settings)).key != task.key  # fmt: skip
+    # Settings are part of it: other parameters, or none recorded, are another run.
+    assert dataclasses.replace(linked, settings=None).key != task.key
+    (other,) = make_tasks(["p.yaml"], ["RRT"], seed=4, time_limit=0.5, params={"RRT": {"range": 2}})
+    assert other.key != task.key and other.key.configuration == task.key.configuration
 
 
 def test_the_results_file_writes_records(tmp_path):
