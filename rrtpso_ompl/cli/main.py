@@ -18,8 +18,9 @@ import logging
 import signal
 import sys
 from collections.abc import Iterator, Sequence
+from typing import NoReturn
 
-from ..errors import OutputError, RrtpsoError
+from ..errors import OutputError, RrtpsoError, shown
 from ..outputs import STDOUT, guard_standard_streams, os_reason, silence_stdout, stdout_closed
 from . import batch, bench, generate, optimum, planners, simulate, solve
 from .common import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK, add_shared_flags, set_quiet
@@ -30,14 +31,26 @@ __all__ = ["Terminated", "main"]
 COMMANDS = (solve, simulate, batch, generate, optimum, bench, planners)
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser, its usage errors bounded: argparse quotes a bad value whole
+    (``--runs 1000...``), and a command-line argument may hold 128 KiB."""
+
+    def error(self, message: str) -> NoReturn:
+        super().error(shown(message, MAX_USAGE_MESSAGE))
+
+
+#: Most characters of a usage error of argparse.
+MAX_USAGE_MESSAGE = 500
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="rrtpso",
         description="Plan 2-D paths for wheeled robots with RRT*PSO and OMPL's planners.",
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    shared = argparse.ArgumentParser(add_help=False)
+    shared = _Parser(add_help=False)
     add_shared_flags(shared)
     for command in COMMANDS:
         command.add_parser(sub, [shared])

@@ -20,7 +20,7 @@ from functools import lru_cache
 from importlib.metadata import entry_points
 from typing import Any
 
-from ..errors import RrtpsoError, did_you_mean
+from ..errors import RrtpsoError, did_you_mean, shown
 from .strategies import FIRST_PARTY, Strategy
 
 __all__ = [
@@ -71,7 +71,8 @@ class StrategyRegistry:
         except KeyError:
             known = ", ".join(self._classes)
             raise UnknownStrategyError(
-                f"no strategy '{name}'{did_you_mean(str(name), self._classes)} (known: {known})"
+                f"no strategy '{shown(name)}'{did_you_mean(str(name), self._classes)} "
+                f"(known: {known})"
             ) from None
 
     def make(self, name: str, values: Mapping[str, Any] | None = None) -> Strategy:

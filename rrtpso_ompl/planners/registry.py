@@ -29,7 +29,7 @@ from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
-from ..errors import ParameterError, UnknownPlannerError, did_you_mean
+from ..errors import ParameterError, UnknownPlannerError, did_you_mean, shown
 from .params import ParamSpec, ParamTable
 
 __all__ = [
@@ -131,7 +131,8 @@ class PlannerEntry:
             known = ", ".join(self.params.names()) or "none"
             hint = did_you_mean(name, self.params.names())
             raise ParameterError(
-                f"planner '{self.name}' has no parameter '{name}'{hint} (known: {known})", name
+                f"planner '{self.name}' has no parameter '{shown(name)}'{hint} (known: {known})",
+                name,
             )
         return self.params[name]
 
