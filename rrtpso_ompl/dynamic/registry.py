@@ -9,7 +9,8 @@ Where strategies come from, in this order:
    iterable of them.
 
 A name that is already taken is refused (a plugin cannot shadow a built-in strategy); a broken
-third-party plugin is reported in a warning and skipped, so it cannot break the tool.
+third-party plugin is reported in a warning and skipped, so it cannot break the tool, whatever it
+raises while it loads (``sys.exit()`` included).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from importlib.metadata import entry_points
 from typing import Any
 
 from ..errors import RrtpsoError, did_you_mean, shown
+from ..foreign import contained
 from .strategies import FIRST_PARTY, Strategy
 
 __all__ = [
@@ -106,12 +108,13 @@ class StrategyRegistry:
         """Register third-party strategies from the entry-point group; warn about broken ones."""
         for ep in entry_points(group=group):
             source = f"entry point '{ep.name} = {ep.value}'"
-            try:
+            # Whatever it raises (sys.exit() included; a real Ctrl-C still stops the command).
+            with contained() as box:
                 obj = ep.load()
                 for cls in [obj] if isinstance(obj, type) else list(obj):
                     self.register(cls, source=source)
-            except Exception as exc:  # a broken plugin must not break the tool: report and skip
-                log.warning("skipping strategy plugin %s: %s", source, exc)
+            if box.error is not None:
+                log.warning("skipping strategy plugin %s: %s", source, box.message)
 
 
 @lru_cache(maxsize=1)

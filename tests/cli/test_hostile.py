@@ -430,6 +430,18 @@ def test_every_echoed_value_is_shown_short(folder, args, text, where):
     assert len(proc.stderr.strip().splitlines()) == 1 or proc.stderr.startswith("usage:")
 
 
+def test_a_batch_input_whose_name_is_too_long_is_an_error_row(folder):
+    """Not a traceback (pathlib's is_dir lets ENAMETOOLONG through): an error row, its message
+    naming the input by its ends and its length."""
+    proc = run("batch", ARGUMENT, "p.yaml", "--planner", "RRTConnect", "--time", "0.05", "--out",
+               "r.jsonl", cwd=folder)  # fmt: skip
+    assert proc.returncode == 1, proc.stderr[-500:]
+    bad, good = rows_of(folder / "r.jsonl")
+    assert bad["file"] == ARGUMENT and bad["status"] == "error" and good["status"] == "exact"
+    assert bad["error"].endswith("(100,000 characters): cannot read it: File name too long")
+    assert len(bad["error"]) < 1200 and len(proc.stderr) < 2500
+
+
 @pytest.mark.parametrize(
     ("name", "words"),
     [
@@ -699,6 +711,45 @@ def test_a_reader_that_went_away_is_quiet(folder, args):
     code = proc.wait(timeout=120)
     assert err == "" and code in ((0, 1) if args[0] == "solve" else (0,)), (code, err)
     assert snapshot(folder) == before  # nothing left behind
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["solve", "p.yaml", "-v", "--time", "0.3", "--json", "-"], "Info:    RRTstar: Started"),
+        (["solve", "p.yaml", "-vv", "--time", "0.3", "--json", "-"], "Debug:   RRTstar: "),
+        (["solve", "p.yaml", "-v", "--planner", "PRMstar", "--time", "0.2", "--json", "-"],
+         "Info:    PRMstar: "),
+        (["simulate", "d.yaml", "-v", "--time", "0.3", "--json", "-"], "Info:    RRTstar: "),
+        (["batch", "p.yaml", "-v", "--planner", "RRTstar,RRTConnect", "--runs", "2", "--time",
+          "0.1", "--out", "-"], "batch: 4 rows"),
+    ],
+    ids=["solve-v", "solve-vv", "prmstar", "simulate", "batch"],
+)  # fmt: skip
+def test_with_ompl_talking_standard_output_holds_only_the_results(folder, args, words):
+    """OMPL writes its Info and Debug lines to C++'s std::cout, descriptor 1: `-v --json -`
+    gave a document jq could not parse (issue 32, item 3). Every log line goes to stderr."""
+    proc = run(*args, cwd=folder)
+    assert proc.returncode in (0, 1), proc.stderr
+    if args[0] == "batch":
+        rows = [json.loads(line) for line in proc.stdout.splitlines()]
+        assert len(rows) == 4 and all(r["status"] == "exact" for r in rows)
+    else:
+        assert isinstance(json.loads(proc.stdout), dict)
+    assert "Info:" not in proc.stdout and "Debug:" not in proc.stdout
+    assert words in proc.stderr, proc.stderr[-2000:]
+
+
+def test_with_ompl_talking_a_reader_that_went_away_is_still_quiet(folder):
+    """The duplicate of standard output that results are written to is the one silenced: no
+    Broken pipe, no traceback, the command's own status; OMPL's lines still on stderr."""
+    proc = subprocess.Popen([*rrtpso_exe(), "solve", "p.yaml", "-v", "--time", "0.2", "--json",
+                             "-"], cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, preexec_fn=_limit)  # fmt: skip
+    proc.stdout.close()
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) in (0, 1), err
+    assert "Info:    RRTstar" in err and "Broken pipe" not in err and "Traceback" not in err
 
 
 def test_closed_standard_streams_change_nothing_else(folder):
