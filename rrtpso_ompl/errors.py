@@ -27,7 +27,42 @@ __all__ = [
     "UnsupportedSpaceError",
     "UsageError",
     "did_you_mean",
+    "shown",
 ]
+
+#: Most characters a message shows of one value it echoes (a key, a name, a unit, a value).
+MAX_SHOWN = 100
+#: Most characters a message shows of a file name (names are long more often than values are).
+MAX_SHOWN_PATH = 1000
+#: Most characters of a whole message: the last guard, for a message that echoes several
+#: values or one this module's callers did not shorten.
+MAX_MESSAGE = 4000
+
+
+def shown(text: object, limit: int = MAX_SHOWN) -> str:
+    """``text`` as a message echoes it: whole when it has at most ``limit`` characters, else its
+    beginning and its end around ``...``, and how long it is.
+
+    Every message echoes what the user wrote through this (or through
+    :func:`~rrtpso_ompl.validation.short_repr` for a value of any type), so that a 1 MB
+    ``units:`` value or key name gives a message of a line, not of a megabyte.
+
+    Examples
+    --------
+    >>> shown("x" * 1_000_000, 20)
+    'xxxxxxxx...xxxxxxxxx (1,000,000 characters)'
+    """
+    if not isinstance(text, str):
+        try:
+            text = str(text)
+        except ValueError:  # an int with more digits than Python converts to text
+            return "(too long to show)"
+    n = len(text)
+    if n <= limit:
+        return text
+    head = max(1, (limit - 3) // 2)
+    tail = max(1, limit - 3 - head)
+    return f"{text[:head]}...{text[-tail:]} ({n:,} characters)"
 
 
 def did_you_mean(word: str, choices: Iterable[str]) -> str:
@@ -48,8 +83,9 @@ class RrtpsoError(Exception):
     """Base of every deliberate error of rrtpso-ompl: bad input, reported by its message alone."""
 
     def __str__(self) -> str:
-        # KeyError quotes its argument; every error of the family reads as plain text.
-        return str(self.args[0]) if self.args else type(self).__name__
+        # KeyError quotes its argument; every error of the family reads as plain text, and is
+        # bounded (MAX_MESSAGE) whatever it echoes.
+        return shown(self.args[0], MAX_MESSAGE) if self.args else type(self).__name__
 
 
 class ProblemError(RrtpsoError, ValueError):
@@ -70,7 +106,9 @@ class ProblemError(RrtpsoError, ValueError):
         self.source = str(source)
         self.key = key
         self.message = message
-        where = f"{self.source}: {key}" if key else self.source
+        path = shown(self.source, MAX_SHOWN_PATH)
+        # A key path joins a few names, each shortened where it is built (an unknown key).
+        where = f"{path}: {shown(key, 3 * MAX_SHOWN)}" if key else path
         super().__init__(f"{where}: {message}")
 
     def __reduce__(self):
@@ -124,12 +162,12 @@ class UnknownPlannerError(PlannerError, KeyError):
         self.origin = origin
         listing = ", ".join(self.known)
         if reason:
-            text = f"planner '{name}' is unavailable ({reason}); known planners: {listing}"
+            text = f"planner '{shown(name)}' is unavailable ({reason}); known planners: {listing}"
         else:
             lower = {k.lower(): k for k in self.known}
             close = difflib.get_close_matches(name.lower(), list(lower), n=1, cutoff=0.6)
             hint = f" (did you mean '{lower[close[0]]}'?)" if close else ""
-            text = f"unknown planner '{name}'{hint}; known planners: {listing}"
+            text = f"unknown planner '{shown(name)}'{hint}; known planners: {listing}"
         super().__init__(f"{origin}: {text}" if origin else text)
 
     def __reduce__(self):

@@ -28,6 +28,7 @@ that may be written may also be written atomically.
 from __future__ import annotations
 
 import contextlib
+import io
 import json
 import math
 import os
@@ -59,6 +60,7 @@ __all__ = [
     "os_reason",
     "publish",
     "remove_folders",
+    "results_only_on_stdout",
     "silence_stdout",
     "stdout_closed",
     "write_json_atomic",
@@ -74,6 +76,9 @@ DEFAULT_NAME_MAX = 255
 _RANDOM_CHARS = 8
 
 _stdout_closed = False
+#: The file descriptor Python's standard output writes to: 1, or its duplicate while
+#: :func:`results_only_on_stdout` holds descriptor 1 for standard error.
+_stdout_fd = 1
 
 
 def guard_standard_streams() -> None:
@@ -101,6 +106,67 @@ def guard_standard_streams() -> None:
                 sys.stderr = open(fd, "w", closefd=False)  # noqa: SIM115 - for the process
     if sys.stdout is None:
         _stdout_closed = True
+
+
+@contextmanager
+def results_only_on_stdout() -> Iterator[None]:
+    """Keep standard output for results while the block runs: file descriptor 1 (where OMPL's
+    C++ code writes its Info and Debug lines, and any library's ``printf``) goes to standard
+    error, and Python's ``sys.stdout`` writes to the real standard output through a duplicate
+    of it.
+
+    So ``rrtpso solve -v --json -`` and ``rrtpso batch -v --out -`` write nothing but their
+    results on standard output, whatever OMPL's log level, and every log line goes to standard
+    error. Processes started meanwhile (the workers of a batch) inherit descriptor 1 as it is
+    then, standard error: the duplicate is not inherited, so no worker can write there.
+    Everything is put back when the block ends (a caller such as a test runs commands in its
+    own process).
+    """
+    global _stdout_fd
+    with contextlib.suppress(AttributeError, ValueError, OSError):
+        sys.stdout.flush()  # what was written before goes where it was meant to
+    saved = os.dup(1)  # not inheritable (PEP 446)
+    _flush_c_stdio()
+    os.dup2(2, 1)
+    old, new = sys.stdout, None
+    if old is not None and _writes_to_fd(old, 1):
+        new = io.TextIOWrapper(
+            open(saved, "wb", closefd=True),  # noqa: SIM115 - closed when the block ends
+            encoding=old.encoding, errors=old.errors, line_buffering=old.line_buffering,
+        )  # fmt: skip
+        sys.stdout = new
+        _stdout_fd = saved
+    try:
+        yield
+    finally:
+        if new is not None:
+            with contextlib.suppress(OSError, ValueError):
+                new.flush()
+        _flush_c_stdio()  # OMPL's lines still buffered by C's stdio go to standard error
+        os.dup2(saved, 1)  # also after silence_stdout: then descriptor 1 is the null device
+        _stdout_fd = 1
+        if new is not None:
+            sys.stdout = old
+            with contextlib.suppress(OSError, ValueError):
+                new.close()  # closes `saved`
+        else:
+            os.close(saved)
+
+
+def _writes_to_fd(stream: Any, fd: int) -> bool:
+    """Whether the text stream ``stream`` writes to file descriptor ``fd``."""
+    try:
+        return stream.fileno() == fd
+    except (AttributeError, ValueError, OSError):  # a test's capture, a closed stream
+        return False
+
+
+def _flush_c_stdio() -> None:
+    """Flush C's stdio buffers (``fflush(NULL)``), where C++'s ``std::cout`` may hold lines."""
+    import ctypes
+
+    with contextlib.suppress(OSError, AttributeError, TypeError):
+        ctypes.CDLL(None).fflush(None)
 
 
 def stdout_closed() -> bool:
@@ -139,7 +205,7 @@ def silence_stdout() -> None:
     """
     devnull = os.open(os.devnull, os.O_WRONLY)
     try:
-        os.dup2(devnull, 1)
+        os.dup2(devnull, _stdout_fd)
     finally:
         os.close(devnull)
 

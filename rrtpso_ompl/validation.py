@@ -12,6 +12,8 @@ import numbers
 import reprlib
 from typing import Any
 
+from .errors import shown
+
 __all__ = [
     "MAX_COORDINATE",
     "MAX_RUNS",
@@ -65,12 +67,17 @@ _MAX_REPR = 100
 
 
 def short_repr(value: Any) -> str:
-    """A repr of at most :data:`_MAX_REPR` characters, however large or nested the value."""
+    """A repr of at most :data:`_MAX_REPR` characters, however large or nested the value (a
+    long string also says how long it is)."""
     try:
         text = _REPR.repr(value)
     except ValueError:  # an int with more digits than Python will convert to text
         return "(too long to show)"
-    return text if len(text) <= _MAX_REPR else text[: _MAX_REPR - 3] + "..."
+    if len(text) > _MAX_REPR:
+        text = text[: _MAX_REPR - 3] + "..."
+    if isinstance(value, str) and len(value) > _REPR.maxstring:
+        text += f" ({len(value):,} characters)"
+    return text
 
 
 def describe(value: Any) -> str:
@@ -130,9 +137,9 @@ def check_integer(value: Any, *, low: int | None = None, high: int | None = None
         value = int(value)
     value = int(value)
     if low is not None and value < low:
-        raise ValueError(f"must be >= {low}, got {value}")
+        raise ValueError(f"must be >= {low}, got {shown(value)}")
     if high is not None and value > high:
-        raise ValueError(f"must be <= {high}, got {value}")
+        raise ValueError(f"must be <= {high}, got {shown(value)}")
     return value
 
 
@@ -198,5 +205,5 @@ def number_hint(value: Any) -> str:
         mantissa, e, exponent = fixed.partition("e")
         if e and "." not in mantissa:
             fixed = f"{mantissa}.0e{exponent}"
-        return f" (YAML reads {value} as text, not a number: write {fixed})"
+        return f" (YAML reads {shown(value)} as text, not a number: write {fixed})"
     return " (a number in quotes is text: remove the quotes)"

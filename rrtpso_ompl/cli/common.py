@@ -18,7 +18,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import ParameterError, UnknownPlannerError, UsageError, did_you_mean
+from ..errors import (
+    MAX_SHOWN,
+    ParameterError,
+    UnknownPlannerError,
+    UsageError,
+    did_you_mean,
+    shown,
+)
 from ..model import load_problem
 from ..model.yamlfile import file_kind
 from ..outputs import STDOUT, is_stream, name_max, os_reason, stdout_closed
@@ -145,9 +152,10 @@ def parse_params(items: list[str], src: str = "") -> dict[str, str]:
         key, sep, value = item.partition("=")
         key, value = key.strip(), value.strip()
         if not sep or not key:
-            raise UsageError(f"{where}: expected NAME=VALUE, got '{item}'")
+            raise UsageError(f"{where}: expected NAME=VALUE, got '{shown(item)}'")
         if key in params:
-            raise UsageError(f"{where} {key}: given twice ({key}={params[key]} and {key}={value}); "
+            name, first, then = shown(key), shown(params[key]), shown(value)
+            raise UsageError(f"{where} {name}: given twice ({name}={first} and {name}={then}); "
                              "give it once")  # fmt: skip
         params[key] = value
     return params
@@ -490,16 +498,17 @@ def check_run_options(args: argparse.Namespace) -> None:
     check_positive_seconds(args.time, "--time")
     for flag in ("runs", "jobs"):
         if getattr(args, flag) < 1:
-            raise UsageError(f"--{flag}: must be at least 1, got {getattr(args, flag)}")
+            raise UsageError(f"--{flag}: must be at least 1, got {shown(getattr(args, flag))}")
     from ..validation import MAX_RUNS
 
     if args.runs > MAX_RUNS:
         raise UsageError(f"--runs: must be at most {MAX_RUNS:,} (the runs of one batch or bench), "
-                         f"got {args.runs}")  # fmt: skip
+                         f"got {shown(args.runs)}")  # fmt: skip
     max_jobs = 4 * (os.cpu_count() or 1)
     if args.jobs > max_jobs:
         raise UsageError(f"--jobs: must be at most {max_jobs} (4 per CPU of this machine; each "
-                         f"worker is a Python process with OMPL), got {args.jobs}")  # fmt: skip
+                         "worker is a Python process with OMPL), "
+                         f"got {shown(args.jobs)}")  # fmt: skip
     check_seed_flag(args.seed, runs=args.runs)
     if args.executor == "dask":
         if not args.scheduler:
@@ -563,6 +572,7 @@ def check_planners(names: list[str], items: list[str], flag: str) -> dict[str, d
         raise UsageError(str(exc)) from None
     for key in params:
         if not any(key in p for p in out.values()):
-            raise UsageError(f"--param {key}: none of the planners {', '.join(names)} has it"
+            raise UsageError(f"--param {shown(key)}: none of the planners "
+                             f"{shown(', '.join(names), 3 * MAX_SHOWN)} has it"
                              f"{did_you_mean(key, sorted(known))}")  # fmt: skip
     return out

@@ -18,9 +18,17 @@ import logging
 import signal
 import sys
 from collections.abc import Iterator, Sequence
+from typing import NoReturn
 
-from ..errors import OutputError, RrtpsoError
-from ..outputs import STDOUT, guard_standard_streams, os_reason, silence_stdout, stdout_closed
+from ..errors import OutputError, RrtpsoError, shown
+from ..outputs import (
+    STDOUT,
+    guard_standard_streams,
+    os_reason,
+    results_only_on_stdout,
+    silence_stdout,
+    stdout_closed,
+)
 from . import batch, bench, generate, optimum, planners, simulate, solve
 from .common import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK, add_shared_flags, set_quiet
 
@@ -30,14 +38,26 @@ __all__ = ["Terminated", "main"]
 COMMANDS = (solve, simulate, batch, generate, optimum, bench, planners)
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser, its usage errors bounded: argparse quotes a bad value whole
+    (``--runs 1000...``), and a command-line argument may hold 128 KiB."""
+
+    def error(self, message: str) -> NoReturn:
+        super().error(shown(message, MAX_USAGE_MESSAGE))
+
+
+#: Most characters of a usage error of argparse.
+MAX_USAGE_MESSAGE = 500
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="rrtpso",
         description="Plan 2-D paths for wheeled robots with RRT*PSO and OMPL's planners.",
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    shared = argparse.ArgumentParser(add_help=False)
+    shared = _Parser(add_help=False)
     add_shared_flags(shared)
     for command in COMMANDS:
         command.add_parser(sub, [shared])
@@ -91,17 +111,22 @@ def _stop_signals_as_interrupts() -> Iterator[None]:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     guard_standard_streams()  # before any file is opened: `rrtpso ... >&-`
-    args = build_parser().parse_args(argv)
-    args.argv = list(sys.argv[1:] if argv is None else argv)
-    set_quiet(args.quiet)
-    if args.quiet:
-        args.verbose = -1  # -q wins over -v: only errors, from Python's logging and from OMPL
-    logging.basicConfig(
-        level={-1: logging.ERROR, 0: logging.WARNING}.get(args.verbose, logging.INFO),
-        format="%(levelname)s: %(name)s: %(message)s",
-    )
+    with results_only_on_stdout():  # OMPL's own lines go to stderr, results to stdout
+        return _run(argv)
+
+
+def _run(argv: Sequence[str] | None) -> int:
     try:
         with _stop_signals_as_interrupts():
+            # Building the parser loads the strategies (simulate's choices), plugins included:
+            # a Ctrl-C then ends as anywhere else, and their warnings wait for -q and -v.
+            try:
+                with _held_log_records() as held:
+                    args = build_parser().parse_args(argv)
+            except SystemExit:  # --help, --version, a usage error: nothing asked for quiet
+                _show(held, logging.WARNING)
+                raise
+            _configure(args, argv, held)
             status = args.func(args)
             _flush_stdout()
         return status
@@ -127,6 +152,52 @@ def main(argv: Sequence[str] | None = None) -> int:
             "limits in docs/problem-format.md)",
             EXIT_BAD_INPUT,
         )
+
+
+def _configure(
+    args: argparse.Namespace, argv: Sequence[str] | None, held: list[logging.LogRecord]
+) -> None:
+    """Quiet, verbose and Python's logging from the flags; then the records held while the
+    parser was built, those the level lets through."""
+    args.argv = list(sys.argv[1:] if argv is None else argv)
+    set_quiet(args.quiet)
+    if args.quiet:
+        args.verbose = -1  # -q wins over -v: only errors, from Python's logging and from OMPL
+    _show(held, {-1: logging.ERROR, 0: logging.WARNING}.get(args.verbose, logging.INFO))
+
+
+def _show(held: list[logging.LogRecord], level: int) -> None:
+    """Python's logging at ``level`` (on stderr), and the ``held`` records it lets through."""
+    logging.basicConfig(level=level, format="%(levelname)s: %(name)s: %(message)s")
+    for record in held:
+        if record.levelno >= level:
+            logging.getLogger(record.name).handle(record)
+
+
+class _Holder(logging.Handler):
+    """A logging handler that keeps the records it is given, in ``records``."""
+
+    def __init__(self, records: list[logging.LogRecord]) -> None:
+        super().__init__()
+        self.records = records
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.records.append(record)
+
+
+@contextlib.contextmanager
+def _held_log_records() -> Iterator[list[logging.LogRecord]]:
+    """Hold the log records of the block (warnings and above) instead of printing them: the
+    flags that say whether to print them (-q, -v) are not parsed yet."""
+    records: list[logging.LogRecord] = []
+    root = logging.getLogger()
+    handler = _Holder(records)
+    handler.setLevel(logging.WARNING)
+    root.addHandler(handler)
+    try:
+        yield records
+    finally:
+        root.removeHandler(handler)
 
 
 def _fail(message: str, status: int) -> int:

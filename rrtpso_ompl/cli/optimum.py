@@ -75,14 +75,14 @@ def run(args: argparse.Namespace) -> int:
 def _shortest(args: argparse.Namespace, problem: Any, frame: Any) -> int:
     """The exact shortest path (with ``--cost`` and no inflation: its ``J`` is its length)."""
     from ..groundtruth import shortest_path
+    from ..model import World
 
-    result = shortest_path(problem)
-    data = None
-    if args.json or frame is not None:
-        from ..model import World
-
-        data = result.to_dict(World.from_problem(problem))  # the polyline the exact check accepts
-    poses = ros_poses(args, frame, data["path"] if result.found else None)  # may refuse: first
+    world = World.from_problem(problem)
+    result = shortest_path(problem, world)
+    # Built whatever the outputs ask for: the message, --json, the poses and the bag all read it.
+    data = result.to_dict(world)  # the polyline the exact check accepts
+    path = data["path"] if result.found else None
+    poses = ros_poses(args, frame, path)  # may refuse: first
     if args.plot:
         from ..plotting import plot_optimum, save_figure
 
@@ -95,7 +95,7 @@ def _shortest(args: argparse.Namespace, problem: Any, frame: Any) -> int:
         if args.cost:
             data = {"length": data["length"], "path": data["path"], "cost": result.length, **data}
         write_json_atomic({**data, **units_fields(problem.units)}, args.json)
-    _write_bag(args, problem, frame, data["path"] if data and result.found else None)
+    _write_bag(args, problem, frame, path)
     if result.found:
         what = "no inflation: J is the length; " if args.cost else ""
         note(f"{problem.name}: {what}optimum length={result.length:.6f}")

@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+import sys
 from typing import Any
 
 from ..dynamic.options import DynamicOptions
 from ..dynamic.registry import STRATEGY_ENTRY_POINT_GROUP, default_strategies
-from ..errors import UsageError
+from ..errors import RrtpsoError, UsageError
+from ..foreign import contained
 from .common import (
     EXIT_OK,
     EXIT_UNSOLVED,
@@ -20,6 +23,7 @@ from .common import (
     choose_planner,
     note,
     progress_bar,
+    report_errors,
 )
 from .ros_flags import add_ros_flags, ros_frame, ros_outputs, ros_poses, write_path_out
 
@@ -124,7 +128,14 @@ def run(args: argparse.Namespace) -> int:
         params=choice.params,
     )
     seed = args.seed if args.seed is not None else problem.planner.seed
-    with progress_bar("simulating", unit="s") as bar:
+    # The planner's and the strategy's code (a plugin's) may raise anything: the simulation is
+    # then an error, not a traceback; bad input and a real Ctrl-C go on to main. What they
+    # print is no result: standard error (`--json -` keeps standard output for the JSON).
+    with (
+        progress_bar("simulating", unit="s") as bar,
+        contained(passthrough=(RrtpsoError, MemoryError)) as box,
+        contextlib.redirect_stdout(sys.stderr),
+    ):
 
         def progress(t: float, t_end: float) -> None:
             bar.total = round(t_end, 1)
@@ -132,6 +143,8 @@ def run(args: argparse.Namespace) -> int:
             bar.refresh()
 
         sim = simulate(problem, options, seed=seed, progress=progress)
+    if box.error is not None:
+        return _failed(args, problem, options, seed, box)
     _write_outputs(args, problem, sim, frame)
     verdict = "reached the goal" if sim.reached_goal else f"did not reach the goal ({sim.status})"
     note(
@@ -139,6 +152,27 @@ def run(args: argparse.Namespace) -> int:
         f"time {sim.total_time:.1f}s, length {sim.path_length:.1f}",
     )
     return EXIT_OK if sim.success else EXIT_UNSOLVED
+
+
+def _failed(args: argparse.Namespace, problem: Any, options: Any, seed: Any, box: Any) -> int:
+    """A simulation that raised (:func:`~rrtpso_ompl.foreign.contained`): one message, and the
+    JSON with status ``error`` and the message, nothing else written; exit status 1. With
+    ``-v`` the traceback is logged too."""
+    import logging
+
+    message = f"{args.problem}: the simulation raised {box.message}"
+    logging.getLogger(__name__).info("the simulation's traceback:", exc_info=box.error)
+    if args.json:
+        from ..outputs import write_json_atomic
+        from ..ros import units_fields
+
+        data = {"problem": problem.name, "status": "error", "strategy": options.strategy,
+                "planner": options.planner, "seed": seed, "reached_goal": False,
+                "replans": [], "trajectory": [], "static_path": [],
+                "error": message}  # fmt: skip
+        write_json_atomic({**data, **units_fields(problem.units)}, args.json)
+    report_errors([f"error: {message}"])
+    return EXIT_UNSOLVED
 
 
 def _write_outputs(args: argparse.Namespace, problem: Any, sim: Any, frame: Any) -> None:

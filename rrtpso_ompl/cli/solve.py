@@ -14,6 +14,7 @@ from .common import (
     check_outputs,
     choose_planner,
     note,
+    report_errors,
 )
 from .ros_flags import add_ros_flags, ros_frame, ros_outputs, ros_poses, write_path_out
 
@@ -121,9 +122,25 @@ def run(args: argparse.Namespace) -> int:
     elif args.slow_near_obstacles:
         raise UsageError("--slow-near-obstacles: only with --trajectory or --plot-velocities")
 
+    import contextlib
+    import sys
+    import time
+
+    from ..errors import RrtpsoError
+    from ..foreign import contained
     from ..planners import solve
 
-    result = solve(request)
+    t0 = time.perf_counter()
+    # A planner's code (a plugin's) may raise anything: the run is then an error, as in a batch
+    # row, not a traceback; bad input and a real Ctrl-C go on to main. What it prints is no
+    # result: standard error (`--json -` keeps standard output for the JSON).
+    with (
+        contained(passthrough=(RrtpsoError, MemoryError)) as box,
+        contextlib.redirect_stdout(sys.stderr),
+    ):
+        result = solve(request)
+    if box.error is not None:
+        return _failed(args, request, box, time.perf_counter() - t0)
     motion = None
     if wants_motion and result.solved:
         motion = _drive(problem, result, args.profile, args.slow_near_obstacles)
@@ -133,6 +150,27 @@ def run(args: argparse.Namespace) -> int:
         f"{problem.name}: {result.planner} {result.status} length={length} time={result.time:.3f}s",
     )
     return EXIT_OK if result.solved else EXIT_UNSOLVED
+
+
+def _failed(args: argparse.Namespace, request: Any, box: Any, elapsed: float) -> int:
+    """A run that raised (:func:`~rrtpso_ompl.foreign.contained`): one message, and the JSON
+    with status ``error`` and the message (as a batch's error row), nothing else written;
+    exit status 1. With ``-v`` the traceback is logged too."""
+    import logging
+
+    message = f"{args.problem}: the run raised {box.message}"
+    logging.getLogger(__name__).info("the run's traceback:", exc_info=box.error)
+    if args.json:
+        from ..outputs import write_json_atomic
+        from ..ros import units_fields
+
+        problem = request.problem
+        data = {"problem": problem.name, "planner": request.label, "status": "error",
+                "solved": False, "length": None, "time": elapsed, "seed": request.seed,
+                "path": [], "time_limit": request.time_limit, "error": message}  # fmt: skip
+        write_json_atomic({**data, **units_fields(problem.units)}, args.json)
+    report_errors([f"error: {message}"])
+    return EXIT_UNSOLVED
 
 
 def _check_drive_keys(args: argparse.Namespace, problem: Any) -> None:

@@ -9,7 +9,8 @@ Where strategies come from, in this order:
    iterable of them.
 
 A name that is already taken is refused (a plugin cannot shadow a built-in strategy); a broken
-third-party plugin is reported in a warning and skipped, so it cannot break the tool.
+third-party plugin is reported in a warning and skipped, so it cannot break the tool, whatever it
+raises while it loads (``sys.exit()`` included).
 """
 
 from __future__ import annotations
@@ -20,7 +21,8 @@ from functools import lru_cache
 from importlib.metadata import entry_points
 from typing import Any
 
-from ..errors import RrtpsoError, did_you_mean
+from ..errors import RrtpsoError, did_you_mean, shown
+from ..foreign import contained
 from .strategies import FIRST_PARTY, Strategy
 
 __all__ = [
@@ -71,7 +73,8 @@ class StrategyRegistry:
         except KeyError:
             known = ", ".join(self._classes)
             raise UnknownStrategyError(
-                f"no strategy '{name}'{did_you_mean(str(name), self._classes)} (known: {known})"
+                f"no strategy '{shown(name)}'{did_you_mean(str(name), self._classes)} "
+                f"(known: {known})"
             ) from None
 
     def make(self, name: str, values: Mapping[str, Any] | None = None) -> Strategy:
@@ -105,12 +108,13 @@ class StrategyRegistry:
         """Register third-party strategies from the entry-point group; warn about broken ones."""
         for ep in entry_points(group=group):
             source = f"entry point '{ep.name} = {ep.value}'"
-            try:
+            # Whatever it raises (sys.exit() included; a real Ctrl-C still stops the command).
+            with contained() as box:
                 obj = ep.load()
                 for cls in [obj] if isinstance(obj, type) else list(obj):
                     self.register(cls, source=source)
-            except Exception as exc:  # a broken plugin must not break the tool: report and skip
-                log.warning("skipping strategy plugin %s: %s", source, exc)
+            if box.error is not None:
+                log.warning("skipping strategy plugin %s: %s", source, box.message)
 
 
 @lru_cache(maxsize=1)

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..errors import ProblemError, RrtpsoError, UsageError
+from ..errors import MAX_SHOWN_PATH, ProblemError, RrtpsoError, UsageError, shown
 from ..model.occupancy import is_map_yaml
 from ..model.problem import input_files
 from ..model.yamlfile import open_input
@@ -120,6 +120,13 @@ def expand_inputs(items: Sequence[str]) -> list[tuple[str, str | None]]:
 
     for item in items:
         p = Path(item)
+        try:
+            p.stat()
+        except OSError as exc:
+            if exc.errno not in (errno.ENOENT, errno.ENOTDIR, errno.ELOOP):
+                # A name too long, a folder that may not be read: why, as the system says it.
+                add(item, f"cannot read it: {exc.strerror or exc}")
+                continue
         if p.is_dir():
             found = folder_problems(p)
             if not found:
@@ -317,12 +324,12 @@ def run_task(task: Task) -> RunRecord:
     base = _base_row(task)
     t0 = time.perf_counter()
     if task.error:
-        return error_row(task, f"{task.file}: {task.error}")
+        return error_row(task, f"{_where(task)}: {task.error}")
     prepare_task(task)
     loaded = _LOADED[task.file]
     if isinstance(loaded, RrtpsoError):
         return error_row(task, str(loaded) if isinstance(loaded, ProblemError) else
-                         f"{task.file}: {loaded}")  # fmt: skip
+                         f"{_where(task)}: {loaded}")  # fmt: skip
     problem, world = loaded
     try:
         result = solve(problem, task.planner, time_limit=task.time_limit, seed=task.seed,
@@ -331,11 +338,16 @@ def run_task(task: Task) -> RunRecord:
     except ProblemError as exc:  # it names the file already
         return error_row(task, str(exc))
     except RrtpsoError as exc:  # unknown planner, bad parameter
-        return error_row(task, f"{task.file}: {exc}")
+        return error_row(task, f"{_where(task)}: {exc}")
     solved = result.to_dict()
     if not task.keep_path:
         solved.pop("path", None)
     return RunRecord.from_solve(base, solved, wall=time.perf_counter() - t0)
+
+
+def _where(task: Task) -> str:
+    """The task's file as its messages name it (a long name shortened, ``errors.shown``)."""
+    return shown(task.file, MAX_SHOWN_PATH)
 
 
 def _base_row(task: Task) -> dict[str, Any]:
@@ -375,7 +387,7 @@ def _row_of(task: Task, result: Any) -> RunRecord:
     from .workers import ChildFailure
 
     if isinstance(result, ChildFailure):
-        return error_row(task, f"{task.file}: {result.message}")
+        return error_row(task, f"{_where(task)}: {result.message}")
     return result
 
 

@@ -51,6 +51,8 @@ from collections.abc import Callable, Iterable, Iterator
 from multiprocessing.connection import Connection, wait
 from typing import Any
 
+from ..foreign import describe_failure
+
 __all__ = [
     "GRACE",
     "WARM_MODULES",
@@ -123,7 +125,7 @@ def run_once_in_child(fn: Callable[[Any], Any], task: Any, timeout: float,
         try:
             payload = pickle.dumps(("ok", fn(task)))
         except BaseException as exc:
-            payload = pickle.dumps(("raised", f"{type(exc).__name__}: {exc}",
+            payload = pickle.dumps(("raised", describe_failure(exc),
                                     traceback.format_exc(limit=5)))  # fmt: skip
             code = 1
         try:
@@ -264,7 +266,7 @@ def run_spawned(fn: Callable[[Any], Any], task: Any, timeout: float, warm: bool 
         except BrokenProcessPool:
             return ChildFailure("the run's process died")
         except Exception as exc:
-            return ChildFailure(f"the run raised {type(exc).__name__}: {exc}")
+            return ChildFailure(f"the run raised {describe_failure(exc)}")
 
 
 def _watched_call(fn: Callable[[Any], Any], task: Any, owner: int) -> Any:

@@ -23,7 +23,7 @@ from typing import Any, TypeVar
 import numpy as np
 import shapely
 
-from ..errors import ArgumentError, ProblemError, did_you_mean
+from ..errors import ArgumentError, ProblemError, did_you_mean, shown
 from ..validation import (
     MAX_COORDINATE,
     MIN_EXTENT,
@@ -613,7 +613,12 @@ class _Validator:
             raise self.error(f"{key}.unknown", f"must be obstacle or free, got {describe(unknown)}")
         if "\0" in file:
             raise self.error(doc_key, "the file name holds a NUL byte")
-        return load_map(map_file_path(file, base), unknown_blocks=unknown == "obstacle")
+        try:
+            return load_map(map_file_path(file, base), unknown_blocks=unknown == "obstacle")
+        except ProblemError as exc:
+            # The map's own message names the map file (and its key); this file and its key
+            # go first, so that `map: /dev/zero` says which problem and key it came from.
+            raise self.error(doc_key, str(exc)) from None
 
     def moving(self, value: Any, key: str) -> MovingObstacle:
         doc = self.mapping(value, key, _MOVING_KEYS, required=_MOVING_KEYS)
@@ -851,9 +856,10 @@ def _join(prefix: str, key: str) -> str:
 
 
 def _key_label(key: Any) -> str:
-    """A mapping key as the user wrote it, for messages (YAML spells None as null)."""
+    """A mapping key as the user wrote it, for messages (YAML spells None as null), shortened
+    when long (:func:`~rrtpso_ompl.errors.shown`)."""
     if key is None:
         return "null"
     if isinstance(key, bool):
         return "true" if key else "false"
-    return str(key) or "''"
+    return shown(key) or "''"

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import contextlib
 
-from ..errors import ProblemError
+from ..errors import ProblemError, shown
 
 __all__ = ["METRES_PER_UNIT", "metres_per_unit", "units_fields"]
 
@@ -56,7 +56,9 @@ def metres_per_unit(units: str, source: str = "<dict>") -> float:
     except KeyError:
         known = ", ".join(sorted({"mm", "cm", "m", "km", "in", "ft"}))
         raise ProblemError(
-            source, "units", f"unknown length unit {units!r} for a ROS output (known: {known})"
+            source,
+            "units",
+            f"unknown length unit '{shown(units)}' for a ROS output (known: {known})",
         ) from None
 
 

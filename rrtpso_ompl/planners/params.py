@@ -31,7 +31,7 @@ from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
-from ..errors import ParameterError, did_you_mean
+from ..errors import ParameterError, did_you_mean, shown
 from ..validation import check_integer, check_number, describe, number_hint
 
 __all__ = ["ParamSpec", "ParamTable", "Rule", "declared", "param"]
@@ -139,12 +139,12 @@ class ParamSpec:
                 return True
             if text.lower() in _FALSE:
                 return False
-            raise ValueError(f"must be a boolean (true/false), got '{value}'")
+            raise ValueError(f"must be a boolean (true/false), got '{shown(value)}'")
         try:
             number = float(text)
         except ValueError:
             raise ValueError(f"must be {'an integer' if self.type is int else 'a number'}, "
-                             f"got '{value}'") from None  # fmt: skip
+                             f"got '{shown(value)}'") from None  # fmt: skip
         if self.type is int and math.isfinite(number) and "." not in text and "e" not in text:
             return int(text)  # exact, also beyond 2**53
         return number
@@ -165,12 +165,12 @@ class ParamSpec:
         if self.type in (int, float):
             x = check_integer(v) if self.type is int else check_number(v)
             if (self.low is not None and x < self.low) or (self.high is not None and x > self.high):
-                raise ValueError(f"must be in {self.range_text()}, got {x!r}")
+                raise ValueError(f"must be in {self.range_text()}, got {shown(x)}")
             return x
         if not isinstance(v, str):
             raise ValueError(f"must be a string, got {describe(v)}")
         if self.choices is not None and v not in self.choices:
-            raise ValueError(f"must be one of {list(self.choices)}, got '{v}'")
+            raise ValueError(f"must be one of {list(self.choices)}, got '{shown(v)}'")
         return v
 
     def range_text(self) -> str:
@@ -254,7 +254,9 @@ class ParamTable:
         except KeyError:
             known = ", ".join(self._params) or "none"
             hint = did_you_mean(name, self._params)
-            raise ParameterError(f"no parameter '{name}'{hint} (known: {known})", name) from None
+            raise ParameterError(
+                f"no parameter '{shown(name)}'{hint} (known: {known})", name
+            ) from None
 
     def names(self) -> list[str]:
         """Parameter names in declaration order."""
@@ -307,13 +309,13 @@ class ParamTable:
             if key not in self._params:
                 known = ", ".join(self._params) or "none"
                 hint = did_you_mean(str(key), self._params)
-                raise ParameterError(f"{owner or 'the planner'} has no parameter '{key}'{hint} "
-                                     f"(known: {known})", key)  # fmt: skip
+                raise ParameterError(f"{owner or 'the planner'} has no parameter "
+                                     f"'{shown(key)}'{hint} (known: {known})", key)  # fmt: skip
             converted[key] = self._params[key].convert(value, owner)
         merged = {**self.defaults(), **converted}
         for rule in self.rules:
             if not rule.holds(*(merged[n] for n in rule.names)):
-                given = ", ".join(f"{n} = {merged[n]!r}" for n in rule.names)
+                given = ", ".join(f"{n} = {shown(repr(merged[n]))}" for n in rule.names)
                 raise ParameterError(f"parameters{of} must satisfy {rule.text}, got {given}",
                                      " + ".join(rule.names))  # fmt: skip
         return converted

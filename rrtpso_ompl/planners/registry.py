@@ -13,7 +13,8 @@ Where planners come from, in this order:
    load to a :class:`PlannerEntry`, an iterable of them, or a callable returning either.
 
 A name that is already taken is refused (a third-party plugin cannot shadow a built-in planner); a
-broken third-party plugin is reported in a warning and skipped, so it cannot break the tool.
+broken plugin is reported in a warning and skipped, so it cannot break the tool, whatever it
+raises while it loads (``sys.exit()`` included).
 """
 
 from __future__ import annotations
@@ -29,7 +30,8 @@ from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
-from ..errors import ParameterError, UnknownPlannerError, did_you_mean
+from ..errors import ParameterError, UnknownPlannerError, did_you_mean, shown
+from ..foreign import contained
 from .params import ParamSpec, ParamTable
 
 __all__ = [
@@ -131,7 +133,8 @@ class PlannerEntry:
             known = ", ".join(self.params.names()) or "none"
             hint = did_you_mean(name, self.params.names())
             raise ParameterError(
-                f"planner '{self.name}' has no parameter '{name}'{hint} (known: {known})", name
+                f"planner '{self.name}' has no parameter '{shown(name)}'{hint} (known: {known})",
+                name,
             )
         return self.params[name]
 
@@ -227,20 +230,30 @@ class PlannerRegistry:
         return [self.register(e, source) for e in items]
 
     def load_first_party(self) -> None:
-        """Register the planners of ``rrtpso_ompl.plugins`` (each module's ``PLANNERS``)."""
+        """Register the planners of ``rrtpso_ompl.plugins`` (each module's ``PLANNERS``); a
+        module that fails to load is reported and skipped, as a third-party one is."""
         for mod_name in FIRST_PARTY_PLUGINS:
-            module = _import_first_party(mod_name)
-            self.register_plugin(module.PLANNERS, source=f"rrtpso_ompl.plugins.{mod_name}")
-            self.unavailable.update(getattr(module, "UNAVAILABLE", {}))
+            source = f"rrtpso_ompl.plugins.{mod_name}"
+            with contained() as box:
+                module = _import_first_party(mod_name)
+                self.register_plugin(module.PLANNERS, source=source)
+                self.unavailable.update(getattr(module, "UNAVAILABLE", {}))
+            if box.error is not None:
+                log.warning("skipping planner plugin %s: %s", source, box.message)
 
     def load_entry_points(self, group: str = ENTRY_POINT_GROUP) -> None:
-        """Register third-party planners from the entry-point group; warn about broken ones."""
+        """Register third-party planners from the entry-point group; warn about broken ones.
+
+        Whatever a plugin raises while it loads is reported and the plugin skipped, so that it
+        cannot break the tool: ``sys.exit()`` and a ``KeyboardInterrupt`` of its own included
+        (a real Ctrl-C still stops the command, :func:`~rrtpso_ompl.foreign.contained`).
+        """
         for ep in entry_points(group=group):
             source = f"entry point '{ep.name} = {ep.value}'"
-            try:
+            with contained() as box:
                 self.register_plugin(ep.load(), source=source)
-            except Exception as exc:  # a broken plugin must not break the tool: report and skip
-                log.warning("skipping planner plugin %s: %s", source, exc)
+            if box.error is not None:
+                log.warning("skipping planner plugin %s: %s", source, box.message)
 
 
 def _import_first_party(mod_name: str) -> Any:

@@ -40,7 +40,14 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
-from ..errors import ArgumentError, ParameterError, ProblemError, UnknownPlannerError, did_you_mean
+from ..errors import (
+    ArgumentError,
+    ParameterError,
+    ProblemError,
+    UnknownPlannerError,
+    did_you_mean,
+    shown,
+)
 from ..model.problem import PlannerConfig, Problem
 from ..validation import check_seconds, check_seed, describe
 from .params import ParamSpec, ParamTable
@@ -96,14 +103,16 @@ def parse_steps(items: Iterable[str], origin: str = "post") -> tuple[str, ...]:
     for step in steps:
         if step not in POST_STEPS:
             known = ", ".join(POST_STEPS)
-            raise ParameterError(f"unknown post-pass {step!r} (known: {known})", step, origin)
+            raise ParameterError(
+                f"unknown post-pass '{shown(step)}' (known: {known})", step, origin
+            )
     return steps
 
 
 def split_spec(spec: str, origin: str = "") -> tuple[str, tuple[str, ...]]:
     """``"BITstar+simplify+pso"`` -> ``("BITstar", ("simplify", "pso"))``; steps checked."""
     name, *steps = spec.split("+")
-    return name.strip(), parse_steps(steps, origin or f"planner {spec!r}")
+    return name.strip(), parse_steps(steps, origin or f"planner '{shown(spec)}'")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -132,7 +141,7 @@ class Sources:
 
     def label(self, what: str, name: str = "") -> str:
         """The origin text of the caller's ``what`` (``"param"`` with its ``name``)."""
-        text = self.param.format(name=name) if what == "param" else getattr(self, what)
+        text = self.param.format(name=shown(name)) if what == "param" else getattr(self, what)
         return f"{self.prefix}: {text}" if self.prefix else text
 
 
@@ -408,7 +417,8 @@ def _params(
     theirs: dict[str, Any] = {}
     for text, values in ((False, cfg.params), (True, given)):
         for key, value in values.items():
-            origin = sources.label("param", key) if text else f"{src}: planner.params.{key}"
+            label = shown(key)
+            origin = sources.label("param", key) if text else f"{src}: planner.params.{label}"
             try:
                 if entry.takes(key) or key not in table:
                     mine[key] = _spec(entry, table, key).convert(value, entry.name, text)
@@ -416,7 +426,7 @@ def _params(
                     theirs[key] = table[key].convert(value, "post-pass", text)
             except ParameterError as exc:
                 if not text:
-                    raise ProblemError(src, f"planner.params.{key}", str(exc)) from None
+                    raise ProblemError(src, f"planner.params.{label}", str(exc)) from None
                 raise ParameterError(exc.detail, exc.name, origin) from None
             origins[f"params.{key}"] = origin
     if entry.takes("budget") and "budget" not in mine:
@@ -436,7 +446,7 @@ def _spec(entry: PlannerEntry, post: ParamTable, key: str) -> ParamSpec:
         return entry.param(key)  # raises, naming the planner's parameters
     known = ", ".join(entry.params.names()) or "none"
     hint = did_you_mean(key, [*entry.params.names(), *post.names()])
-    raise ParameterError(f"planner '{entry.name}' has no parameter '{key}'{hint} (known: "
+    raise ParameterError(f"planner '{entry.name}' has no parameter '{shown(key)}'{hint} (known: "
                          f"{known}; the post-passes': {', '.join(post.names())})", key)  # fmt: skip
 
 

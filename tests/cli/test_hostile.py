@@ -378,6 +378,99 @@ def test_a_long_value_is_echoed_short(folder):
     assert proc.returncode == 2 and len(proc.stderr) < 400
 
 
+#: A megabyte of one letter, and a long command-line argument (Linux allows 128 KiB).
+MEGABYTE, ARGUMENT = "u" * 2**20, "u" * 100_000
+#: A problem without robot, obstacles, units or planner: each case adds what it tests.
+_BASE = "bounds: [[0, 0], [500, 500]]\nstart: [20, 20]\ngoal: [450, 450]\n"
+_ROBOT = "robot: {radius: 1}\n"
+
+
+@pytest.mark.parametrize(
+    ("args", "text", "where"),
+    [
+        (["solve", "x.yaml", "--path-out", "p.yaml"], f"{_ROBOT}units: {MEGABYTE}\n",
+         "x.yaml: units: "),
+        (["solve", "x.yaml"], f"{_ROBOT}? {MEGABYTE}\n: 1\n", "x.yaml: uuuu"),  # a long key
+        (["solve", "x.yaml"], f"robot:\n  radius: 1\n  ? {MEGABYTE}\n  : 2\n",
+         "x.yaml: robot.uuu"),
+        (["solve", "x.yaml"], f"{_ROBOT}planner: {{type: {MEGABYTE}}}\n",
+         "x.yaml: planner.type: "),
+        (["solve", "x.yaml"], f"{_ROBOT}planner:\n  params:\n    ? {MEGABYTE}\n    : 3\n",
+         "x.yaml: planner.params.uuu"),
+        (["solve", "x.yaml"], f"{_ROBOT}planner: {{params: {{swarm_size: '{'1' * 2**20}e3'}}}}\n",
+         "x.yaml: planner.params.swarm_size: "),
+        (["optimum", "x.yaml"], f"{_ROBOT}obstacles: [{{type: {MEGABYTE}}}]\n",
+         "x.yaml: obstacles[0]"),
+        (["optimum", "x.yaml"], f"{_ROBOT}map: {MEGABYTE}\n", "x.yaml: map: "),
+        (["solve", "p.yaml", "--planner", ARGUMENT], "", "--planner: unknown planner 'uuu"),
+        (["solve", "p.yaml", "--param", f"{ARGUMENT}=1"], "", "no parameter 'uuu"),
+        (["solve", "p.yaml", "--param", f"swarm_size={ARGUMENT}"], "", "swarm_size"),
+        (["solve", "p.yaml", "--param", ARGUMENT], "", "expected NAME=VALUE"),
+        (["solve", "p.yaml", "--post", ARGUMENT], "", "unknown post-pass 'uuu"),
+        (["simulate", "d.yaml", "--strategy", ARGUMENT], "", "--strategy: invalid choice"),
+        (["batch", "p.yaml", "--runs", "9" * 4000, "--out", "r.jsonl"], "", "--runs: must be"),
+        (["batch", "p.yaml", "--runs", "9" * 5000, "--out", "r.jsonl"], "", "argument --runs"),
+        (["batch", "p.yaml", "--planner", ARGUMENT, "--out", "r.jsonl"], "", "unknown planner"),
+    ],
+    ids=["units", "key", "robot-key", "planner-type", "param-key", "param-number", "obstacle-type",
+         "map", "--planner", "--param-name", "--param-value", "--param-form", "--post",
+         "--strategy", "--runs", "--runs-digits", "batch-planner"],
+)  # fmt: skip
+def test_every_echoed_value_is_shown_short(folder, args, text, where):
+    """A value of a megabyte (or a whole command-line argument) is echoed by its beginning, its
+    end and its length, in one short message that still names the file and the key (issue 32,
+    item 10: a 1 MB `units:` value was echoed whole)."""
+    if text:
+        (folder / "x.yaml").write_text(_BASE + text)
+    proc = run(*args, cwd=folder)
+    assert proc.returncode == 2, proc.stderr[:500]
+    message = proc.stderr.strip().splitlines()[-1]  # after argparse's usage lines
+    assert where in message and len(message) < 1200, proc.stderr[-1200:]
+    assert len(proc.stderr) < 2500 and "characters)" in message  # and how long the value was
+    assert len(proc.stderr.strip().splitlines()) == 1 or proc.stderr.startswith("usage:")
+
+
+def test_a_batch_input_whose_name_is_too_long_is_an_error_row(folder):
+    """Not a traceback (pathlib's is_dir lets ENAMETOOLONG through): an error row, its message
+    naming the input by its ends and its length."""
+    proc = run("batch", ARGUMENT, "p.yaml", "--planner", "RRTConnect", "--time", "0.05", "--out",
+               "r.jsonl", cwd=folder)  # fmt: skip
+    assert proc.returncode == 1, proc.stderr[-500:]
+    bad, good = rows_of(folder / "r.jsonl")
+    assert bad["file"] == ARGUMENT and bad["status"] == "error" and good["status"] == "exact"
+    assert bad["error"].endswith("(100,000 characters): cannot read it: File name too long")
+    assert len(bad["error"]) < 1200 and len(proc.stderr) < 2500
+
+
+@pytest.mark.parametrize(
+    ("name", "words"),
+    [
+        ("/dev/zero", "/dev/zero: is a character device, not a regular file"),
+        ("fifo.yaml", "fifo.yaml: is a fifo (named pipe), not a regular file"),
+        ("sub", "sub: is a directory, not a regular file"),
+        ("absent.yaml", "absent.yaml: no such file"),
+        ("big.yaml", "big.yaml: the file is larger than 64 MiB"),
+        ("m.yaml", "m.yaml: image: /dev/zero is a character device"),
+    ],
+    ids=["dev-zero", "fifo", "dir", "absent", "huge", "image-device"],
+)
+def test_a_map_that_cannot_be_read_names_the_problem_file_and_its_key(folder, name, words):
+    """`map: /dev/zero` said only "/dev/zero: is a character device" (issue 32, item 10): the
+    problem file and its key come first, then what the map's own reader says."""
+    os.mkfifo(folder / "fifo.yaml")
+    (folder / "sub").mkdir()
+    with open(folder / "big.yaml", "wb") as fh:  # sparse: no 64 MiB written
+        fh.truncate(64 * 2**20 + 1)
+    (folder / "m.yaml").write_text(MAP_YAML.format(image="/dev/zero"))
+    for key, text in (("map", f"map: {name}\n"), ("map.file", f"map: {{file: {name}}}\n")):
+        (folder / "mp.yaml").write_text(MAP_PROBLEM.replace("map: m.yaml\n", text))
+        for command in ("solve", "optimum"):
+            proc = run(command, "mp.yaml", cwd=folder, timeout=60)
+            assert proc.returncode == 2, proc.stderr
+            assert f"rrtpso: error: mp.yaml: {key}: " in proc.stderr and words in proc.stderr
+            assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+
+
 # ----------------------------------------------------------------------------------------------
 # Command-line conventions
 # ----------------------------------------------------------------------------------------------
@@ -618,6 +711,45 @@ def test_a_reader_that_went_away_is_quiet(folder, args):
     code = proc.wait(timeout=120)
     assert err == "" and code in ((0, 1) if args[0] == "solve" else (0,)), (code, err)
     assert snapshot(folder) == before  # nothing left behind
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["solve", "p.yaml", "-v", "--time", "0.3", "--json", "-"], "Info:    RRTstar: Started"),
+        (["solve", "p.yaml", "-vv", "--time", "0.3", "--json", "-"], "Debug:   RRTstar: "),
+        (["solve", "p.yaml", "-v", "--planner", "PRMstar", "--time", "0.2", "--json", "-"],
+         "Info:    PRMstar: "),
+        (["simulate", "d.yaml", "-v", "--time", "0.3", "--json", "-"], "Info:    RRTstar: "),
+        (["batch", "p.yaml", "-v", "--planner", "RRTstar,RRTConnect", "--runs", "2", "--time",
+          "0.1", "--out", "-"], "batch: 4 rows"),
+    ],
+    ids=["solve-v", "solve-vv", "prmstar", "simulate", "batch"],
+)  # fmt: skip
+def test_with_ompl_talking_standard_output_holds_only_the_results(folder, args, words):
+    """OMPL writes its Info and Debug lines to C++'s std::cout, descriptor 1: `-v --json -`
+    gave a document jq could not parse (issue 32, item 3). Every log line goes to stderr."""
+    proc = run(*args, cwd=folder)
+    assert proc.returncode in (0, 1), proc.stderr
+    if args[0] == "batch":
+        rows = [json.loads(line) for line in proc.stdout.splitlines()]
+        assert len(rows) == 4 and all(r["status"] == "exact" for r in rows)
+    else:
+        assert isinstance(json.loads(proc.stdout), dict)
+    assert "Info:" not in proc.stdout and "Debug:" not in proc.stdout
+    assert words in proc.stderr, proc.stderr[-2000:]
+
+
+def test_with_ompl_talking_a_reader_that_went_away_is_still_quiet(folder):
+    """The duplicate of standard output that results are written to is the one silenced: no
+    Broken pipe, no traceback, the command's own status; OMPL's lines still on stderr."""
+    proc = subprocess.Popen([*rrtpso_exe(), "solve", "p.yaml", "-v", "--time", "0.2", "--json",
+                             "-"], cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, preexec_fn=_limit)  # fmt: skip
+    proc.stdout.close()
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) in (0, 1), err
+    assert "Info:    RRTstar" in err and "Broken pipe" not in err and "Traceback" not in err
 
 
 def test_closed_standard_streams_change_nothing_else(folder):

@@ -107,3 +107,45 @@ def test_cost_bad_resolution_exit_2_without_output(tmp_path, flags, needle):
     assert needle in proc.stderr and "Traceback" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
     assert not out.exists()
+
+
+#: A wall across the whole workspace: no path exists.
+WALLED = """\
+name: walled
+bounds: [[0, 0], [10, 10]]
+start: [1, 1]
+goal: [9, 9]
+robot: {radius: 0.2}
+obstacles:
+  - {type: rectangle, min: [4.9, -1], max: [5.1, 11]}
+"""
+
+
+@pytest.mark.parametrize(
+    ("problem", "flags", "status", "needle"),
+    [
+        (PROBLEMS / "static" / "single_circle.yaml", [], 0, "optimum length=647.45"),
+        (PROBLEMS / "static" / "maze.yaml", ["--plot", "o.png"], 0, "optimum length="),
+        (PROBLEMS / "maps" / "office_rooms.yaml", [], 0, "optimum length=34.77"),
+        (PROBLEMS / "static" / "single_circle.yaml", ["--cost"], 0, "J is the length"),
+        (PROBLEMS / "static" / "single_circle.yaml", ["--path-out", "p.yaml"], 0, "length="),
+        ("walled.yaml", ["--plot", "o.png"], 1, "no path exists"),
+        ("walled.yaml", ["--path-out", "p.yaml"], 1, "no path exists"),
+    ],
+    ids=["plain", "plot-only", "map", "cost-plain", "path-out-only", "none-plot", "none-path"],
+)  # fmt: skip
+def test_optimum_without_json_reports_and_writes_what_was_asked(
+    tmp_path, problem, flags, status, needle
+):
+    """The result is built whatever the outputs ask for (issue 32, item 7: these crashed with
+    'NoneType' object is not subscriptable)."""
+    (tmp_path / "walled.yaml").write_text(WALLED)
+    proc = subprocess.run([*rrtpso_exe(), "optimum", str(problem), *flags],
+                          capture_output=True, text=True, cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == status, proc.stderr
+    assert needle in proc.stderr and "Traceback" not in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+    if "--plot" in flags:
+        assert (tmp_path / "o.png").read_bytes()[:4] == b"\x89PNG"
+    if "--path-out" in flags:  # written only when there is a path
+        assert (tmp_path / "p.yaml").exists() == (status == 0)
