@@ -137,8 +137,9 @@ class GeneratorOptions:
         unit="length",
         low=0.0,
     )
-    max_attempts: int = param(50, "How many times the obstacles are drawn before giving up.",
-                              low=1)  # fmt: skip
+    max_attempts: int = param(50, "How many times the obstacles are drawn before giving up "
+                              "(each draw is certified: at most 10,000).", low=1,
+                              high=10_000)  # fmt: skip
     decimals: int | None = param(
         None,
         "Decimal places of every coordinate. Default: about 1e-5 of the workspace "
