@@ -26,8 +26,6 @@ from ..errors import (
     did_you_mean,
     shown,
 )
-from ..model import load_problem
-from ..model.yamlfile import file_kind
 from ..outputs import STDOUT, is_stream, name_max, os_reason, stdout_closed
 from ..validation import check_seconds, check_seed
 
@@ -114,6 +112,7 @@ def choose_planner(args: argparse.Namespace) -> PlannerRequest:
         For an unknown planner or a bad flag, the message naming the file and where the value
         came from (``--planner``, ``planner.type``, ``--param NAME``, ...).
     """
+    from ..model import load_problem
     from ..planners.request import command_line, resolve
 
     problem = load_problem(args.problem)
@@ -281,6 +280,8 @@ def _check_one(out: Output) -> None:
 
 def _check_place(out: Output) -> None:
     """The checks of :func:`_check_one` on the file system (they may raise OSError)."""
+    from ..model.yamlfile import file_kind
+
     path, flag = out.path, out.flag
     target = Path(os.path.realpath(path))  # where it is written: links are written through
     parent = _nearest_existing(target)
@@ -321,6 +322,7 @@ def _check_existing_bag(target: Path, mode: int, flag: str, path: str) -> None:
     (only an MCAP file: a bag name over another kind of file is a mistake), a stream written
     through; a sqlite3 bag directory is only made over an empty folder, never over anything
     with content (a folder is not ours to empty)."""
+    from ..model.yamlfile import file_kind
     from ..ros.bag import is_mcap, is_mcap_file
 
     if is_mcap(path):
