@@ -422,11 +422,35 @@ def check_output(path: str | None, flag: str, image: bool = False) -> None:
 # Progress on stderr
 # ----------------------------------------------------------------------------------------------
 def progress_bar(desc: str, **kwargs: Any) -> Any:
-    """A tqdm bar on stderr, silent when stderr is not a terminal (logs, CI, pipes)."""
+    """A tqdm bar on stderr; a silent stand-in when stderr is not a terminal (logs, CI, pipes)
+    or with ``-q``, so that tqdm is imported only to draw."""
+    if _quiet or not sys.stderr.isatty():
+        return _NoBar()
     from tqdm import tqdm
 
-    quiet = _quiet or not sys.stderr.isatty()
-    return tqdm(desc=desc, file=sys.stderr, disable=quiet, leave=False, **kwargs)
+    return tqdm(desc=desc, file=sys.stderr, leave=False, **kwargs)
+
+
+class _NoBar:
+    """What the commands use of a tqdm bar, doing nothing (tqdm's ``disable=True``)."""
+
+    total: float | None = None
+    n: float = 0
+
+    def __enter__(self) -> _NoBar:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        pass
+
+    def update(self, n: float = 1) -> None:
+        pass
+
+    def refresh(self) -> None:
+        pass
+
+    def set_postfix(self, *args: Any, **kwargs: Any) -> None:
+        pass
 
 
 class RunProgress:
