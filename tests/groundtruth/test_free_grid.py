@@ -56,3 +56,20 @@ def test_the_optimum_is_the_same_through_either_search(name, monkeypatch):
     large = shortest_path(problem, world)
     assert small.found and small.length == large.length
     assert small.pieces == large.pieces and small.n_edges == large.n_edges
+
+
+def test_a_winding_search_has_one_level_per_cell_and_scipys_counts(monkeypatch):
+    """A serpentine corridor: the deepest search there is (about one level per free cell)."""
+    free = np.ones((41, 40), dtype=bool)
+    for j in range(1, 41, 2):  # walls with one gap, at alternate ends
+        free[j, :] = False
+        free[j, 39 if j % 4 == 1 else 0] = True
+    start, goal = (0.5, 0.5), (0.5, 40.5)
+    numpy_grid = FreeGrid((0.0, 0.0), 1.0, free, start, goal)
+    monkeypatch.setattr(free_grid, "NUMPY_SEARCH_CELLS", 0)
+    scipy_grid = FreeGrid((0.0, 0.0), 1.0, free, start, goal)
+    m8 = numpy_grid._dist[0][0]
+    assert np.nanmax(m8[np.isfinite(m8)]) > 20 * 40  # it winds through every row
+    for ours, theirs in zip(numpy_grid._dist, scipy_grid._dist, strict=True):
+        np.testing.assert_array_equal(ours[0], theirs[0])
+        np.testing.assert_array_equal(ours[1], theirs[1])
