@@ -14,37 +14,30 @@ One subpackage per stage, each with a short ``__init__`` that is its public face
   files;
 - :mod:`rrtpso_ompl.cli`: the ``rrtpso`` command; :mod:`rrtpso_ompl.plotting`: every figure.
 
-The names below are importable from here; ``solve`` and ``RRTstarPSO`` load OMPL on first use,
-so ``import rrtpso_ompl`` alone stays light.
+The names below are importable from here, each imported on first use (PEP 562,
+:mod:`rrtpso_ompl.lazy`): ``import rrtpso_ompl`` alone loads neither numpy nor OMPL, and
+``solve`` and ``RRTstarPSO`` load OMPL when first used.
 """
 
-from importlib import import_module
-from importlib.metadata import PackageNotFoundError, version
-from typing import Any
+from __future__ import annotations
 
-from .errors import (
-    ArgumentError,
-    ParameterError,
-    PlannerError,
-    ProblemError,
-    RrtpsoError,
-    UnknownPlannerError,
-    UnsupportedSpaceError,
-)
-from .model import Problem, World, load_problem, problem_from_dict
+from typing import TYPE_CHECKING
 
-try:
-    __version__ = version("rrtpso-ompl")
-except PackageNotFoundError:  # running from a source tree that was never installed
-    __version__ = "0+unknown"
+from ._version import __version__
+from .lazy import export_lazily
 
-#: Names that need OMPL, imported on first access (PEP 562).
-_LAZY = {
-    "solve": "rrtpso_ompl.planners",
-    "SolveResult": "rrtpso_ompl.planners",
-    "RRTstarPSO": "rrtpso_ompl.planners",
-    "default_registry": "rrtpso_ompl.planners",
-}
+if TYPE_CHECKING:  # what the lazy names are, for type checkers and editors
+    from .errors import (
+        ArgumentError,
+        ParameterError,
+        PlannerError,
+        ProblemError,
+        RrtpsoError,
+        UnknownPlannerError,
+        UnsupportedSpaceError,
+    )
+    from .model import Problem, World, load_problem, problem_from_dict
+    from .planners import RRTstarPSO, SolveResult, default_registry, solve
 
 __all__ = [
     "ArgumentError",
@@ -65,8 +58,23 @@ __all__ = [
     "solve",
 ]
 
-
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        return getattr(import_module(_LAZY[name]), name)
-    raise AttributeError(f"module 'rrtpso_ompl' has no attribute {name!r}")
+export_lazily(
+    __name__,
+    {
+        **dict.fromkeys(
+            (
+                "ArgumentError",
+                "ParameterError",
+                "PlannerError",
+                "ProblemError",
+                "RrtpsoError",
+                "UnknownPlannerError",
+                "UnsupportedSpaceError",
+            ),
+            ".errors",
+        ),
+        **dict.fromkeys(("Problem", "World", "load_problem", "problem_from_dict"), ".model"),
+        # the planners stage: solve and RRTstarPSO load OMPL when first used
+        **dict.fromkeys(("RRTstarPSO", "SolveResult", "default_registry", "solve"), ".planners"),
+    },
+)

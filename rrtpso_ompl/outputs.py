@@ -41,8 +41,6 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from .errors import OutputError
 from .ownership import ABSENT, MOVED, inspected
 
@@ -462,8 +460,10 @@ def finite(obj: Any) -> Any:
 
 
 def _json_default(obj: Any) -> Any:
-    if isinstance(obj, np.ndarray):
+    # Not imported here: a command that has not loaded numpy holds no numpy object.
+    np = sys.modules.get("numpy")
+    if np is not None and isinstance(obj, np.ndarray):
         return finite(obj.tolist())
-    if isinstance(obj, np.generic):
+    if np is not None and isinstance(obj, np.generic):
         return finite(obj.item())
     raise TypeError(f"not JSON serialisable: {type(obj).__name__}")

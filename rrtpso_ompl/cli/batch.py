@@ -21,14 +21,17 @@ from .common import (
     run_keywords,
 )
 
-__all__ = ["add_parser", "run"]
+__all__ = ["HELP", "add_parser", "run"]
+
+#: The line of ``rrtpso --help``.
+HELP = "solve many problem files in parallel, streaming JSON lines"
 
 
 def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     b = sub.add_parser(
         "batch",
         parents=parents,
-        help="solve many problem files in parallel, streaming JSON lines",
+        help=HELP,
         description="Solve every problem file x planner x run in its own process and stream one "
         "JSON row per run to --out as it finishes. A bad file becomes an error row and the batch "
         "goes on; exit status 1 when any row is unsolved or an error, 130 when interrupted (the "

@@ -25,14 +25,17 @@ from .common import (
     run_keywords,
 )
 
-__all__ = ["add_parser", "run"]
+__all__ = ["HELP", "add_parser", "run"]
+
+#: The line of ``rrtpso --help``.
+HELP = "benchmark planners: OMPL benchmark logs, a Planner Arena database and a report"
 
 
 def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     b = sub.add_parser(
         "bench",
         parents=parents,
-        help="benchmark planners: OMPL benchmark logs, a Planner Arena database and a report",
+        help=HELP,
         description="Run every problem x time budget x planner x run in its own process with the "
         "same collision checker, then write to --out: runs.jsonl, one OMPL benchmark log per "
         "problem and budget (*.log), benchmark.db (built by OMPL's converter; open it in Planner "

@@ -26,8 +26,6 @@ from ..errors import (
     did_you_mean,
     shown,
 )
-from ..model import load_problem
-from ..model.yamlfile import file_kind
 from ..outputs import STDOUT, is_stream, name_max, os_reason, stdout_closed
 from ..validation import check_seconds, check_seed
 
@@ -114,6 +112,7 @@ def choose_planner(args: argparse.Namespace) -> PlannerRequest:
         For an unknown planner or a bad flag, the message naming the file and where the value
         came from (``--planner``, ``planner.type``, ``--param NAME``, ...).
     """
+    from ..model import load_problem
     from ..planners.request import command_line, resolve
 
     problem = load_problem(args.problem)
@@ -281,6 +280,8 @@ def _check_one(out: Output) -> None:
 
 def _check_place(out: Output) -> None:
     """The checks of :func:`_check_one` on the file system (they may raise OSError)."""
+    from ..model.yamlfile import file_kind
+
     path, flag = out.path, out.flag
     target = Path(os.path.realpath(path))  # where it is written: links are written through
     parent = _nearest_existing(target)
@@ -321,6 +322,7 @@ def _check_existing_bag(target: Path, mode: int, flag: str, path: str) -> None:
     (only an MCAP file: a bag name over another kind of file is a mistake), a stream written
     through; a sqlite3 bag directory is only made over an empty folder, never over anything
     with content (a folder is not ours to empty)."""
+    from ..model.yamlfile import file_kind
     from ..ros.bag import is_mcap, is_mcap_file
 
     if is_mcap(path):
@@ -420,11 +422,35 @@ def check_output(path: str | None, flag: str, image: bool = False) -> None:
 # Progress on stderr
 # ----------------------------------------------------------------------------------------------
 def progress_bar(desc: str, **kwargs: Any) -> Any:
-    """A tqdm bar on stderr, silent when stderr is not a terminal (logs, CI, pipes)."""
+    """A tqdm bar on stderr; a silent stand-in when stderr is not a terminal (logs, CI, pipes)
+    or with ``-q``, so that tqdm is imported only to draw."""
+    if _quiet or not sys.stderr.isatty():
+        return _NoBar()
     from tqdm import tqdm
 
-    quiet = _quiet or not sys.stderr.isatty()
-    return tqdm(desc=desc, file=sys.stderr, disable=quiet, leave=False, **kwargs)
+    return tqdm(desc=desc, file=sys.stderr, leave=False, **kwargs)
+
+
+class _NoBar:
+    """What the commands use of a tqdm bar, doing nothing (tqdm's ``disable=True``)."""
+
+    total: float | None = None
+    n: float = 0
+
+    def __enter__(self) -> _NoBar:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        pass
+
+    def update(self, n: float = 1) -> None:
+        pass
+
+    def refresh(self) -> None:
+        pass
+
+    def set_postfix(self, *args: Any, **kwargs: Any) -> None:
+        pass
 
 
 class RunProgress:

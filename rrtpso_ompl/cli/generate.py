@@ -16,7 +16,11 @@ from ..errors import GenerationError, UsageError
 from ..outputs import is_stream
 from .common import EXIT_OK, Output, check_outputs, check_seed_flag, note
 
-__all__ = ["add_parser", "run"]
+__all__ = ["HELP", "add_parser", "run"]
+
+#: The line of ``rrtpso --help``. It does not list the kinds: they are known once the generators
+#: are imported, which ``rrtpso --help`` does not do (``rrtpso generate --help`` lists them).
+HELP = "write a seeded random problem, certified solvable (kinds: rrtpso generate --help)"
 
 
 def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
@@ -26,7 +30,7 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     g = sub.add_parser(
         "generate",
         parents=parents,
-        help=f"write a seeded random problem ({', '.join(kinds)})",
+        help=HELP,
         description="Write a seeded random problem file whose start and goal are free and "
         "connected (certified by a collision-checked grid path). The same seed and options give "
         "the same file, byte for byte. Each option applies to the kinds named in its help.",

@@ -14,12 +14,14 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import importlib
 import logging
 import signal
 import sys
 from collections.abc import Iterator, Sequence
 from typing import NoReturn
 
+from .._version import __version__
 from ..errors import OutputError, RrtpsoError, shown
 from ..outputs import (
     STDOUT,
@@ -29,13 +31,15 @@ from ..outputs import (
     silence_stdout,
     stdout_closed,
 )
-from . import batch, bench, generate, optimum, planners, simulate, solve
 from .common import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK, add_shared_flags, set_quiet
 
 __all__ = ["Terminated", "main"]
 
-#: The subcommands, in the order ``rrtpso --help`` lists them.
-COMMANDS = (solve, simulate, batch, generate, optimum, bench, planners)
+#: The subcommands, in the order ``rrtpso --help`` lists them: each a module of this package with
+#: ``HELP`` (its line in ``rrtpso --help``), ``add_parser`` and ``run``. A module imports what
+#: its command needs in ``add_parser`` and ``run``, not at its top, so that importing all of them
+#: costs nothing (docs/design.md, "Start-up").
+COMMANDS = ("solve", "simulate", "batch", "generate", "optimum", "bench", "planners")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -50,18 +54,37 @@ class _Parser(argparse.ArgumentParser):
 MAX_USAGE_MESSAGE = 500
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The parser of ``rrtpso``: every subcommand's, or with ``only``, that subcommand's in
+    full and the others as their line in ``rrtpso --help`` alone. A subcommand's flags may need
+    its modules (``generate``'s kinds, ``simulate``'s strategies), which a command that does not
+    run it should not import (:func:`command_of`)."""
     parser = _Parser(
         prog="rrtpso",
         description="Plan 2-D paths for wheeled robots with RRT*PSO and OMPL's planners.",
     )
-    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     shared = _Parser(add_help=False)
     add_shared_flags(shared)
-    for command in COMMANDS:
-        command.add_parser(sub, [shared])
+    for name in COMMANDS:
+        module = importlib.import_module(f"{__package__}.{name}")
+        if only is None or name == only:
+            module.add_parser(sub, [shared])
+        else:
+            sub.add_parser(name, help=module.HELP)
     return parser
+
+
+def command_of(argv: Sequence[str]) -> str:
+    """The subcommand ``argv`` runs: its first argument that is not an option, as argparse
+    reads it (``rrtpso`` itself takes no option with a value); "" when there is none."""
+    for i, arg in enumerate(argv):
+        if arg == "--":
+            return argv[i + 1] if i + 1 < len(argv) else ""
+        if not arg.startswith("-") or arg == "-":
+            return arg
+    return ""
 
 
 class Terminated(KeyboardInterrupt):
@@ -118,11 +141,13 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _run(argv: Sequence[str] | None) -> int:
     try:
         with _stop_signals_as_interrupts():
-            # Building the parser loads the strategies (simulate's choices), plugins included:
+            # Building simulate's parser loads the strategies (its choices), plugins included:
             # a Ctrl-C then ends as anywhere else, and their warnings wait for -q and -v.
+            # Only the parser of the command run is built (build_parser).
+            words = sys.argv[1:] if argv is None else list(argv)
             try:
                 with _held_log_records() as held:
-                    args = build_parser().parse_args(argv)
+                    args = build_parser(command_of(words)).parse_args(words)
             except SystemExit:  # --help, --version, a usage error: nothing asked for quiet
                 _show(held, logging.WARNING)
                 raise
@@ -216,12 +241,6 @@ def _flush_stdout() -> None:
         raise  # the reader went away: quiet (main)
     except OSError as exc:
         raise OutputError(STDOUT, os_reason(exc)) from None
-
-
-def _version() -> str:
-    from .. import __version__
-
-    return __version__
 
 
 if __name__ == "__main__":

@@ -11,14 +11,17 @@ from ..errors import UsageError
 from .common import EXIT_OK, EXIT_UNSOLVED, Output, check_outputs, note
 from .ros_flags import add_ros_flags, ros_frame, ros_outputs, ros_poses, write_path_out
 
-__all__ = ["add_parser", "run"]
+__all__ = ["HELP", "add_parser", "run"]
+
+#: The line of ``rrtpso --help``.
+HELP = "compute the exact shortest path (the reference for path-length ratios)"
 
 
 def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     o = sub.add_parser(
         "optimum",
         parents=parents,
-        help="compute the exact shortest path (the reference for path-length ratios)",
+        help=HELP,
         description="Compute the exact shortest path for the problem's disc robot among its "
         "circles, polygons and map cells: a tangent graph with arcs around the inflated "
         "obstacles, searched with A* and geodesic lower bounds (docs/benchmarking.md). With "

@@ -9,14 +9,17 @@ from typing import Any
 from ..outputs import write_stdout
 from .common import EXIT_OK
 
-__all__ = ["add_parser", "run"]
+__all__ = ["HELP", "add_parser", "run"]
+
+#: The line of ``rrtpso --help``.
+HELP = "list the planners and their parameters"
 
 
 def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     q = sub.add_parser(
         "planners",
         parents=parents,
-        help="list the planners and their parameters",
+        help=HELP,
         description="List the registered planners and their parameters.",
     )
     q.add_argument("name", nargs="?", help="show only this planner")

@@ -8,8 +8,6 @@ import math
 import sys
 from typing import Any
 
-from ..dynamic.options import DynamicOptions
-from ..dynamic.registry import STRATEGY_ENTRY_POINT_GROUP, default_strategies
 from ..errors import RrtpsoError, UsageError
 from ..foreign import contained
 from .common import (
@@ -27,7 +25,10 @@ from .common import (
 )
 from .ros_flags import add_ros_flags, ros_frame, ros_outputs, ros_poses, write_path_out
 
-__all__ = ["OPTION_FLAGS", "add_parser", "run"]
+__all__ = ["HELP", "OPTION_FLAGS", "add_parser", "run"]
+
+#: The line of ``rrtpso --help``.
+HELP = "drive among moving obstacles with collision prediction and replanning"
 
 #: The ``DynamicOptions`` the command sets, and their flags (``--time`` and ``--planner`` come
 #: from the planner flags; the others keep their declared defaults).
@@ -44,6 +45,8 @@ OPTION_FLAGS = {
 
 def _help(name: str, default: str | None = None) -> str:
     """A flag's help: the option's declared documentation and default."""
+    from ..dynamic.options import DynamicOptions
+
     spec = DynamicOptions.PARAMS[name]
     unit = f" {spec.unit}" if spec.unit and spec.unit != "length" else ""
     shown = default if default is not None else f"{spec.default}{unit}"
@@ -51,10 +54,15 @@ def _help(name: str, default: str | None = None) -> str:
 
 
 def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
+    # The dynamic stage, and the strategies with their plugins (the choices of --strategy):
+    # only for this command (the parser of another command does not build this one).
+    from ..dynamic.options import DynamicOptions
+    from ..dynamic.registry import STRATEGY_ENTRY_POINT_GROUP, default_strategies
+
     m = sub.add_parser(
         "simulate",
         parents=parents,
-        help="drive among moving obstacles with collision prediction and replanning",
+        help=HELP,
         description="Drive the robot from start to goal among the problem's moving obstacles: it "
         "senses them within robot.sensor_range, predicts collisions and replans contour detours "
         "(docs/dynamic.md). Exit status 0 when the goal is reached without a collision, else 1.",
@@ -115,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
     check_outputs(outputs, inputs=problem.inputs)
     frame = ros_frame(args, problem)  # the units and the pose spacing, known before planning
 
-    from ..dynamic import simulate
+    from ..dynamic import DynamicOptions, simulate
 
     timing = {} if args.replan_time is None else {"replan_time": args.replan_time}
     options = DynamicOptions(

@@ -18,14 +18,17 @@ from .common import (
 )
 from .ros_flags import add_ros_flags, ros_frame, ros_outputs, ros_poses, write_path_out
 
-__all__ = ["add_parser", "run"]
+__all__ = ["HELP", "add_parser", "run"]
+
+#: The line of ``rrtpso --help``.
+HELP = "solve one problem file"
 
 
 def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
     p = sub.add_parser(
         "solve",
         parents=parents,
-        help="solve one problem file",
+        help=HELP,
         description="Solve one problem file and report the path.",
     )
     p.add_argument("problem", help="problem file (YAML, see docs/problem-format.md)")

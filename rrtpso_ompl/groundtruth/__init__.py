@@ -7,13 +7,12 @@
 - :mod:`.certify`: :func:`grid_path`, a collision-checked grid path that certifies a problem
   solvable (and bounds the optimum from above);
 - :mod:`.generate`: seeded random problems with such a certificate.
+
+The names below are imported on first use (:mod:`rrtpso_ompl.lazy`): ``rrtpso optimum`` loads
+the optimum's modules, not the generators'.
 """
 
-from .certify import grid_path, is_solvable
-from .costgrid import CostGridResult, cost_reference
-from .generate import generate, generate_to_file
-from .map_kinds import GeneratedMap, generate_map
-from .optimum import OptimumResult, shortest_path
+from ..lazy import export_lazily
 
 __all__ = [
     "CostGridResult",
@@ -27,3 +26,19 @@ __all__ = [
     "is_solvable",
     "shortest_path",
 ]
+
+export_lazily(
+    __name__,
+    {
+        "grid_path": ".certify",
+        "is_solvable": ".certify",
+        "CostGridResult": ".costgrid",
+        "cost_reference": ".costgrid",
+        "generate": ".generate",
+        "generate_to_file": ".generate",
+        "GeneratedMap": ".map_kinds",
+        "generate_map": ".map_kinds",
+        "OptimumResult": ".optimum",
+        "shortest_path": ".optimum",
+    },
+)

@@ -27,19 +27,27 @@ whose centre is so far inside the grown obstacles that no point of it can be fre
 Euclidean distance transform of the blocked cells (``scipy.ndimage``); for circles, polygons and
 boxes, from the world's exact point clearance at the cell centres (clearance is 1-Lipschitz, so
 a cell whose centre has clearance ``c`` has none above ``c + h / sqrt(2)``).
+
+scipy is imported only where it is needed: for a map (the distance transform) and for a search
+grid of more than :data:`NUMPY_SEARCH_CELLS` cells (scipy's breadth-first search). A smaller one,
+every raster of a few dozen obstacles without a map, is searched level by level in numpy: the
+same step counts (a breadth-first search's are unique), without the 0.2-0.4 s importing scipy
+costs, several times what ``rrtpso optimum`` of such a problem computes (docs/startup.md).
 """
 
 from __future__ import annotations
 
 import itertools
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy import ndimage
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import breadth_first_order
+from numpy.lib.stride_tricks import sliding_window_view
 
 from ..model.world import World
+
+if TYPE_CHECKING:
+    from scipy.sparse import csr_matrix
 
 __all__ = ["FreeGrid", "Stopped"]
 
@@ -49,6 +57,11 @@ _SQRT2 = math.sqrt(2.0)
 GENERIC_CELLS = 192
 #: Most cells of the breadth-first search: finer rasters are searched in blocks of k x k cells.
 MAX_SEARCH_CELLS = 300_000
+#: Most cells of a search grid searched in numpy, level by level (:func:`_numpy_steps`), rather
+#: than with scipy: a level costs a few numpy calls, and a search has at most one level per cell,
+#: so even a winding one stays below the cost of importing scipy (a 100 x 100 serpentine, 5,000
+#: levels, takes 0.03 s per search on the machine of docs/startup.md; importing scipy 0.35 s).
+NUMPY_SEARCH_CELLS = 10_000
 #: Most cells of a raster on the lattice of a world's boxes (else the generic raster is used).
 MAX_LATTICE_CELLS = 30_000_000
 #: Most samples one call of :meth:`FreeGrid.blocked_segments` takes at once (memory bound).
@@ -127,6 +140,8 @@ class FreeGrid:
             origin, h, blocked = lattice
             free = ~blocked
             if blocked.any():
+                from scipy import ndimage
+
                 # Distance (cells) from each free cell's centre to the nearest blocked centre;
                 # the blocked square holds the disc of radius h/2 around its centre, and no point
                 # of the cell is more than h/sqrt(2) from the centre.
@@ -204,7 +219,7 @@ class FreeGrid:
             w = math.ceil(float(c[small, 2].max()) / self.H)
             grid = self._geodesic(which, np.arange(self.cnx * self.cny)).reshape(self.cny, self.cnx)
             if w > 0:
-                grid = ndimage.minimum_filter(grid, size=2 * w + 1, mode="nearest")
+                grid = _window_extreme(grid, w, np.minimum)
             out[small] = np.maximum(euclid[small], grid.ravel()[self._cells(c[small, :2])])
         if which == 1 and self.goal_tolerance > 0:
             out = np.maximum(out - self.goal_tolerance, 0.0)
@@ -234,8 +249,8 @@ class FreeGrid:
             lo = np.where(np.isfinite(g), g, np.inf)
             hi = np.where(np.isfinite(g), g, -np.inf)
             if w > 0:
-                lo = ndimage.minimum_filter(lo, size=2 * w + 1, mode="nearest")
-                hi = ndimage.maximum_filter(hi, size=2 * w + 1, mode="nearest")
+                lo = _window_extreme(lo, w, np.minimum)
+                hi = _window_extreme(hi, w, np.maximum)
             out[small, k, 0] = lo.ravel()[cells]
             out[small, k, 1] = hi.ravel()[cells]
         return out
@@ -342,6 +357,8 @@ class FreeGrid:
         """Cells with a blocked cell within ``k`` cells each way (cached per ``k``)."""
         cache = self.__dict__.setdefault("_near_cache", {})
         if k not in cache:
+            from scipy import ndimage  # a map's raster: scipy is loaded for it already
+
             cache[k] = ndimage.maximum_filter(self.blocked, size=2 * k + 1, mode="constant")
         return cache[k]
 
@@ -439,35 +456,53 @@ def _block_any(free: np.ndarray, k: int) -> np.ndarray:
     return f.reshape(f.shape[0] // k, k, f.shape[1] // k, k).any(axis=(1, 3))
 
 
+def _window_extreme(grid: np.ndarray, w: int, extreme: np.ufunc) -> np.ndarray:
+    """The least (``extreme=np.minimum``) or greatest (``np.maximum``) value of each cell's
+    ``(2w + 1) x (2w + 1)`` window, the border cells repeated beyond the edges: what
+    ``scipy.ndimage.minimum_filter(grid, size=2 * w + 1, mode="nearest")`` (or
+    ``maximum_filter``) returns, one axis after the other (a square window's extreme is the
+    extreme of its rows' extremes)."""
+    out = grid
+    for axis in (0, 1):
+        pad = [(0, 0), (0, 0)]
+        pad[axis] = (w, w)
+        rows = sliding_window_view(np.pad(out, pad, mode="edge"), 2 * w + 1, axis=axis)
+        out = extreme.reduce(rows, axis=-1)
+    return out
+
+
 def _bfs_distances(free: np.ndarray, sources: list[int],
                    terminate=None) -> list[tuple[np.ndarray, np.ndarray]]:  # fmt: skip
     """Breadth-first step counts over the possibly-free cells, 8- and 4-connected, from each
-    source cell: ``[(m8, m4), ...]`` as flat arrays (``inf`` where unreachable)."""
+    source cell: ``[(m8, m4), ...]`` as flat arrays (``inf`` where unreachable).
+
+    Searched in numpy up to :data:`NUMPY_SEARCH_CELLS` cells, else with scipy's
+    ``breadth_first_order``: the step counts are the same (a cell's is its distance in steps)."""
     ny, nx = free.shape
     n = nx * ny
     flat = free.ravel()
     out = [[None, None] for _ in sources]
     for k, moves in enumerate((((0, 1), (1, 0), (1, 1), (1, -1)), ((0, 1), (1, 0)))):
-        graph = _grid_graph(free, moves)
+        nbr, ok = _neighbours(free, moves)
+        graph = _grid_graph(nbr, ok) if n > NUMPY_SEARCH_CELLS else None
         for s, src in enumerate(sources):
             _poll(terminate)
-            steps = np.full(n, np.inf)
-            if flat[src]:
-                order, pred = breadth_first_order(graph, src, directed=True,
-                                                  return_predecessors=True)  # fmt: skip
-                steps[order] = _depths(pred)[order]
-            else:  # a source outside the possibly-free cells: no grid bound
-                steps[:] = 0.0
-            out[s][k] = steps
+            if not flat[src]:  # a source outside the possibly-free cells: no grid bound
+                out[s][k] = np.zeros(n)
+            elif graph is None:
+                out[s][k] = _numpy_steps(np.where(ok, nbr, n), src)
+            else:
+                out[s][k] = _scipy_steps(graph, src)
     return [(m8, m4) for m8, m4 in out]
 
 
-def _grid_graph(free: np.ndarray, moves) -> csr_matrix:
-    """The graph of the possibly-free cells joined along ``moves`` and their opposites, built
-    straight as CSR arrays (a cell's neighbours come in a fixed order, so no sorting)."""
+def _neighbours(free: np.ndarray, moves) -> tuple[np.ndarray, np.ndarray]:
+    """Each cell's neighbours along ``moves`` and their opposites: ``(nbr, ok)``, both ``(n,
+    2 len(moves))``, ``nbr`` the neighbours' flat indices and ``ok`` where both cells are
+    possibly free (and the neighbour inside the grid). A cell's neighbours come in the order of
+    their index."""
     ny, nx = free.shape
     n = nx * ny
-    # In order of the neighbour's index, so that each row's indices come sorted.
     offsets = sorted((m for dj, di in moves for m in ((dj, di), (-dj, -di))),
                      key=lambda m: m[0] * nx + m[1])  # fmt: skip
     nbr = np.empty((n, len(offsets)), dtype=np.int64)
@@ -482,6 +517,42 @@ def _grid_graph(free: np.ndarray, moves) -> csr_matrix:
         both[js, is_] = free[js, is_] & free[jt, it]
         ok[:, k] = both.ravel()
         nbr[:, k] = (idx + dj * nx + di).ravel()
+    return nbr, ok
+
+
+def _numpy_steps(nbr: np.ndarray, src: int) -> np.ndarray:
+    """Breadth-first step counts from ``src`` (``inf`` where unreachable), level by level:
+    ``nbr`` is ``(n, m)``, each cell's neighbours, ``n`` where there is none."""
+    n = len(nbr)
+    steps = np.full(n + 1, np.inf)
+    steps[n] = -1.0  # "no neighbour" is never reached
+    steps[src] = 0.0
+    frontier = np.array([src])
+    level = 0.0
+    while len(frontier):
+        level += 1.0
+        reached = nbr[frontier].ravel()
+        frontier = np.unique(reached[steps[reached] == np.inf])
+        steps[frontier] = level
+    return steps[:n]
+
+
+def _scipy_steps(graph: csr_matrix, src: int) -> np.ndarray:
+    """:func:`_numpy_steps` with scipy's breadth-first search (for large grids)."""
+    from scipy.sparse.csgraph import breadth_first_order
+
+    steps = np.full(graph.shape[0], np.inf)
+    order, pred = breadth_first_order(graph, src, directed=True, return_predecessors=True)
+    steps[order] = _depths(pred)[order]
+    return steps
+
+
+def _grid_graph(nbr: np.ndarray, ok: np.ndarray) -> csr_matrix:
+    """The graph of the possibly-free cells (:func:`_neighbours`), built straight as CSR arrays
+    (a cell's neighbours come in the order of their index, so no sorting)."""
+    from scipy.sparse import csr_matrix
+
+    n = len(nbr)
     indices = nbr[ok]
     indptr = np.concatenate([[0], np.cumsum(ok.sum(axis=1))])
     graph = csr_matrix((np.ones(len(indices)), indices, indptr), shape=(n, n))

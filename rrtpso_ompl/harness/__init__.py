@@ -8,14 +8,11 @@
 - :mod:`.bench`: :func:`run_bench`, a batch written as OMPL benchmark logs, the SQLite database
   Planner Arena opens (:mod:`.ompl_log`) and a report (:mod:`.report`: its markdown tables).
 
-The reference lengths come from :mod:`rrtpso_ompl.groundtruth`.
+The reference lengths come from :mod:`rrtpso_ompl.groundtruth`. The names below are imported
+on first use (:mod:`rrtpso_ompl.lazy`): ``rrtpso batch`` loads no bench, log or database code.
 """
 
-from .batch import Task, expand_inputs, make_tasks, read_rows, run_batch, run_task
-from .bench import BenchResult, SummaryRow, run_bench, summarise
-from .ompl_log import Experiment, PlannerRuns, build_database, format_log, write_log
-from .record import RunKey, RunRecord
-from .report import markdown_table
+from ..lazy import export_lazily
 
 __all__ = [
     "BenchResult",
@@ -37,3 +34,18 @@ __all__ = [
     "summarise",
     "write_log",
 ]
+
+export_lazily(
+    __name__,
+    {
+        **dict.fromkeys(
+            ("Task", "expand_inputs", "make_tasks", "read_rows", "run_batch", "run_task"), ".batch"
+        ),
+        **dict.fromkeys(("BenchResult", "SummaryRow", "run_bench", "summarise"), ".bench"),
+        **dict.fromkeys(
+            ("Experiment", "PlannerRuns", "build_database", "format_log", "write_log"), ".ompl_log"
+        ),
+        **dict.fromkeys(("RunKey", "RunRecord"), ".record"),
+        "markdown_table": ".report",
+    },
+)

@@ -6,22 +6,12 @@
   (scalar for OMPL's callbacks, vectorised for the swarm);
 - :mod:`.geometry`: polyline lengths, shortcutting and point-segment distances, used by every
   stage.
+
+The names below are imported on first use (:mod:`rrtpso_ompl.lazy`): :func:`load_problem`
+loads neither :mod:`.world` nor shapely (but for a polygon's checks).
 """
 
-from .geometry import path_length, shortcut
-from .problem import (
-    Circle,
-    MovingObstacle,
-    Obstacle,
-    PlannerConfig,
-    Polygon,
-    Problem,
-    ProblemError,
-    Robot,
-    load_problem,
-    problem_from_dict,
-)
-from .world import World
+from ..lazy import export_lazily
 
 __all__ = [
     "Circle",
@@ -38,3 +28,27 @@ __all__ = [
     "problem_from_dict",
     "shortcut",
 ]
+
+export_lazily(
+    __name__,
+    {
+        "path_length": ".geometry",
+        "shortcut": ".geometry",
+        **dict.fromkeys(
+            (
+                "Circle",
+                "MovingObstacle",
+                "Obstacle",
+                "PlannerConfig",
+                "Polygon",
+                "Problem",
+                "ProblemError",
+                "Robot",
+                "load_problem",
+                "problem_from_dict",
+            ),
+            ".problem",
+        ),
+        "World": ".world",
+    },
+)

@@ -21,7 +21,6 @@ from types import MappingProxyType
 from typing import Any, TypeVar
 
 import numpy as np
-import shapely
 
 from ..errors import ArgumentError, ProblemError, did_you_mean, shown
 from ..validation import (
@@ -586,6 +585,8 @@ class _Validator:
         if all(_cross3(ring[0], ring[1], p) == 0.0 for p in ring[2:]):
             # Checked before shapely, which would call this a self-intersection.
             raise self.error(key, "degenerate polygon: all vertices are collinear (zero area)")
+        import shapely  # here: a problem of circles (or a map) is read without it
+
         shape = shapely.Polygon(ring)
         if not math.isfinite(shape.area):
             raise self.error(key, "the coordinates are too large for floating-point arithmetic")
@@ -837,6 +838,8 @@ def _clearance(obstacle: Obstacle, x: float, y: float) -> float:
     if isinstance(obstacle, Circle):
         cx, cy = obstacle.center
         return max(0.0, math.hypot(x - cx, y - cy) - obstacle.radius)
+    import shapely
+
     return float(shapely.Polygon(obstacle.points).distance(shapely.Point(x, y)))
 
 

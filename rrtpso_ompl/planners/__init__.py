@@ -14,39 +14,14 @@
 - :mod:`.solve`: :func:`solve`, the one door every caller plans through, returning a
   :class:`SolveResult`.
 
-The planner classes and the post-passes import OMPL, on first access (PEP 562), and
+Every name here is imported on first access (PEP 562, :mod:`rrtpso_ompl.lazy`), so importing
+this package, or ``rrtpso_ompl.planners.params`` (the declarations the generators and the dynamic
+stage use), loads no planner. The planner classes and the post-passes import OMPL, and
 :func:`solve` when it runs; everything else here is plain numpy, so importing
-``rrtpso_ompl.planners.swarm`` (or this package) loads no OMPL.
+``rrtpso_ompl.planners.swarm`` loads no OMPL.
 """
 
-from importlib import import_module
-from typing import Any
-
-from .params import ParamSpec, ParamTable, Rule
-from .path_optimizer import PathOptimizationResult, PathOptimizerOptions, optimize_path
-from .registry import Capabilities, PlannerEntry, PlannerRegistry, default_registry
-from .request import (
-    DEFAULT_PLANNER,
-    DEFAULT_TIME_LIMIT,
-    POST_PARAMS,
-    POST_STEPS,
-    PlannerRequest,
-    resolve,
-    split_spec,
-)
-from .result import BenchmarkRun, SolveResult
-from .solve import solve
-from .swarm import PSOOptions, PSOResult, minimize
-
-#: Names whose modules import OMPL, imported on first access.
-_LAZY = {
-    "PlannerStats": ".base",
-    "PythonPlanner": ".base",
-    "PostStep": ".post",
-    "PSOPathOptimizer": ".post",
-    "PSOPlanner": ".pso_baseline",
-    "RRTstarPSO": ".rrtstar_pso",
-}
+from ..lazy import export_lazily
 
 __all__ = [
     "DEFAULT_PLANNER",
@@ -81,11 +56,35 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        return getattr(import_module(_LAZY[name], __name__), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(__all__)
+export_lazily(
+    __name__,
+    {
+        **dict.fromkeys(("ParamSpec", "ParamTable", "Rule"), ".params"),
+        **dict.fromkeys(
+            ("PathOptimizationResult", "PathOptimizerOptions", "optimize_path"), ".path_optimizer"
+        ),
+        **dict.fromkeys(
+            ("Capabilities", "PlannerEntry", "PlannerRegistry", "default_registry"), ".registry"
+        ),
+        **dict.fromkeys(
+            (
+                "DEFAULT_PLANNER",
+                "DEFAULT_TIME_LIMIT",
+                "POST_PARAMS",
+                "POST_STEPS",
+                "PlannerRequest",
+                "resolve",
+                "split_spec",
+            ),
+            ".request",
+        ),
+        **dict.fromkeys(("BenchmarkRun", "SolveResult"), ".result"),
+        "solve": ".solve",
+        **dict.fromkeys(("PSOOptions", "PSOResult", "minimize"), ".swarm"),
+        # these import OMPL
+        **dict.fromkeys(("PlannerStats", "PythonPlanner"), ".base"),
+        **dict.fromkeys(("PostStep", "PSOPathOptimizer"), ".post"),
+        "PSOPlanner": ".pso_baseline",
+        "RRTstarPSO": ".rrtstar_pso",
+    },
+)

@@ -26,7 +26,6 @@ import sys
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
-from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
@@ -248,6 +247,10 @@ class PlannerRegistry:
         cannot break the tool: ``sys.exit()`` and a ``KeyboardInterrupt`` of its own included
         (a real Ctrl-C still stops the command, :func:`~rrtpso_ompl.foreign.contained`).
         """
+        # Here, not at the top: importing importlib.metadata and scanning the installed
+        # distributions is for the commands that look a planner up (docs/design.md, "Start-up").
+        from importlib.metadata import entry_points
+
         for ep in entry_points(group=group):
             source = f"entry point '{ep.name} = {ep.value}'"
             with contained() as box:

@@ -1,0 +1,75 @@
+"""The free grid searches small rasters in numpy and scipy large ones (so that ``rrtpso optimum``
+of a small problem need not import scipy): both give the same step counts, bounds and optimum."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers import PROBLEMS
+from scipy import ndimage
+
+from rrtpso_ompl.groundtruth import free_grid, shortest_path
+from rrtpso_ompl.groundtruth.free_grid import FreeGrid, _window_extreme
+from rrtpso_ompl.model import World, load_problem
+
+
+def _grid(rng: np.random.Generator) -> FreeGrid:
+    """A random raster of possibly-free cells (some walls, some islands), start and goal in it."""
+    ny, nx = (int(v) for v in rng.integers(1, 45, size=2))
+    free = rng.random((ny, nx)) < rng.uniform(0.35, 0.95)
+    start, goal = rng.uniform(0, 1, size=2) * [nx, ny], rng.uniform(0, 1, size=2) * [nx, ny]
+    return FreeGrid((0.0, 0.0), 1.0, free, start, goal)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_the_numpy_search_gives_the_step_counts_of_scipys(seed, monkeypatch):
+    numpy_grid = _grid(np.random.default_rng(seed))
+    assert numpy_grid.cnx * numpy_grid.cny <= free_grid.NUMPY_SEARCH_CELLS
+    monkeypatch.setattr(free_grid, "NUMPY_SEARCH_CELLS", 0)  # every grid through scipy
+    scipy_grid = _grid(np.random.default_rng(seed))
+    for (m8, m4), (s8, s4) in zip(numpy_grid._dist, scipy_grid._dist, strict=True):
+        np.testing.assert_array_equal(m8, s8)
+        np.testing.assert_array_equal(m4, s4)
+    assert numpy_grid.connected == scipy_grid.connected
+    circles = np.random.default_rng(seed).uniform(0, 45, size=(30, 3)) * [1, 1, 0.1]
+    np.testing.assert_array_equal(numpy_grid.step_ranges(circles), scipy_grid.step_ranges(circles))
+
+
+@pytest.mark.parametrize("w", [1, 2, 4])
+def test_the_window_extremes_are_scipys_filters(w):
+    grid = np.random.default_rng(w).integers(0, 50, size=(23, 31)).astype(float)
+    grid[grid > 45] = np.inf
+    grid[grid < 3] = -np.inf
+    size = 2 * w + 1
+    low = ndimage.minimum_filter(grid, size=size, mode="nearest")
+    high = ndimage.maximum_filter(grid, size=size, mode="nearest")
+    np.testing.assert_array_equal(_window_extreme(grid, w, np.minimum), low)
+    np.testing.assert_array_equal(_window_extreme(grid, w, np.maximum), high)
+
+
+@pytest.mark.parametrize("name", ["paper_static", "bug_trap", "dense_polygons"])
+def test_the_optimum_is_the_same_through_either_search(name, monkeypatch):
+    problem = load_problem(PROBLEMS / "static" / f"{name}.yaml")
+    world = World.from_problem(problem)
+    small = shortest_path(problem, world)
+    monkeypatch.setattr(free_grid, "NUMPY_SEARCH_CELLS", 0)
+    large = shortest_path(problem, world)
+    assert small.found and small.length == large.length
+    assert small.pieces == large.pieces and small.n_edges == large.n_edges
+
+
+def test_a_winding_search_has_one_level_per_cell_and_scipys_counts(monkeypatch):
+    """A serpentine corridor: the deepest search there is (about one level per free cell)."""
+    free = np.ones((41, 40), dtype=bool)
+    for j in range(1, 41, 2):  # walls with one gap, at alternate ends
+        free[j, :] = False
+        free[j, 39 if j % 4 == 1 else 0] = True
+    start, goal = (0.5, 0.5), (0.5, 40.5)
+    numpy_grid = FreeGrid((0.0, 0.0), 1.0, free, start, goal)
+    monkeypatch.setattr(free_grid, "NUMPY_SEARCH_CELLS", 0)
+    scipy_grid = FreeGrid((0.0, 0.0), 1.0, free, start, goal)
+    m8 = numpy_grid._dist[0][0]
+    assert np.nanmax(m8[np.isfinite(m8)]) > 20 * 40  # it winds through every row
+    for ours, theirs in zip(numpy_grid._dist, scipy_grid._dist, strict=True):
+        np.testing.assert_array_equal(ours[0], theirs[0])
+        np.testing.assert_array_equal(ours[1], theirs[1])
