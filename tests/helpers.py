@@ -36,6 +36,47 @@ def run(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
     return subprocess.run([*rrtpso_exe(), *args], capture_output=True, text=True, timeout=timeout)
 
 
+class HeldBatch:
+    """A batch that stays running after its first row until the test says (the batch's test hook
+    :data:`~rrtpso_ompl.harness.batch.HOLD_ENV`): "a batch still running" by construction, not
+    by a race with the machine's speed.
+
+    ``env`` goes to the batch's ``subprocess.Popen``; :meth:`wait_for_rows` waits for the first
+    row(s) to be written (the batch is then at the hold, or on its way to it); :meth:`release`
+    lets it go on to the end.
+    """
+
+    def __init__(self, folder: Path) -> None:
+        from rrtpso_ompl.harness.batch import HOLD_ENV
+
+        self.fifo = folder / "hold.fifo"
+        os.mkfifo(self.fifo)
+        self.env = {**os.environ, HOLD_ENV: str(self.fifo)}
+
+    @staticmethod
+    def wait_for_rows(proc: subprocess.Popen, out: Path, rows: int = 1,
+                      seconds: float = 300) -> None:  # fmt: skip
+        """Wait until ``out`` holds ``rows`` whole lines (a deadline only against a hang: the
+        batch cannot finish without :meth:`release`)."""
+        import time
+
+        deadline = time.monotonic() + seconds
+        while time.monotonic() < deadline and proc.poll() is None:
+            if out.exists() and out.read_bytes().count(b"\n") >= rows:
+                return
+            time.sleep(0.05)
+        raise AssertionError(f"no {rows} rows in {out} (exit status {proc.poll()})")
+
+    def release(self, seconds: float = 300) -> None:
+        """Open the fifo for reading: the held batch goes on."""
+        import threading
+
+        opener = threading.Thread(target=lambda: open(self.fifo, "rb").close(), daemon=True)
+        opener.start()
+        opener.join(seconds)
+        assert not opener.is_alive(), "the batch never reached its hold"
+
+
 def _generate_parser():
     """The parser of ``rrtpso generate`` (its flags are derived from the declared options)."""
     import argparse
@@ -229,7 +270,7 @@ def install_plugin(tmp_path: Path, name: str, source: str, group: str,
     pkg = tmp_path / name
     (pkg / name).mkdir(parents=True)
     (pkg / name / "__init__.py").write_text(source)
-    lines = "\n".join(f"{k} = \"{v}\"" for k, v in entry_points.items())
+    lines = "\n".join(f'{k} = "{v}"' for k, v in entry_points.items())
     (pkg / "pyproject.toml").write_text(textwrap.dedent(f"""
         [build-system]
         requires = ["setuptools"]
