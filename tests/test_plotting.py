@@ -368,6 +368,25 @@ def test_the_simulation_plot_legend_hides_no_obstacle(simulated):
         _close(fig)
 
 
+def test_gif_frames_are_drawn_as_the_whole_figure_would_be(simulated):
+    """``frame_images`` keeps what does not move and redraws the rest: each frame is, pixel for
+    pixel, what drawing the whole figure gives."""
+    from rrtpso_ompl.plotting import frame_images, simulation_frames
+
+    problem, sim = simulated
+    fig, draw, frames = simulation_frames(problem, sim, max_frames=6)
+    try:
+        fig.set_dpi(40)
+        fast = [np.asarray(image) for image in frame_images(fig, draw, frames)]
+        for i, image in zip(frames, fast, strict=True):
+            draw(int(i))
+            fig.canvas.draw()
+            whole = np.asarray(fig.canvas.buffer_rgba())[..., :3]
+            assert np.array_equal(image, whole), int(i)
+    finally:
+        _close(fig)
+
+
 def test_every_gif_frame_has_a_legend_that_hides_nothing(simulated, tmp_path):
     from PIL import Image
 
