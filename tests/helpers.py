@@ -31,6 +31,14 @@ def rrtpso_exe() -> list[str]:
     return [exe] if exe else [sys.executable, "-m", "rrtpso_ompl"]
 
 
+#: RRTstarPSO bounded by work (RRT*'s iterations, one swarm round of bounded iterations) on the
+#: command line: its path is the same on every machine, ``--time`` only a cap it never reaches
+#: (a static path planned for a time budget differs with the machine's speed, and with it, say,
+#: whether a moving obstacle crosses it).
+BOUNDED_ARGS = ["--time", "30", "--param", "rrt_max_iterations=300", "--param", "iterations=20",
+                "--param", "refine_rounds=0", "--param", "polish_rounds=0"]  # fmt: skip
+
+
 def run(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
     """``rrtpso *args`` in a subprocess, its output captured as text."""
     return subprocess.run([*rrtpso_exe(), *args], capture_output=True, text=True, timeout=timeout)

@@ -8,7 +8,7 @@ import subprocess
 
 import numpy as np
 import pytest
-from helpers import PROBLEMS, corridor, manager_for, observe, rrtpso_exe
+from helpers import BOUNDED_ARGS, PROBLEMS, corridor, manager_for, observe, rrtpso_exe
 
 from rrtpso_ompl.dynamic import DynamicOptions, Motion, predict_threats, simulate
 from rrtpso_ompl.model.problem import load_problem
@@ -127,7 +127,7 @@ def test_simulate_command_takes_no_reshorten_and_the_default_budget(tmp_path):
     out = tmp_path / "run.json"
     proc = subprocess.run(
         [*rrtpso_exe(), "simulate", str(PROBLEMS / "dynamic" / "paper_dynamic.yaml"),
-         "--no-reshorten", "--time", "0.3", "--json", str(out)],
+         "--no-reshorten", *BOUNDED_ARGS, "--json", str(out)],
         capture_output=True, text=True, timeout=300,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr

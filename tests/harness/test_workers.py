@@ -67,9 +67,11 @@ def test_same_seed_same_path_as_a_separate_solve(tmp_path):
     from helpers import rrtpso_exe
 
     problem = str(PROBLEMS / "static" / "maze.yaml")
-    params = {"RRTstarPSO": {"rrt_max_iterations": "300", "iterations": "20"}}
-    # Bounded by iterations, not by the clock: a budget no run comes near (a warm worker after
-    # a Dask cluster ran 4 times slower, and a swarm cut by the deadline differs run to run).
+    params = {"RRTstarPSO": {"rrt_max_iterations": "300", "iterations": "20", "refine_rounds": "0",
+                            "polish_rounds": "0"}}  # fmt: skip
+    # Bounded by iterations (RRT*'s, the swarm's, one round), not by the clock: a budget no run
+    # comes near (a warm worker after a Dask cluster ran 4 times slower, and a swarm cut by the
+    # deadline differs run to run).
     tasks = make_tasks([problem], ["RRTConnect", "RRTstarPSO"], runs=2, seed=5, time_limit=30.0,
                        params=params)  # fmt: skip
     rows = run_batch(tasks, tmp_path / "r.jsonl", jobs=2, optimum=False)
