@@ -250,7 +250,7 @@ def _with_closed_stdout(*args: str, cwd: Path) -> tuple[int, str]:
         (["planners", "--json"], 0),
         # a single result on stdout: the command finishes and keeps its own status
         (["solve", "p.yaml", "--planner", "RRTConnect", "--time", "0.5", "--json", "-"], 0),
-        (["solve", "maze.yaml", "--planner", "RRTstar", "--time", "0.05", "--json", "-"], 1),
+        (["solve", "walled.yaml", "--planner", "RRTstar", "--time", "0.05", "--json", "-"], 1),
         # a batch streaming rows: nobody reads the rest, so it stops
         (["batch", "p.yaml", "--planner", "RRTConnect", "--runs", "50", "--time", "0.5",
           "--out", "-"], 0),
@@ -258,7 +258,11 @@ def _with_closed_stdout(*args: str, cwd: Path) -> tuple[int, str]:
     ids=["planners", "planners-json", "solve-solved", "solve-unsolved", "batch"],
 )  # fmt: skip
 def test_a_closed_pipe_is_quiet(folder, args, status):
-    (folder / "maze.yaml").write_text((PROBLEMS / "static" / "maze.yaml").read_text())
+    # A wall across the whole workspace: unsolved on any machine, however fast.
+    (folder / "walled.yaml").write_text(
+        "bounds: [[0, 0], [100, 100]]\nstart: [50, 10]\ngoal: [50, 90]\nrobot: {radius: 2}\n"
+        "obstacles:\n  - {type: rectangle, min: [0, 45], max: [100, 55]}\n"
+    )
     code, err = _with_closed_stdout(*args, "-q", cwd=folder)
     assert code == status and err == "", err
 
