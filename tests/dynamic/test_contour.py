@@ -127,6 +127,7 @@ def test_planning_time_is_measured_per_replan():
     assert all(r.planning_time == 0.0 for r in sim.replans if r.budget == 0)
 
 
+@pytest.mark.slow  # the rrtpso command end to end
 def test_simulate_command_takes_no_reshorten_and_the_default_budget(tmp_path):
     out = tmp_path / "run.json"
     proc = subprocess.run(

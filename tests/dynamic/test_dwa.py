@@ -312,6 +312,7 @@ def test_navgrid_is_bounded(monkeypatch):
 
 
 # -- the command ---------------------------------------------------------------------------------
+@pytest.mark.slow  # the rrtpso command end to end
 def test_simulate_command_runs_the_dwa(tmp_path):
     out = tmp_path / "dwa.json"
     proc = subprocess.run(

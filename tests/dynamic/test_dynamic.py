@@ -281,6 +281,7 @@ def test_simulate_command_writes_the_contract(tmp_path):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+@pytest.mark.slow  # the rrtpso command end to end
 def test_simulate_command_writes_a_gif(tmp_path):
     """``--gif`` on a short run (head-on, the goal a few seconds away): a GIF, one frame per
     sample of the drive."""

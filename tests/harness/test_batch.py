@@ -23,6 +23,7 @@ def test_inputs_mix_files_globs_and_directories(folder, tmp_path):
     assert "no file matches" in errors[str(tmp_path / "*.none")]
 
 
+@pytest.mark.slow  # the optional Dask executor: a cluster of processes
 def test_dask_local_cluster_runs_the_same_batch(folder, tmp_path):
     distributed = pytest.importorskip("distributed")
     tasks = make_tasks([str(folder / "a_circle.yaml"), str(folder / "c_bad.yaml")], ["RRTConnect"],
@@ -48,6 +49,7 @@ def _cluster_batch(tasks, out):
         return run_batch(tasks, out, executor="dask", scheduler=client, optimum=False)
 
 
+@pytest.mark.slow  # the optional Dask executor: a cluster of processes
 def test_dask_process_workers_fork_warm_runs_with_the_same_paths(tmp_path):
     """Dask's worker processes are daemonic and run threads: each run is forked from a warm fork
     server instead, and its path is the one the local warm workers give for the same seed."""

@@ -99,6 +99,7 @@ def test_rrtstarpso_lowers_the_objective_below_the_shortest_paths(door, hugging)
     assert result.stages["pso_cost"] <= result.stages["seed_cost"]
 
 
+@pytest.mark.slow  # the rrtpso command, in a process of its own
 def test_bitstar_survives_the_objective(tmp_path):
     """OMPL 2.0.1's BIT* crashed (a segmentation fault) under a PathLengthOptimizationObjective
     subclass with this cost (paper_static, seed 1): the objective derives from

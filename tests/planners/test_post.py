@@ -302,6 +302,7 @@ def test_bench_logs_each_spec_as_a_configuration(tmp_path):
         assert simplified <= raw + 1e-9 and seconds >= 0
 
 
+@pytest.mark.slow  # the rrtpso command end to end
 def test_batch_takes_post_pass_parameters_for_the_specs_that_have_post_passes(tmp_path):
     out = tmp_path / "b.jsonl"
     proc = run_cli("batch", str(PROBLEMS / "static" / "single_circle.yaml"), "--planner",
