@@ -202,3 +202,18 @@ def test_resuming_with_other_settings_runs_the_tasks_and_says_so(tmp_path):
     rows = run_batch([again], out, resume=True,
                      on_start=lambda n, skipped: seen.append((n, skipped)))  # fmt: skip
     assert seen == [(0, 1)] and len(rows) == 1
+
+
+def test_the_hold_hook_holds_only_at_a_fifo_and_never_writes_a_file(folder, tmp_path, monkeypatch):
+    """``RRTPSO_TEST_HOLD_BATCH`` naming a regular file or nothing at all: the batch runs to its
+    end and the file is as it was (the held batch itself: tests/cli/test_batch.py)."""
+    from rrtpso_ompl.harness.batch import HOLD_ENV
+
+    mine = tmp_path / "mine.txt"
+    mine.write_text("mine\n")
+    tasks = make_tasks([str(folder / "a_circle.yaml")], ["RRTConnect"], runs=2, time_limit=5.0)
+    for i, target in enumerate((mine, tmp_path / "absent")):
+        monkeypatch.setenv(HOLD_ENV, str(target))
+        rows = run_batch(tasks, tmp_path / f"r{i}.jsonl", optimum=False)
+        assert len(rows) == 2 and all(r.solved for r in rows)
+    assert mine.read_text() == "mine\n" and not (tmp_path / "absent").exists()
