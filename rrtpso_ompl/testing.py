@@ -15,7 +15,8 @@ OMPL, one property per check:
                           the best-cost samples never increase, and the returned path is no
                           longer than the planner's own first path (RRTstarPSO: its RRT* path)
                           or the seed path its stats name
-:func:`check_deadline`    every solve returns within ``1.5 x budget + 0.2 s``
+:func:`check_deadline`    every solve returns within ``1.5 x budget + 1 s``, and one whose
+                          termination condition has already fired within ``1 s``
 :func:`check_clear_and_solve_again`
                           ``solve``, ``clear()``, ``solve`` again: exact both times; an already
                           expired termination condition returns without a crash
@@ -46,11 +47,13 @@ cases::
         check(entry)
 
 The deadline's tolerance is generous on purpose: the project's promise is 5 % (measured by the
-benchmarks on a quiet machine); a test on a shared, loaded machine can be descheduled for a
-tenth of a second or more, and the planner's last iteration stretched with it. ``1.5 x budget +
-0.2 s`` absorbs that, and still fails a planner that ignores its termination condition (runs a
-fixed amount of work, or waits for a solution that does not come). Solves the checks share (the
-same entry, problem, budget and seed) run once per process.
+benchmarks on a quiet machine, never by a test); a test on a shared, loaded machine can be
+descheduled for a good part of a second, and the planner's last iteration and the exact check
+after it stretched with it. ``1.5 x budget + 1 s`` absorbs that, and still fails a planner that
+ignores its termination condition: one that runs a fixed amount of work, or waits for a solution
+that does not come. The mechanism itself is checked as OMPL's ``PlannerTest`` does: a solve
+whose condition has already fired must return at once (within the same ``1 s``). Solves the
+checks share (the same entry, problem, budget and seed) run once per process.
 """
 
 from __future__ import annotations
@@ -112,10 +115,11 @@ SIMPLE_PROBLEM = {
 BUDGET = 0.5
 #: Seconds of the deadline check's smallest budget.
 TINY_BUDGET = 0.01
-#: A solve may take ``DEADLINE_FACTOR x budget + DEADLINE_SLACK`` seconds (see the module's
-#: docstring for why so much).
+#: A solve may take ``DEADLINE_FACTOR x budget + DEADLINE_SLACK`` seconds, one with an expired
+#: termination condition ``DEADLINE_SLACK`` (see the module's docstring for why so much: a
+#: loaded machine must hold it).
 DEADLINE_FACTOR = 1.5
-DEADLINE_SLACK = 0.2
+DEADLINE_SLACK = 1.0
 #: Round-off allowed when comparing lengths and costs (relative).
 _RTOL = 1e-9
 #: The spaces of :func:`check_other_spaces`: a user's own ``og.SimpleSetup`` in each. Not
@@ -216,17 +220,24 @@ def check_deadline(
     registry: PlannerRegistry | None = None,
 ) -> None:
     """Every solve returns within ``DEADLINE_FACTOR x budget + DEADLINE_SLACK`` seconds: the
-    solves at ``budget`` (through :func:`~rrtpso_ompl.planners.solve` and directly in OMPL) and
-    one at :data:`TINY_BUDGET`."""
+    solves at ``budget`` (through :func:`~rrtpso_ompl.planners.solve` and directly in OMPL), one
+    at :data:`TINY_BUDGET`, and one whose termination condition has already fired (budget 0:
+    within ``DEADLINE_SLACK``). Each is checked as soon as it has run (a planner that ignores its
+    condition fails at its first solve, not after all of them)."""
     case = _case(entry, problem, budget, seed, registry)
     tiny = _case(entry, problem, TINY_BUDGET, seed, registry)
-    times = [("solve()", budget, _result(case).time)]
-    times += [(f"ss.solve() #{i + 1}", budget, t) for i, t in enumerate(_direct(case).times)]
-    times.append(("solve() with the tiny budget", TINY_BUDGET, _result(tiny).time))
-    for what, limit, seconds in times:
+
+    def within(what: str, limit: float, seconds: float) -> None:
         allowed = DEADLINE_FACTOR * limit + DEADLINE_SLACK
         assert seconds <= allowed, (f"{case.name}: {what} took {seconds:.3f} s for a {limit:g} s "
                                     f"budget (allowed {allowed:.3f} s)")  # fmt: skip
+
+    within("solve()", budget, _result(case).time)
+    direct = _direct(case)
+    for i, seconds in enumerate(direct.times[:2]):
+        within(f"ss.solve() #{i + 1}", budget, seconds)
+    within("ss.solve() with an expired termination condition", 0.0, direct.times[2])
+    within("solve() with the tiny budget", TINY_BUDGET, _result(tiny).time)
 
 
 def check_clear_and_solve_again(
@@ -485,7 +496,8 @@ class _Case:
 @dataclass(frozen=True)
 class _Direct:
     """The planner run in OMPL directly: each ``ss.solve``'s status text, the path it left
-    (``(n, 2)``, empty for none) and the seconds it took."""
+    (``(n, 2)``, empty for none) and the seconds it took (the two timed solves, then the one
+    with an expired condition)."""
 
     statuses: tuple[str, ...]
     paths: tuple[np.ndarray, ...]
@@ -580,8 +592,7 @@ def _direct(case: _Case) -> _Direct:
                 status = ctx.ss.solve(ptc)
             except Exception as exc:  # the check reports it
                 raise AssertionError(f"{case.name}: solve() raised {exc!r}") from exc
-            if condition == "timed":
-                times.append(time.perf_counter() - t0)
+            times.append(time.perf_counter() - t0)
             pdef = ctx.ss.getProblemDefinition()
             paths.append(path_to_array(pdef.getSolutionPath()) if pdef.hasSolution()
                          else np.empty((0, 2)))  # fmt: skip

@@ -31,9 +31,58 @@ def rrtpso_exe() -> list[str]:
     return [exe] if exe else [sys.executable, "-m", "rrtpso_ompl"]
 
 
+#: RRTstarPSO bounded by work (RRT*'s iterations, one swarm round of bounded iterations) on the
+#: command line: its path is the same on every machine, ``--time`` only a cap it never reaches
+#: (a static path planned for a time budget differs with the machine's speed, and with it, say,
+#: whether a moving obstacle crosses it).
+BOUNDED_ARGS = ["--time", "30", "--param", "rrt_max_iterations=300", "--param", "iterations=20",
+                "--param", "refine_rounds=0", "--param", "polish_rounds=0"]  # fmt: skip
+
+
 def run(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
     """``rrtpso *args`` in a subprocess, its output captured as text."""
     return subprocess.run([*rrtpso_exe(), *args], capture_output=True, text=True, timeout=timeout)
+
+
+class HeldBatch:
+    """A batch that stays running after its first row until the test says (the batch's test hook
+    :data:`~rrtpso_ompl.harness.batch.HOLD_ENV`): "a batch still running" by construction, not
+    by a race with the machine's speed.
+
+    ``env`` goes to the batch's ``subprocess.Popen``; :meth:`wait_for_rows` waits for the first
+    row(s) to be written (the batch is then at the hold, or on its way to it); :meth:`release`
+    lets it go on to the end.
+    """
+
+    def __init__(self, folder: Path) -> None:
+        from rrtpso_ompl.harness.batch import HOLD_ENV
+
+        self.fifo = folder / "hold.fifo"
+        os.mkfifo(self.fifo)
+        self.env = {**os.environ, HOLD_ENV: str(self.fifo)}
+
+    @staticmethod
+    def wait_for_rows(proc: subprocess.Popen, out: Path, rows: int = 1,
+                      seconds: float = 300) -> None:  # fmt: skip
+        """Wait until ``out`` holds ``rows`` whole lines (a deadline only against a hang: the
+        batch cannot finish without :meth:`release`)."""
+        import time
+
+        deadline = time.monotonic() + seconds
+        while time.monotonic() < deadline and proc.poll() is None:
+            if out.exists() and out.read_bytes().count(b"\n") >= rows:
+                return
+            time.sleep(0.05)
+        raise AssertionError(f"no {rows} rows in {out} (exit status {proc.poll()})")
+
+    def release(self, seconds: float = 300) -> None:
+        """Open the fifo for reading: the held batch goes on."""
+        import threading
+
+        opener = threading.Thread(target=lambda: open(self.fifo, "rb").close(), daemon=True)
+        opener.start()
+        opener.join(seconds)
+        assert not opener.is_alive(), "the batch never reached its hold"
 
 
 def _generate_parser():
@@ -229,7 +278,7 @@ def install_plugin(tmp_path: Path, name: str, source: str, group: str,
     pkg = tmp_path / name
     (pkg / name).mkdir(parents=True)
     (pkg / name / "__init__.py").write_text(source)
-    lines = "\n".join(f"{k} = \"{v}\"" for k, v in entry_points.items())
+    lines = "\n".join(f'{k} = "{v}"' for k, v in entry_points.items())
     (pkg / "pyproject.toml").write_text(textwrap.dedent(f"""
         [build-system]
         requires = ["setuptools"]

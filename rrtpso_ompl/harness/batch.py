@@ -624,9 +624,34 @@ def _record(
             rows.append(row)
             if progress is not None:
                 progress(row)
+            if len(rows) == 1:
+                _hold_for_tests()
     finally:
         stream.close()  # on Ctrl-C: stop the workers before the file is released
     return rows
+
+
+#: Test hook (environment variable): the path of a fifo. A batch (or bench) that finds one there
+#: holds after writing its first row until the fifo is opened for reading, the results file
+#: still locked and its workers stopped or idle. Tests that need "a batch still running" (Ctrl-C,
+#: a second batch on the same file) get it by construction, on any machine (``tests/helpers.py``,
+#: ``held_batch``). A path that is not a fifo is ignored, so the hook can never write a file.
+HOLD_ENV = "RRTPSO_TEST_HOLD_BATCH"
+
+
+def _hold_for_tests() -> None:
+    """Wait, when :data:`HOLD_ENV` names a fifo, until a reader opens it (a blocking open:
+    Ctrl-C and the termination signals still interrupt it)."""
+    fifo = os.environ.get(HOLD_ENV)
+    if not fifo:
+        return
+    try:
+        if not stat.S_ISFIFO(os.stat(fifo).st_mode):
+            return
+    except OSError:
+        return
+    with open(fifo, "wb"):
+        pass
 
 
 def _done(task: Task, done: Mapping[RunKey, str | None]) -> bool:

@@ -13,6 +13,7 @@ from helpers import PROBLEMS, rrtpso_exe
 from rrtpso_ompl.groundtruth.optimum import shortest_path
 from rrtpso_ompl.harness.batch import read_rows
 from rrtpso_ompl.model.problem import load_problem
+from rrtpso_ompl.testing import DEADLINE_FACTOR, DEADLINE_SLACK
 
 pytestmark = pytest.mark.slow
 
@@ -89,8 +90,9 @@ def test_database_has_one_experiment_per_budget_and_the_optimum(bench_dir):
 
 def test_rrtstarpso_runs_report_rrtstar_then_pso_as_simplification(bench_dir):
     _, out, _ = bench_dir
-    runs = _query(out / "benchmark.db", "SELECT r.*, p.name AS planner FROM runs r JOIN "
-                  "plannerConfigs p ON p.id = r.plannerid")  # fmt: skip
+    runs = _query(out / "benchmark.db", "SELECT r.*, p.name AS planner, e.timelimit FROM runs r "
+                  "JOIN plannerConfigs p ON p.id = r.plannerid JOIN experiments e ON "
+                  "e.id = r.experimentid")  # fmt: skip
     assert {"solution_length", "simplified_solution_length", "simplification_time",
             "length_over_optimum", "total_time", "correct_solution"} <= set(runs[0])  # fmt: skip
     for r in runs:
@@ -101,9 +103,11 @@ def test_rrtstarpso_runs_report_rrtstar_then_pso_as_simplification(bench_dir):
         assert r["simplification_time"] > 0
         assert r["total_time"] == pytest.approx(r["time"] + r["simplification_time"], rel=1e-6)
     pso = [r for r in runs if r["planner"] == "geometric_RRTstarPSO"]
-    budgets = {0.1, 0.2}
-    # For RRTstarPSO the RRT* stage and the swarm share the budget.
-    assert all(min(abs(r["total_time"] - b) for b in budgets) < 0.05 for r in pso)
+    # For RRTstarPSO the RRT* stage and the swarm share the budget: the swarm is not extra time
+    # (the swarm's deadline inside the budget is checked exactly in tests/planners/test_anytime.py;
+    # here the conformance kit's tolerance, which a loaded machine holds: the 5 % is for the
+    # benchmarks to measure, docs/families.md's deadline column).
+    assert all(r["total_time"] <= DEADLINE_FACTOR * r["timelimit"] + DEADLINE_SLACK for r in pso)
 
 
 def test_progress_rows_for_every_run(bench_dir):

@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 import pytest
-from helpers import PROBLEMS, rrtpso_exe
+from helpers import PROBLEMS, HeldBatch, rrtpso_exe
 
 pytestmark = pytest.mark.slow
 
@@ -68,17 +68,19 @@ def folder(tmp_path: Path) -> Path:
 # Data loss and overwriting
 # ----------------------------------------------------------------------------------------------
 def test_a_second_batch_on_the_same_file_is_refused_and_the_first_keeps_its_rows(folder):
-    args = ["batch", "p.yaml", "--planner", "RRTstar", "--runs", "4", "--time", "0.5",
+    # The first batch holds after its first row (the test hook) until the second has been refused:
+    # "while the first still writes" by construction. RRTConnect stops at its first path.
+    args = ["batch", "p.yaml", "--planner", "RRTConnect", "--runs", "4", "--time", "5",
             "--out", "r.jsonl"]  # fmt: skip
+    held = HeldBatch(folder)
     first = subprocess.Popen([*rrtpso_exe(), *args], cwd=folder, stderr=subprocess.PIPE,
-                             text=True, preexec_fn=_limit)  # fmt: skip
-    deadline = time.time() + 30
-    while not (folder / "r.jsonl").exists() and time.time() < deadline:
-        time.sleep(0.05)
+                             text=True, preexec_fn=_limit, env=held.env)  # fmt: skip
+    held.wait_for_rows(first, folder / "r.jsonl")
     second = run(*args, "--overwrite", cwd=folder)
     assert second.returncode == 2 and "another rrtpso batch or bench is writing" in second.stderr
+    held.release()
     _, err = first.communicate(timeout=120)
-    assert first.returncode == 0 and "Traceback" not in err
+    assert first.returncode == 0 and "Traceback" not in err, err
     assert len(rows_of(folder / "r.jsonl")) == 4
 
 
@@ -248,7 +250,7 @@ def _with_closed_stdout(*args: str, cwd: Path) -> tuple[int, str]:
         (["planners", "--json"], 0),
         # a single result on stdout: the command finishes and keeps its own status
         (["solve", "p.yaml", "--planner", "RRTConnect", "--time", "0.5", "--json", "-"], 0),
-        (["solve", "maze.yaml", "--planner", "RRTstar", "--time", "0.05", "--json", "-"], 1),
+        (["solve", "walled.yaml", "--planner", "RRTstar", "--time", "0.05", "--json", "-"], 1),
         # a batch streaming rows: nobody reads the rest, so it stops
         (["batch", "p.yaml", "--planner", "RRTConnect", "--runs", "50", "--time", "0.5",
           "--out", "-"], 0),
@@ -256,7 +258,11 @@ def _with_closed_stdout(*args: str, cwd: Path) -> tuple[int, str]:
     ids=["planners", "planners-json", "solve-solved", "solve-unsolved", "batch"],
 )  # fmt: skip
 def test_a_closed_pipe_is_quiet(folder, args, status):
-    (folder / "maze.yaml").write_text((PROBLEMS / "static" / "maze.yaml").read_text())
+    # A wall across the whole workspace: unsolved on any machine, however fast.
+    (folder / "walled.yaml").write_text(
+        "bounds: [[0, 0], [100, 100]]\nstart: [50, 10]\ngoal: [50, 90]\nrobot: {radius: 2}\n"
+        "obstacles:\n  - {type: rectangle, min: [0, 45], max: [100, 55]}\n"
+    )
     code, err = _with_closed_stdout(*args, "-q", cwd=folder)
     assert code == status and err == "", err
 
@@ -303,26 +309,22 @@ def test_a_misspelt_or_repeated_param_is_refused_with_a_hint(folder, args, words
 
 
 def test_ctrl_c_in_a_batch_leaves_a_valid_file_and_no_tracebacks(folder):
-    proc = subprocess.Popen(
-        [*rrtpso_exe(), "batch", "p.yaml", "--planner", "RRTstar", "--runs", "20", "--time", "0.5",
-         "--jobs", "2", "--out", "r.jsonl"],
-        cwd=folder, stderr=subprocess.PIPE, text=True, preexec_fn=_limit,
-    )  # fmt: skip
-    deadline = time.time() + 60
-    while time.time() < deadline:
-        path = folder / "r.jsonl"
-        if path.exists() and path.read_text().count("\n") >= 2:
-            break
-        time.sleep(0.1)
+    # Held after its first row (the test hook): Ctrl-C comes while the batch runs, on any machine.
+    args = ["batch", "p.yaml", "--planner", "RRTConnect", "--runs", "6", "--time", "5",
+            "--jobs", "2", "--out", "r.jsonl"]  # fmt: skip
+    held = HeldBatch(folder)
+    proc = subprocess.Popen([*rrtpso_exe(), *args], cwd=folder, stderr=subprocess.PIPE,
+                            text=True, preexec_fn=_limit, env=held.env)  # fmt: skip
+    held.wait_for_rows(proc, folder / "r.jsonl")
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130 and "Traceback" not in err, err
+    assert len(rows_of(folder / "r.jsonl")) == 1
+    # and it continues: the same runs, the one done kept
+    proc = run(*args, "--resume", cwd=folder)
+    assert proc.returncode == 0, proc.stderr
     rows = rows_of(folder / "r.jsonl")
-    assert 2 <= len(rows) < 20
-    # and it continues
-    proc = run("batch", "p.yaml", "--planner", "RRTstar", "--runs", "20", "--time", "0.05",
-               "--jobs", "2", "--out", "r.jsonl", "--resume", cwd=folder)  # fmt: skip
-    assert proc.returncode == 0 and len(rows_of(folder / "r.jsonl")) >= 20
+    assert sorted(r["seed"] for r in rows) == [1, 2, 3, 4, 5, 6] and all(r["solved"] for r in rows)
 
 
 def test_inputs_too_large_for_the_machine_end_cleanly(folder):

@@ -138,7 +138,8 @@ def test_same_seed_same_path_iteration_bounded(circle_file, tmp_path):
     per process, so each run is its own process; bounded by iterations (RRT*'s and the swarm's)
     under a time limit it never reaches, two processes with the same seed, running at the same
     time on a loaded machine, give the same result in every field but the clock's."""
-    args = ["--time", "30", "--param", "rrt_max_iterations=600", "--param", "iterations=30"]
+    args = ["--time", "30", "--param", "rrt_max_iterations=600", "--param", "iterations=30",
+            "--param", "refine_rounds=0", "--param", "polish_rounds=0"]  # fmt: skip
     procs = []
     for i, seed in enumerate((11, 11, 12)):
         cmd = [*rrtpso_exe(), "solve", str(circle_file), "--seed", str(seed), *args, "--json",

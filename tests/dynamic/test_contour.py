@@ -8,7 +8,7 @@ import subprocess
 
 import numpy as np
 import pytest
-from helpers import PROBLEMS, corridor, manager_for, observe, rrtpso_exe
+from helpers import BOUNDED_ARGS, PROBLEMS, corridor, manager_for, observe, rrtpso_exe
 
 from rrtpso_ompl.dynamic import DynamicOptions, Motion, predict_threats, simulate
 from rrtpso_ompl.model.problem import load_problem
@@ -119,15 +119,20 @@ def test_planning_time_is_measured_per_replan():
     problem = load_problem(PROBLEMS / "dynamic" / "crossing_from_below.yaml")
     path = np.array([problem.start, problem.goal])
     sim = simulate(problem, DynamicOptions(replan_time=0.05), seed=1, initial_path=path)
-    planned = [r for r in sim.replans if r.kind == "contour"]
+    # Every reaction that planned (a contour detour, or a fallback after detours that found
+    # nothing in time: which one depends on the machine) is charged; one with no time to plan is
+    # charged nothing.
+    planned = [r for r in sim.replans if r.budget > 0]
     assert planned and all(r.planning_time > 0 and r.budget == 0.05 for r in planned)
+    assert all(r.planning_time == 0.0 for r in sim.replans if r.budget == 0)
 
 
+@pytest.mark.slow  # the rrtpso command end to end
 def test_simulate_command_takes_no_reshorten_and_the_default_budget(tmp_path):
     out = tmp_path / "run.json"
     proc = subprocess.run(
         [*rrtpso_exe(), "simulate", str(PROBLEMS / "dynamic" / "paper_dynamic.yaml"),
-         "--no-reshorten", "--time", "0.3", "--json", str(out)],
+         "--no-reshorten", *BOUNDED_ARGS, "--json", str(out)],
         capture_output=True, text=True, timeout=300,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr

@@ -9,7 +9,7 @@ import subprocess
 
 import numpy as np
 import pytest
-from helpers import PROBLEMS, corridor, manager_for, observe, rrtpso_exe
+from helpers import BOUNDED_ARGS, PROBLEMS, corridor, manager_for, observe, rrtpso_exe
 
 from rrtpso_ompl.dynamic import (
     DynamicOptions,
@@ -256,12 +256,14 @@ def test_heading_changes_are_seeded_and_still_avoided():
 
 
 def test_simulate_command_writes_the_contract(tmp_path):
+    """The JSON and the PNG of the paper's scenario (the GIF the command writes is checked by
+    ``test_readme_office_dwa_run_reaches_the_goal`` and on a short run below: 150 frames of
+    this one take 13 s)."""
     out = tmp_path / "run.json"
-    gif = tmp_path / "run.gif"
     png = tmp_path / "run.png"
     proc = subprocess.run(
         [*rrtpso_exe(), "simulate", str(PROBLEMS / "dynamic" / "paper_dynamic.yaml"), "--json",
-         str(out), "--gif", str(gif), "--plot", str(png), "--seed", "2", "--time", "0.5"],
+         str(out), "--plot", str(png), "--seed", "2", *BOUNDED_ARGS],
         capture_output=True, text=True, timeout=300,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr
@@ -276,8 +278,28 @@ def test_simulate_command_writes_the_contract(tmp_path):
     assert data["replans"] and {"t", "start", "goal", "side", "planning_time", "length"} <= set(
         data["replans"][0]
     )
-    assert gif.read_bytes()[:6] in (b"GIF89a", b"GIF87a")
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.slow  # the rrtpso command end to end
+def test_simulate_command_writes_a_gif(tmp_path):
+    """``--gif`` on a short run (head-on, the goal a few seconds away): a GIF, one frame per
+    sample of the drive."""
+    from PIL import Image
+
+    problem = tmp_path / "short.yaml"
+    text = (PROBLEMS / "dynamic" / "head_on.yaml").read_text()
+    problem.write_text(text.replace("goal: [470, 250]", "goal: [90, 250]"))
+    gif, out = tmp_path / "run.gif", tmp_path / "run.json"
+    proc = subprocess.run(
+        [*rrtpso_exe(), "simulate", str(problem), "--gif", str(gif), "--json", str(out),
+         *BOUNDED_ARGS], capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert gif.read_bytes()[:6] in (b"GIF89a", b"GIF87a")
+    samples = len(json.loads(out.read_text())["trajectory"])
+    with Image.open(gif) as image:
+        assert 2 <= image.n_frames <= samples
 
 
 def test_simulate_rejects_a_problem_without_sensor(tmp_path):

@@ -165,7 +165,10 @@ def test_the_header_command_regenerates_the_three_files(tmp_path):
 # ----------------------------------------------------------------------------------------------
 # The three files follow the output rules
 # ----------------------------------------------------------------------------------------------
-@pytest.mark.parametrize("which", [0, 1, 2])
+# Each case runs the command (a second each): the quick run keeps one (pytest.mark.slow).
+@pytest.mark.parametrize(
+    "which", [0, pytest.param(1, marks=pytest.mark.slow), pytest.param(2, marks=pytest.mark.slow)]
+)
 def test_any_existing_file_is_refused_without_overwrite_and_nothing_is_written(which, tmp_path):
     out = tmp_path / "p.yaml"
     paths = three(out)
@@ -226,7 +229,10 @@ def test_a_write_that_fails_midway_leaves_nothing_behind(tmp_path, monkeypatch):
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize("what", ["link", "directory", "fifo", "stdout"])
+@pytest.mark.parametrize(
+    "what",
+    [pytest.param(w, marks=pytest.mark.slow) for w in ("link", "directory")] + ["fifo", "stdout"],
+)
 def test_links_folders_fifos_and_stdout_are_refused(what, tmp_path):
     out = tmp_path / "p.yaml"
     target = three(out)[1]  # the map YAML's place

@@ -209,8 +209,9 @@ def _cluttered(seed: int, robot_radius: float, n: int = 9, sizes=(5, 14)) -> dic
 
 @pytest.mark.parametrize(
     ("seed", "robot_radius", "n"),
-    [(1, 0.0, 9), (2, 1.5, 9), (3, 3.0, 9), (4, 0.5, 9), (5, 0.5, 40), (6, 1.0, 50)],
-)
+    [(1, 0.0, 9), (2, 1.5, 9), (3, 3.0, 9), (4, 0.5, 9), (5, 0.5, 40),
+     pytest.param(6, 1.0, 50, marks=pytest.mark.slow)],  # 2.5 s: the quick run has 40 obstacles
+)  # fmt: skip
 def test_agrees_with_brute_force_and_is_below_a_certified_grid_path(seed, robot_radius, n):
     """Few obstacles, and many (indexed world, tangents pruned by occlusion)."""
     size = (5, 14) if n < 20 else (1.5, 4)

@@ -23,6 +23,7 @@ def test_inputs_mix_files_globs_and_directories(folder, tmp_path):
     assert "no file matches" in errors[str(tmp_path / "*.none")]
 
 
+@pytest.mark.slow  # the optional Dask executor: a cluster of processes
 def test_dask_local_cluster_runs_the_same_batch(folder, tmp_path):
     distributed = pytest.importorskip("distributed")
     tasks = make_tasks([str(folder / "a_circle.yaml"), str(folder / "c_bad.yaml")], ["RRTConnect"],
@@ -48,6 +49,7 @@ def _cluster_batch(tasks, out):
         return run_batch(tasks, out, executor="dask", scheduler=client, optimum=False)
 
 
+@pytest.mark.slow  # the optional Dask executor: a cluster of processes
 def test_dask_process_workers_fork_warm_runs_with_the_same_paths(tmp_path):
     """Dask's worker processes are daemonic and run threads: each run is forked from a warm fork
     server instead, and its path is the one the local warm workers give for the same seed."""
@@ -200,3 +202,18 @@ def test_resuming_with_other_settings_runs_the_tasks_and_says_so(tmp_path):
     rows = run_batch([again], out, resume=True,
                      on_start=lambda n, skipped: seen.append((n, skipped)))  # fmt: skip
     assert seen == [(0, 1)] and len(rows) == 1
+
+
+def test_the_hold_hook_holds_only_at_a_fifo_and_never_writes_a_file(folder, tmp_path, monkeypatch):
+    """``RRTPSO_TEST_HOLD_BATCH`` naming a regular file or nothing at all: the batch runs to its
+    end and the file is as it was (the held batch itself: tests/cli/test_batch.py)."""
+    from rrtpso_ompl.harness.batch import HOLD_ENV
+
+    mine = tmp_path / "mine.txt"
+    mine.write_text("mine\n")
+    tasks = make_tasks([str(folder / "a_circle.yaml")], ["RRTConnect"], runs=2, time_limit=5.0)
+    for i, target in enumerate((mine, tmp_path / "absent")):
+        monkeypatch.setenv(HOLD_ENV, str(target))
+        rows = run_batch(tasks, tmp_path / f"r{i}.jsonl", optimum=False)
+        assert len(rows) == 2 and all(r.solved for r in rows)
+    assert mine.read_text() == "mine\n" and not (tmp_path / "absent").exists()

@@ -59,6 +59,7 @@ def test_property_mapping_takes_each_planner_s_own_figures():
     assert s.median_raw_ratio == pytest.approx(700 / 647.5)
 
 
+@pytest.mark.slow  # the optional Dask executor: a cluster of processes
 def test_dask_local_cluster_runs_a_bench(tmp_path):
     distributed = pytest.importorskip("distributed")
     problem = str(PROBLEMS / "static" / "single_circle.yaml")

@@ -542,7 +542,12 @@ def _gear(n: int, centre=(50.0, 50.0), r=(20.0, 23.0)) -> np.ndarray:
     return np.column_stack([centre[0] + rad * np.cos(ang), centre[1] + rad * np.sin(ang)])
 
 
-@pytest.mark.parametrize(("radius", "crowded"), [(0.0, 256), (1.0, 256), (1.0, 8)])
+@pytest.mark.parametrize(
+    ("radius", "crowded"),
+    # 3 s each, most of it the brute-force reference: the quick run keeps one.
+    [pytest.param(0.0, 256, marks=pytest.mark.slow), pytest.param(1.0, 256, marks=pytest.mark.slow),
+     (1.0, 8)],
+)  # fmt: skip
 def test_a_polygon_of_thousands_of_vertices_is_checked_edge_by_edge(radius, crowded, monkeypatch):
     """A detailed polygon is indexed as its edges and its interior: a check looks at the edges
     near it only, and the answers are those of brute force and of shapely, also for segments

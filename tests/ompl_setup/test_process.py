@@ -10,8 +10,10 @@ from helpers import PROBLEMS
 from rrtpso_ompl import load_problem, solve
 
 MAZE = PROBLEMS / "static" / "maze.yaml"
-#: Bounded by iterations under a time limit no run comes near: the clock never decides a path.
-BOUNDED = {"RRTstarPSO": {"rrt_max_iterations": 300, "iterations": 20}, "RRTConnect": {}}
+#: Bounded by iterations (and one swarm round) under a time limit no run comes near: the clock
+#: never decides a path.
+BOUNDED = {"RRTstarPSO": {"rrt_max_iterations": 300, "iterations": 20, "refine_rounds": 0,
+                          "polish_rounds": 0}, "RRTConnect": {}}  # fmt: skip
 
 
 def _path(planner: str, seed: int) -> list[list[float]]:

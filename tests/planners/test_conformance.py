@@ -108,10 +108,21 @@ class Line(ob.Planner):
 
 
 class Sleepy(Line):
-    """Ignores its termination condition: 0.3 s, whatever the budget."""
+    """Ignores its termination condition: 1.3 s, whatever the budget (more than the kit's
+    tolerance, ``1.5 x 0.05 s + 1 s``)."""
 
     def solve(self, ptc):
-        time.sleep(0.3)
+        time.sleep(1.3)
+        return super().solve(ptc)
+
+
+class Late(Line):
+    """Keeps its timed deadlines, but with a condition that has fired before it starts it does a
+    first long iteration (1.3 s) before it looks."""
+
+    def solve(self, ptc):
+        if ptc():
+            time.sleep(1.3)
         return super().solve(ptc)
 
 
@@ -157,6 +168,7 @@ def _entry(name, factory, **kw):
 
 LINE = _entry("Line", Line)
 SLEEPY = _entry("Sleepy", Sleepy)
+LATE = _entry("Late", Late)
 ONCE = _entry("OnceOnly", OnceOnly)
 RISING = _entry("Rising", Line, stats=lambda planner: RisingStats())
 SLOPPY = _entry("Sloppy", Sloppy, params=Sloppy.PARAMS)
@@ -171,8 +183,14 @@ def test_a_path_through_the_obstacle_is_caught():
 
 
 def test_a_planner_that_ignores_its_deadline_is_caught():
-    with pytest.raises(AssertionError, match=r"took 0\.3\d* s for a 0\.05 s budget \(allowed"):
+    with pytest.raises(AssertionError, match=r"solve\(\) took 1\.3\d* s for a 0\.05 s budget"):
         check_deadline(SLEEPY, problem=OPEN, budget=FAST)
+
+
+def test_a_planner_that_ignores_an_expired_condition_is_caught():
+    with pytest.raises(AssertionError, match=r"expired termination condition took 1\.3\d* s for "
+                                             r"a 0 s budget \(allowed 1\.000 s\)"):  # fmt: skip
+        check_deadline(LATE, problem=OPEN, budget=FAST)
 
 
 def test_a_planner_that_cannot_solve_after_clear_is_caught():

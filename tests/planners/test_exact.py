@@ -85,6 +85,7 @@ def test_refuses_a_users_own_validity_checker(caplog):
     assert "explicit geometry" in caplog.text and "validity checker" in caplog.text
 
 
+@pytest.mark.slow  # the rrtpso command end to end
 def test_bench_logs_its_rows(tmp_path):
     """``rrtpso bench --planner Exact``: Planner Arena rows with time and length, and the graph's
     size as run properties."""
