@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import RrtpsoError
 from ..model.problem import Problem
-from ..planners.params import Rule, declared, param
+from ..params import Rule, declared, param
 from ..validation import MAX_STEPS as _MAX_STEPS
 
 __all__ = [

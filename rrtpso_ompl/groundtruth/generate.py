@@ -32,8 +32,8 @@ path (:mod:`rrtpso_ompl.groundtruth.certify`); when the certificate fails the ob
 again from the same generator stream.
 
 **Options are declared once.** A kind is an option set: a class of
-:func:`~rrtpso_ompl.planners.params.param` fields made a frozen, keyword-only dataclass by
-:func:`~rrtpso_ompl.planners.params.declared`, extending :class:`GeneratorOptions` (the options
+:func:`~rrtpso_ompl.params.param` fields made a frozen, keyword-only dataclass by
+:func:`~rrtpso_ompl.params.declared`, extending :class:`GeneratorOptions` (the options
 every kind takes). Everything else is derived from the declarations: the checks of the values
 (one :class:`~rrtpso_ompl.errors.GenerationError` naming the option), the flags of ``rrtpso
 generate`` (:mod:`rrtpso_ompl.cli.generate`), the command line written into a generated file's
@@ -74,7 +74,7 @@ from ..errors import GenerationError, ParameterError, ProblemError, RrtpsoError
 from ..model.geometry import path_length
 from ..model.problem import problem_from_dict
 from ..model.problem_file import default_decimals, round_floats, write_problem
-from ..planners.params import ParamTable, Rule, declared, param
+from ..params import ParamTable, Rule, declared, param
 from ..validation import check_integer
 from .certify import GRID_POINTS, grid_path, is_solvable
 

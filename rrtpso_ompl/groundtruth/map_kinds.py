@@ -66,7 +66,7 @@ from ..model.problem_file import round_floats, write_problem
 from ..model.raster import Lattice
 from ..model.world import World
 from ..outputs import make_folders, publish, remove_folders
-from ..planners.params import Rule, declared, param
+from ..params import Rule, declared, param
 from .generate import GeneratorOptions, _round_up, generate_command, register_kind
 
 __all__ = [

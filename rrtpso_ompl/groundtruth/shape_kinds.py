@@ -23,7 +23,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import GenerationError
-from ..planners.params import Rule, declared, param
+from ..params import Rule, declared, param
 from .certify import GRID_POINTS
 from .generate import GeneratorOptions, register_kind
 

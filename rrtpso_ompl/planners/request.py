@@ -49,9 +49,9 @@ from ..errors import (
     shown,
 )
 from ..model.problem import PlannerConfig, Problem
+from ..params import ParamSpec, ParamTable
 from ..validation import check_seconds, check_seed, describe
-from .params import ParamSpec, ParamTable
-from .path_optimizer import PathOptimizerOptions
+from .pso.path_optimizer import PathOptimizerOptions
 from .registry import PlannerEntry, PlannerRegistry, default_registry
 
 __all__ = [

@@ -11,8 +11,8 @@ from rrtpso_ompl.groundtruth.generate import generate
 from rrtpso_ompl.model import World, load_problem, problem_from_dict
 from rrtpso_ompl.model.geometry import path_length, shortcut
 from rrtpso_ompl.planners import solve
-from rrtpso_ompl.planners.path_optimizer import PathOptimizerOptions, _refine, optimize_path
-from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSO
+from rrtpso_ompl.planners.pso.path_optimizer import PathOptimizerOptions, _refine, optimize_path
+from rrtpso_ompl.planners.rrtstar_pso.planner import RRTstarPSO
 
 
 def test_refinement_fires_for_a_point_robot():
@@ -95,7 +95,7 @@ def test_without_a_corridor_path_bitstar_finds_the_first_path_through_a_narrow_m
     from ompl import base as ob
 
     from rrtpso_ompl.ompl_setup import make_context, path_to_array, seed_ompl
-    from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSOStats
+    from rrtpso_ompl.planners.rrtstar_pso.planner import RRTstarPSOStats
 
     maze = _narrow_maze()
     seed_ompl(1)
@@ -128,7 +128,7 @@ def test_rrtstarpso_gives_its_swarm_the_rest_of_the_budget(monkeypatch):
     they pay: ``test_a_budget_is_used_by_further_rounds_while_they_pay``) and a deadline at the
     budget's end less the reserve for handing the path over, both from the planner's own start."""
     from rrtpso_ompl.planners import post
-    from rrtpso_ompl.planners.rrtstar_pso import FINISH_RESERVE
+    from rrtpso_ompl.planners.rrtstar_pso.planner import FINISH_RESERVE
 
     calls = []
     original = post.PSOPathOptimizer.optimize_array

@@ -24,8 +24,8 @@ from typing import Any
 import numpy as np
 from scipy.sparse.csgraph import dijkstra
 
-from ..model.objective import InflationCost
-from ..model.raster import Lattice
+from ...model.objective import InflationCost
+from ...model.raster import Lattice
 from .corridor import _entry, _walk, band, lattice_graph
 
 __all__ = [

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .params import Rule, declared, param
+from ...params import Rule, declared, param
 
 __all__ = ["SWARM_PARAMS", "PSOOptions", "PSOResult", "minimize"]
 

@@ -1,6 +1,6 @@
 """RRTstarPSO: OMPL's RRT* followed by the particle swarm over its waypoints (the paper's RRT*PSO).
 
-0. The corridor stage (:mod:`rrtpso_ompl.planners.corridor`) looks at every way round the
+0. The corridor stage (:mod:`.corridor`) looks at every way round the
    obstacles at once, on a lattice of the free space, and pulls the best route taut: a first
    path in milliseconds, in the right corridor, also through mazes that RRT*'s tree would not
    cross in time.
@@ -36,10 +36,11 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from ..model.geometry import path_length, shortcut
-from ..model.world import World
-from ..ompl_setup import array_to_path, path_to_array
-from .base import (
+from ...model.geometry import path_length, shortcut
+from ...model.world import World
+from ...ompl_setup import array_to_path, path_to_array
+from ...params import ParamSpec, ParamTable
+from ..base import (
     BUDGET,
     SEED,
     PlannerStats,
@@ -48,14 +49,13 @@ from .base import (
     collision_model_for,
     refusing_motions_after,
 )
+from ..baselines.ompl_planners import RRTSTAR_PARAMS
+from ..post import PSOPathOptimizer, inflation_of, simplify_until
+from ..pso.path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
+from ..pso.swarm import SWARM_PARAMS
+from ..result import BenchmarkRun
 from .corridor import search
 from .costroute import cost_route
-from .ompl_planners import RRTSTAR_PARAMS
-from .params import ParamSpec, ParamTable
-from .path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
-from .post import PSOPathOptimizer, inflation_of, simplify_until
-from .result import BenchmarkRun
-from .swarm import SWARM_PARAMS
 
 #: The RRT* parameters RRTstarPSO passes on to its inner og.RRTstar.
 _INNER = ("range", "goal_bias", "rewire_factor", "informed_sampling", "tree_pruning")
@@ -126,7 +126,7 @@ class RRTstarPSOStats(PlannerStats):
     describe the corridor stage (``corridor_cells``: its lattice's cells; ``corridor_reason``:
     why it has no path);
     ``costroute_time`` the re-routing of the best candidate through the cheapest cells under an
-    inflation cost (:mod:`~rrtpso_ompl.planners.costroute`; its path is a candidate,
+    inflation cost (:mod:`~rrtpso_ompl.planners.rrtstar_pso.costroute`; its path is a candidate,
     ``"costroute"``).
     ``range_used`` is the inner RRT*'s range, the one chosen for the world when the ``range``
     parameter is 0 (the parameter itself stays as the user set it).
@@ -332,7 +332,7 @@ class RRTstarPSO(PythonPlanner):
         return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
 
     def _corridor(self, ptc, t0: float, stats: RRTstarPSOStats) -> np.ndarray | None:
-        """Stage 0: the corridor stage's path (:func:`~rrtpso_ompl.planners.corridor.search`
+        """Stage 0: the corridor stage's path (:func:`.corridor.search`
         within ``corridor_fraction`` of the budget; with no route at all, up to
         :data:`_CORRIDOR_NO_ROUTE_SHARE` of it), or None."""
         v = self._values

@@ -40,9 +40,9 @@ from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from ..model.geometry import path_length, shortcut
-from ..model.raster import Lattice
-from ..model.world import MarkingStopped
+from ...model.geometry import path_length, shortcut
+from ...model.raster import Lattice
+from ...model.world import MarkingStopped
 
 #: Lattice cells the corridor stage builds, searches and funnels per second, on the safe side
 #: (measured on the reference machine: 2-3 million on maps, fewer among many shapes).

@@ -31,7 +31,7 @@ Stages, each optional:
 2. *PSO* over the interior waypoints, seeded around the current path: one swarm over all of
    them (the paper's), or, on longer paths, one small swarm per window of ``window``
    consecutive waypoints (a fixed waypoint between two windows makes their costs independent,
-   so every window keeps a best of its own, :func:`~rrtpso_ompl.planners.swarm.minimize` with
+   so every window keeps a best of its own, :func:`~rrtpso_ompl.planners.pso.swarm.minimize` with
    ``blocks``); the windows shift from round to round so that every waypoint moves;
 3. *refine*: where a segment runs along an obstacle (a polyline can only approximate an arc by its
    chords' tangents), insert mid-points and run the swarm again, up to ``max_waypoints``;
@@ -52,11 +52,11 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..model.geometry import path_length, shortcut, turning_angles
-from ..model.objective import ClearanceField, InflationCost
-from ..model.world import World
+from ...model.geometry import path_length, shortcut, turning_angles
+from ...model.objective import ClearanceField, InflationCost
+from ...model.world import World
+from ...params import declared, param
 from . import swarm as pso
-from .params import declared, param
 from .swarm import SWARM_PARAMS, PSOOptions
 
 __all__ = [
@@ -460,7 +460,7 @@ def _window_round(
     deadline: float | None = None,
 ) -> tuple[np.ndarray, pso.PSOResult]:
     """One round of a small swarm per window of ``options.window`` waypoints, all windows in one
-    array operation (:func:`~rrtpso_ompl.planners.swarm.minimize` with ``blocks``).
+    array operation (:func:`~rrtpso_ompl.planners.pso.swarm.minimize` with ``blocks``).
 
     Window ``k`` is the chain ``fixed, q_1 .. q_W, fixed``; a short window's empty slots are
     pinned to its closing fixed waypoint (zero-length segments, no cost). Its cost is the
