@@ -56,6 +56,7 @@ from ..pso.swarm import SWARM_PARAMS
 from ..result import BenchmarkRun
 from .corridor import search
 from .costroute import cost_route
+from .rrtstar_stage import INFLATION_RRT_MIN, INFLATION_RRT_SHARE, grow_rrtstar
 
 #: The RRT* parameters RRTstarPSO passes on to its inner og.RRTstar.
 _INNER = ("range", "goal_bias", "rewire_factor", "informed_sampling", "tree_pruning")
@@ -209,11 +210,6 @@ _CORRIDOR_NO_ROUTE_SHARE = 0.5
 #: Share of the budget kept back for handing the path over (the last checks, OMPL's path): the
 #: stages aim to be done by the rest.
 FINISH_RESERVE = 0.03
-
-#: RRT*'s share of the budget under an inflation cost when the corridor stage has a path.
-INFLATION_RRT_SHARE = 0.1
-#: ... and none when that share is under this many seconds (:meth:`RRTstarPSO._rrt_futile`).
-INFLATION_RRT_MIN = 0.05
 
 #: RRT*'s automatic range is at most this many times the median clearance of free points.
 RANGE_PER_CLEARANCE = 10.0
@@ -546,50 +542,14 @@ class RRTstarPSO(PythonPlanner):
     def _resumable(self, t0: float, ptc) -> bool:
         """Whether the anytime loop may grow RRT* again: a time budget with time left that the
         swarm did not use, and no iteration cap (which keeps runs reproducible)."""
-        v = self._values
-        if v["budget"] <= 0 or v["stall_fraction"] <= 0 or v["rrt_max_iterations"] > 0:
+        budget = self._values["budget"]
+        if budget <= 0 or self._values["stall_fraction"] <= 0:
             return False
-        if self._inflation is not None and INFLATION_RRT_SHARE * v["budget"] < INFLATION_RRT_MIN:
+        if self._values["rrt_max_iterations"] > 0:
+            return False
+        if self._inflation is not None and INFLATION_RRT_SHARE * budget < INFLATION_RRT_MIN:
             return False  # RRT* cannot help in what is left (:meth:`_rrt_futile`)
-        return not ptc() and time.perf_counter() < t0 + 0.98 * v["budget"]
-
-    def _has_exact(self) -> bool:
-        pdef = self.getProblemDefinition()
-        return pdef.hasSolution() and not pdef.hasApproximateSolution()
-
-    def _stalled(
-        self, progress: list[tuple[float, float]], elapsed: float, budget: float, since: float
-    ) -> bool:
-        """Whether RRT*'s best cost fell by less than 0.1 % over the last ``stall_fraction`` of
-        the budget (relative, so the same on every scale), looking no further back than
-        ``since`` (seconds into the solve)."""
-        window = self._values["stall_fraction"] * budget
-        if window <= 0 or not progress or elapsed < max(progress[0][0], since) + window:
-            return False
-        then = [c for t, c in progress if t <= elapsed - window]
-        if not then:
-            return False
-        now = progress[-1][1]
-        return then[-1] - now <= 1e-3 * now
-
-    def _connect(self, ptc, end: float, stats: RRTstarPSOStats) -> None:
-        """OMPL's BIT* on the same problem until ``end`` or its first path: through narrow
-        passages that RRT*'s single tree has not crossed yet.
-
-        Measured on narrow unique-solution mazes (point robot, corridors 1-2 % of the width):
-        RRTConnect found no path in 4 s where BIT*, whose batches of samples are searched as a
-        graph, found one in under a second (docs/benchmarking.md).
-        """
-        pdef = self.getProblemDefinition()
-        pdef.clearSolutionPaths()  # RRT*'s approximate path, if any
-        connect = og.BITstar(self.getSpaceInformation())
-        connect.setStopOnSolnImprovement(True)  # the first path is all it is asked for
-        connect.setProblemDefinition(pdef)
-        connect.setup()
-        left = max(end - time.perf_counter(), 1e-4)
-        connect.solve(ob.plannerOrTerminationCondition(
-            ptc, ob.timedPlannerTerminationCondition(left)))  # fmt: skip
-        stats.first_solution = "BITstar"
+        return not ptc() and time.perf_counter() < t0 + 0.98 * budget
 
     def _rrt_futile(self, corridor) -> bool:
         """Under an inflation cost with the corridor stage's path in hand, RRT* is left out when
@@ -608,64 +568,8 @@ class RRTstarPSO(PythonPlanner):
         resume: bool = False,
         fallback: bool = True,
     ) -> None:
-        """Grow RRT* until its share of the budget, its iteration cap or the outer condition, or
-        until its best cost stalls (the swarm gets the rest); with no path at ``connect_after``
-        of its share (and ``fallback``: no corridor path either), BIT* looks for the first one.
-        ``resume`` grows the tree on after a swarm run, for at most 70 % of the time left.
-
-        The tree is grown in short slices (repeated ``solve`` calls continue the same tree) so that
-        the best cost can be sampled over time: OMPL's progress properties are not reachable from
-        Python.
-        """
-        values = self._values
-        budget = values["budget"]
-        t_begin = time.perf_counter()
-        # RRT*'s share of what the corridor stage left.
-        share = values["rrt_time_fraction"]
-        if self._inflation is not None and not fallback:
-            # With the corridor's path in hand and every motion's cost a Python call (10-30
-            # times fewer vertices a second), the cost route and the swarm make better use of it.
-            share = min(share, INFLATION_RRT_SHARE)
-        rrt_end = t_begin + share * max(t0 + budget - t_begin, 0.0) if budget > 0 else None
-        if resume:  # grown on after a swarm run: until a stall again, or 70 % of what is left
-            rrt_end = t_begin + 0.7 * max(t0 + budget - t_begin, 0.0)
-        max_iter = values["rrt_max_iterations"]
-        start_iter = self.inner.numIterations()
-        inner_cost = self.inner.bestCost
-
-        if max_iter > 0:
-            # Iteration-bounded: one call with a Python condition that RRT* polls once per
-            # iteration (no period, so no checker thread and no GIL deadlock).
-            def stop() -> bool:
-                return (
-                    self.inner.numIterations() - start_iter >= max_iter
-                    or ptc()
-                    or (rrt_end is not None and time.perf_counter() >= rrt_end)
-                )
-
-            self.inner.solve(ob.PlannerTerminationCondition(stop))
-        else:
-            slice_s = 0.05 if budget <= 0 else max(0.01, values["rrt_time_fraction"] * budget / 20)
-            connect_at = None
-            if rrt_end is not None and values["connect_after"] < 1.0 and not resume:
-                connect_at = t_begin + values["connect_after"] * (rrt_end - t_begin)
-            while not ptc():
-                now = time.perf_counter()
-                if rrt_end is not None and now >= rrt_end:
-                    break
-                if connect_at is not None and now >= connect_at and not self._has_exact():
-                    if fallback:
-                        self._connect(ptc, rrt_end, stats)
-                    break  # with the corridor's path in hand, the swarm gets the time instead
-                if self._stalled(stats.rrt_progress, now - t0, budget, t_begin - t0):
-                    break
-                step = slice_s if rrt_end is None else min(slice_s, rrt_end - now)
-                sub = ob.plannerOrTerminationCondition(
-                    ptc, ob.timedPlannerTerminationCondition(max(step, 1e-4))
-                )
-                self.inner.solve(sub)
-                cost = inner_cost().value()
-                if np.isfinite(cost):
-                    stats.rrt_progress.append((time.perf_counter() - t0, float(cost)))
-        stats.rrt_time += time.perf_counter() - t_begin
-        stats.rrt_iterations += self.inner.numIterations() - start_iter
+        """Stage 1: :func:`.rrtstar_stage.grow_rrtstar` on this planner's inner RRT*."""
+        grow_rrtstar(
+            self.inner, self.getProblemDefinition(), self._values, ptc, t0, stats,
+            inflation=self._inflation is not None, resume=resume, fallback=fallback,
+        )  # fmt: skip
