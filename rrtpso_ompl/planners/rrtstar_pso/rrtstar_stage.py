@@ -49,10 +49,8 @@ def grow_rrtstar(
 
     Parameters
     ----------
-    inner : og.RRTstar
-        The planner's RRT*, set up on ``pdef``.
-    pdef : ob.ProblemDefinition
-        The problem both RRT* and BIT* solve.
+    inner, pdef : og.RRTstar, ob.ProblemDefinition
+        The planner's RRT*, set up on ``pdef``, the problem BIT* solves too.
     values : mapping
         RRTstarPSO's parameter values (``budget`` in seconds, ``rrt_time_fraction``,
         ``rrt_max_iterations``, ``connect_after``, ``stall_fraction``).
