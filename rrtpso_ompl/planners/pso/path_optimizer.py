@@ -450,6 +450,37 @@ def _window_boxes(seed_path: np.ndarray, world, options: PathOptimizerOptions, o
     return win, slot_idx, lo, hi, before, after, seg_len, violation
 
 
+def _window_terms(cost_model: PathCost, before, after, violation, n_win: int, width: int):
+    """The swarm's cost terms of :func:`_window_round`: ``terms(x)`` gives, per particle and
+    window, the chain's length (plus smoothness and inflation) and its collision violation.
+
+    Window ``k`` is the chain ``before[k], q_1 .. q_W, after[k]`` (``x`` holds the ``q``)."""
+
+    def chains(x: np.ndarray) -> np.ndarray:
+        n = x.shape[0]
+        mid = x.reshape(n, n_win, width, 2)
+        a = np.broadcast_to(before[None, :, None], (n, n_win, 1, 2))
+        b = np.broadcast_to(after[None, :, None], (n, n_win, 1, 2))
+        return np.concatenate([a, mid, b], axis=2)
+
+    def terms(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        ch = chains(x)
+        seg = np.diff(ch, axis=2)
+        length = np.sqrt(np.einsum("pksi,pksi->pks", seg, seg)).sum(axis=2)
+        if cost_model.smoothness_weight > 0:
+            # Turning at the moving waypoints; the turn at a fixed waypoint depends on two
+            # windows and is left out, so that the windows' costs stay independent.
+            length = length + cost_model.smoothness_weight * (
+                turning_angles(ch) ** 2).sum(axis=2)  # fmt: skip
+        if cost_model.objective is not None:
+            length = length + cost_model.inflation(ch[:, :, :-1], ch[:, :, 1:]).sum(axis=2)
+        n = ch.shape[0]
+        v = violation(ch[:, :, :-1].reshape(n, -1, 2), ch[:, :, 1:].reshape(n, -1, 2))
+        return length, v.reshape(n, n_win, width + 1).sum(axis=2)
+
+    return terms
+
+
 def _window_round(
     seed_path: np.ndarray,
     cost_model: PathCost,
@@ -478,29 +509,7 @@ def _window_round(
         return seed_path, _unstarted(x0, _cost_of(cost_model, seed_path), time.perf_counter())
     real = win >= 0
     n_win = len(win)
-
-    def chains(x: np.ndarray) -> np.ndarray:
-        n = x.shape[0]
-        mid = x.reshape(n, n_win, width, 2)
-        a = np.broadcast_to(before[None, :, None], (n, n_win, 1, 2))
-        b = np.broadcast_to(after[None, :, None], (n, n_win, 1, 2))
-        return np.concatenate([a, mid, b], axis=2)
-
-    def terms(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        ch = chains(x)
-        seg = np.diff(ch, axis=2)
-        length = np.sqrt(np.einsum("pksi,pksi->pks", seg, seg)).sum(axis=2)
-        if cost_model.smoothness_weight > 0:
-            # Turning at the moving waypoints; the turn at a fixed waypoint depends on two
-            # windows and is left out, so that the windows' costs stay independent.
-            length = length + cost_model.smoothness_weight * (
-                turning_angles(ch) ** 2).sum(axis=2)  # fmt: skip
-        if cost_model.objective is not None:
-            length = length + cost_model.inflation(ch[:, :, :-1], ch[:, :, 1:]).sum(axis=2)
-        n = ch.shape[0]
-        v = violation(ch[:, :, :-1].reshape(n, -1, 2), ch[:, :, 1:].reshape(n, -1, 2))
-        return length, v.reshape(n, n_win, width + 1).sum(axis=2)
-
+    terms = _window_terms(cost_model, before, after, violation, n_win, width)
     x0 = seed_path[slot_idx].reshape(-1)
     local = np.minimum(seg_len[:-1], seg_len[1:])
     spread = np.where(real, options.init_spread * np.maximum(local[np.maximum(win - 1, 0)],
