@@ -409,15 +409,11 @@ def unsupported_space(si_or_space: Any) -> str | None:
     space = _space_of(si_or_space)
     if isinstance(space, ob.SE2StateSpace):
         return None
-    if isinstance(space, ob.RealVectorStateSpace):
-        n = int(space.getDimension())
-        if 1 <= n <= MAX_DIMENSION:
-            return None
-        what = f"a real vector space of {n} dimensions (at most {MAX_DIMENSION})"
-    else:
-        what = "not one of them"
-    return (f"the state space {describe_space(space)} is {what}: this package's swarm reads "
-            f"{', '.join(SUPPORTED_SPACES)}")  # fmt: skip
+    if isinstance(space, ob.RealVectorStateSpace) and 1 <= space.getDimension() <= MAX_DIMENSION:
+        return None
+    return (f"the state space {describe_space(space)} is none of those this package's planners "
+            f"plan in: ob.RealVectorStateSpace(n) for n = 1..{MAX_DIMENSION}, "
+            f"{', '.join(SUPPORTED_SPACES[1:])}")  # fmt: skip
 
 
 def space_adapter(si_or_space: Any, who: str = "") -> SpaceAdapter:

@@ -31,9 +31,11 @@ from ..model.geometry import path_length as path_length_of
 from ..model.objective import InflationCost
 from ..ompl_setup import InflationObjective, assign_path, path_to_array
 from ..ompl_setup.objective import path_cost
-from ..ompl_setup.space import require_plane_space
+from ..ompl_setup.space import plane_space_problem
+from ..ompl_setup.spaces import space_adapter
 from .base import SpaceInformationCollisionModel, collision_model_for, refusing_motions_after
 from .pso.path_optimizer import PathOptimizationResult, PathOptimizerOptions, optimize_path
+from .pso.space_path import optimize_ompl_path, optimize_space_path
 from .request import POST_PARAMS, POST_STEPS, parse_steps, split_spec
 
 __all__ = [
@@ -86,8 +88,10 @@ class PSOPathOptimizer:
     Parameters
     ----------
     si : ompl.base.SpaceInformation
-        A 2-D real vector space (``ob.RealVectorStateSpace(2)``) with the user's validity checker
-        (and motion validator).
+        The user's validity checker (and motion validator) over ``ob.RealVectorStateSpace(2)``;
+        or over R^n, SE(2), Dubins or Reeds-Shepp, where the swarm of
+        :mod:`~rrtpso_ompl.planners.pso.space_path` lowers the space's own length and checks
+        every path it keeps with ``si.checkMotion`` (docs/spaces.md).
     options : PathOptimizerOptions, optional
         The swarm's and the optimiser's parameters (defaults when omitted); or pass them by name
         in ``params``.
@@ -106,9 +110,9 @@ class PSOPathOptimizer:
     Raises
     ------
     UnsupportedSpaceError
-        When ``si``'s space is not ``ob.RealVectorStateSpace(2)`` (SE(2), Dubins, ``R^3``, ...):
-        the swarm moves waypoints in the plane, so it refuses here, at construction, rather than
-        hand back a path of the wrong space. OMPL's ``og.PathSimplifier`` works in any space.
+        When ``si``'s space is none of those (SE(3), SO(2), a compound space, ...): it refuses
+        here, at construction, naming the space, rather than hand back a path of the wrong
+        space. OMPL's ``og.PathSimplifier`` works in any space.
 
     Examples
     --------
@@ -129,11 +133,16 @@ class PSOPathOptimizer:
     ) -> None:
         if options is not None and params:
             raise TypeError("give the options or parameters by name, not both")
-        require_plane_space(si, "PSOPathOptimizer")
+        # Outside the plane: R^n, SE(2), Dubins, Reeds-Shepp through the space information
+        # (:mod:`.pso.space_path`); any other space is refused here, naming it.
+        plane = plane_space_problem(si) is None
+        self.space = None if plane else space_adapter(si, "PSOPathOptimizer")
         self.si = si
         self.options = options or PathOptimizerOptions()
         self.set_params(**params)
-        self.model = world if world is not None else collision_model_for(si)
+        if world is None and self.space is None:
+            world = collision_model_for(si)
+        self.model = world
         if rng is None:
             rng = np.random.default_rng(ou.RNG().uniformInt(0, 2**31 - 2))
         self.rng = rng
@@ -181,6 +190,17 @@ class PSOPathOptimizer:
         deadline = None
         if isinstance(ptc_or_seconds, int | float):
             deadline = time.perf_counter() + float(ptc_or_seconds)
+        if self.space is not None:
+            self.last_result = optimize_ompl_path(
+                self.si,
+                self.space,
+                path,
+                self.options,
+                self.rng,
+                _terminator(ptc_or_seconds, deadline),
+                deadline,
+            )
+            return self.last_result.improved
         result = self.optimize_array(
             path_to_array(path), _terminator(ptc_or_seconds, deadline), deadline
         )
@@ -206,6 +226,10 @@ class PSOPathOptimizer:
         """
         model, options = self.model, self.options
         self.skipped = ""
+        if self.space is not None:  # rows of the space (n, dim): :mod:`.pso.space_path`
+            self.last_result = optimize_space_path(xy, self.space, self.si, options, self.rng,
+                                                   terminate, deadline)  # fmt: skip
+            return self.last_result
         if isinstance(model, SpaceInformationCollisionModel) and deadline is not None:
             options, reserve = self._size(xy, deadline)
             if options is None:
@@ -300,7 +324,8 @@ def run_post(
     the swarm gets the rest. ``values`` holds the swarm's and :data:`POST_PARAMS`' parameters by
     name (defaults for the missing ones). With the problem's ``objective`` (an OMPL objective)
     no step raises its cost: a step that did is undone. ``simplify`` works in any state space;
-    ``pso`` only in the plane (:class:`PSOPathOptimizer` raises ``UnsupportedSpaceError``).
+    ``pso`` in the plane, R^n, SE(2), Dubins and Reeds-Shepp (elsewhere :class:`PSOPathOptimizer`
+    raises ``UnsupportedSpaceError``).
     """
     steps = tuple(steps)
     values = dict(values or {})

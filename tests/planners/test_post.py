@@ -158,21 +158,22 @@ def _poses(path):
 DETOUR = [(1.0, 1.0, 0.0), (5.0, 8.0, 0.5), (9.0, 1.0, 0.0)]
 
 
-def test_the_optimizer_refuses_a_space_other_than_the_plane_at_construction():
-    """The swarm moves waypoints in the plane: given SE(2) (or R^3) it says so at once, instead
-    of reading two coordinates of each state (issue 32)."""
-    si, path = _se2_path(DETOUR)
+def test_the_optimizer_refuses_a_space_it_does_not_read_at_construction():
+    """The swarm reads the plane, R^n, SE(2), Dubins and Reeds-Shepp (issue 35): given SE(3) or
+    SO(2) it says so at once, instead of reading two coordinates of each state (issue 32)."""
+    space = ob.SE3StateSpace()
+    bounds = ob.RealVectorBounds(3)
+    bounds.setLow(0.0)
+    bounds.setHigh(1.0)
+    space.setBounds(bounds)
     with pytest.raises(
         UnsupportedSpaceError,
-        match=r"^PSOPathOptimizer: the state space .*"
-        r"\(ob\.SE2StateSpace, 3 dimensions\) is not ob\.RealVectorStateSpace\(2\)",
+        match=r"^PSOPathOptimizer: the state space .*\(ob\.SE3StateSpace, 6 dimensions\) is "
+        r"none of those",
     ):
-        PSOPathOptimizer(si)
-    assert _poses(path) == DETOUR
-    space = ob.RealVectorStateSpace(3)
-    space.setBounds(0.0, 1.0)
-    with pytest.raises(UnsupportedSpaceError, match=r"RealVectorStateSpace\(3\)"):
-        PSOPathOptimizer(ob.SpaceInformation(space), rng=np.random.default_rng(0))
+        PSOPathOptimizer(ob.SpaceInformation(space))
+    with pytest.raises(UnsupportedSpaceError, match=r"\(ob\.SO2StateSpace, 1 dimension\)"):
+        PSOPathOptimizer(ob.SpaceInformation(ob.SO2StateSpace()), rng=np.random.default_rng(0))
 
 
 class LongerIsCheaper(ob.OptimizationObjective):
@@ -189,9 +190,9 @@ class LongerIsCheaper(ob.OptimizationObjective):
         return ob.Cost(-self.si.distance(a, b))
 
 
-def test_the_simplify_post_pass_works_in_any_space_and_the_swarm_refuses_there():
+def test_the_simplify_post_pass_works_in_any_space_and_the_swarm_in_se2():
     """``run_post``: OMPL's simplifier in SE(2) (a step that raises the objective is undone, its
-    states put back as they were), and the swarm refused before it touches the path."""
+    states put back as they were), and the swarm (issue 35) leaves a single motion as it is."""
     si, path = _se2_path(DETOUR)
     (step,) = run_post(si, path, ["simplify"], time.perf_counter() + 1.0,
                        objective=LongerIsCheaper(si))  # fmt: skip
@@ -199,9 +200,8 @@ def test_the_simplify_post_pass_works_in_any_space_and_the_swarm_refuses_there()
     assert step.cost_after == step.cost_before
     (step,) = run_post(si, path, ["simplify"], time.perf_counter() + 1.0)
     assert _poses(path) == [DETOUR[0], DETOUR[-1]] and step.length_after < step.length_before
-    with pytest.raises(UnsupportedSpaceError, match="PSOPathOptimizer"):
-        run_post(si, path, ["pso"], time.perf_counter() + 1.0)
-    assert _poses(path) == [DETOUR[0], DETOUR[-1]]
+    (step,) = run_post(si, path, ["pso"], time.perf_counter() + 1.0)
+    assert _poses(path) == [DETOUR[0], DETOUR[-1]] and step.length_after == step.length_before
 
 
 def test_an_undone_simplify_step_puts_a_plane_path_back_exactly():

@@ -56,6 +56,7 @@ from ..pso.swarm import SWARM_PARAMS
 from ..result import BenchmarkRun
 from .corridor import search
 from .costroute import cost_route
+from .general import solve_in_space, space_of_planner
 from .rrtstar_stage import INFLATION_RRT_MIN, INFLATION_RRT_SHARE, grow_rrtstar
 
 #: The RRT* parameters RRTstarPSO passes on to its inner og.RRTstar.
@@ -242,7 +243,9 @@ class RRTstarPSO(PythonPlanner):
     Parameters
     ----------
     si : ompl.base.SpaceInformation
-        A 2-D real vector space (``ob.RealVectorStateSpace(2)``): in any other space the planner
+        A 2-D real vector space (``ob.RealVectorStateSpace(2)``); or R^n, SE(2), Dubins or
+        Reeds-Shepp, where RRT*, OMPL's simplifier and the swarm run through the space
+        information (:mod:`.general`, docs/spaces.md). In any other space the planner
         refuses, saying why (``planner.unsupported``, logged; ``solve`` returns ``ABORT``). When
         its validity checker carries a ``world`` (as built by
         :func:`rrtpso_ompl.ompl_setup.make_context`), candidate paths are checked in vectorised
@@ -257,6 +260,11 @@ class RRTstarPSO(PythonPlanner):
 
     def __init__(self, si: ob.SpaceInformation, name: str = "RRTstarPSO", **params: Any) -> None:
         super().__init__(si, name, **params)
+        # Outside the plane: R^n, SE(2), Dubins and Reeds-Shepp through the space information
+        # (:mod:`.general`); any other space is refused, naming it.
+        self._space = None
+        if self.unsupported is not None:
+            self._space, self.unsupported = space_of_planner(si, name)
         self.inner = og.RRTstar(si)
         self._inner_ready = False
         self._inflation = None  # the problem's inflation cost, read from the objective in solve
@@ -269,6 +277,9 @@ class RRTstarPSO(PythonPlanner):
         for name in _INNER:
             getattr(self.inner, self.PARAMS[name].setter)(self._values[name])
         self.inner.setup()
+        if self._space is not None:
+            self._inner_ready = True
+            return  # no world, no plane stages: the space information does every check
         # Our exact world, or the user's checker behind a fine-sampling model whose measured
         # cost sizes the swarm (one model per planner, so the measurements carry over).
         self._model = collision_model_for(self.getSpaceInformation())
@@ -295,6 +306,8 @@ class RRTstarPSO(PythonPlanner):
         t0 = time.perf_counter()
         if not self._inner_ready:
             self.setup()
+        if self._space is not None:
+            return solve_in_space(self, self._space, ptc, t0, self._rng())
         pdef = self.getProblemDefinition()
         stats = RRTstarPSOStats(range_used=self.inner.getRange())  # the one chosen when 0
         self.last_stats = stats
