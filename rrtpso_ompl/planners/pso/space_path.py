@@ -15,7 +15,10 @@ is a Python callback per state, far too slow for every particle of every iterati
   :data:`CHECKED_PER_EVALUATION` of them per evaluation (each costs one ``checkMotion`` per
   segment, stopping at the first blocked one), so ``checkMotion`` runs a bounded number of
   times per iteration; a blocked candidate is ``inf`` too. Every particle's best and the swarm's
-  best are therefore checked paths (the seed, particle 0, is the input);
+  best are therefore checked paths (the seed, particle 0, is the input). A candidate that
+  would become the swarm's best is also checked between ``checkMotion``'s states
+  (:class:`MotionChecker`: a shortened path hugs obstacles, in the gaps of a coarse check);
+  a particle's own best only guides the swarm, ``checkMotion`` suffices for it;
 * the result is checked once more, segment by segment, and returned only when strictly shorter
   than the input; else the input comes back unchanged.
 
@@ -46,12 +49,15 @@ from .swarm import PSOOptions
 
 __all__ = [
     "CHECKED_PER_EVALUATION",
+    "FINER",
     "MotionChecker",
     "SpacePathResult",
     "optimize_ompl_path",
     "optimize_space_path",
 ]
 
+#: Motions are checked at this many times the space's validity-checking resolution.
+FINER = 10
 #: Candidates checked with ``checkMotion`` per evaluation of the swarm, at most (the shortest of
 #: those that would improve their particle's best).
 CHECKED_PER_EVALUATION = 8
@@ -103,7 +109,16 @@ class SpacePathResult:
 
 
 class MotionChecker:
-    """``si.checkMotion`` over rows: the space's interpolation and the user's checker.
+    """A motion of rows checked by ``si.checkMotion`` (the space's interpolation and the user's
+    checker, or the user's motion validator), then at :data:`FINER` times its resolution.
+
+    OMPL's discrete check samples a motion at the space's resolution; a swarm that shortens a
+    path looks for exactly the gaps between those samples (a tight motion past an obstacle
+    cuts its corner between two of them), so the states in between are checked too, as the
+    plane's :class:`~rrtpso_ompl.planners.base.SpaceInformationCollisionModel` does. Not exact
+    (nothing is with a point checker): a motion may still cut into an obstacle between the
+    finer samples, by at most ``(h / FINER)^2 / (8 r)`` for a disc of radius ``r`` and a
+    resolution ``h``.
 
     Parameters
     ----------
@@ -114,29 +129,46 @@ class MotionChecker:
     Attributes
     ----------
     calls : int
-        ``checkMotion`` calls made.
+        Motions checked (one ``checkMotion`` each).
     """
 
     def __init__(self, si: ob.SpaceInformation, adapter: SpaceAdapter) -> None:
         self.si = si
         self.adapter = adapter
+        self.space = si.getStateSpace()
         self.calls = 0
         self._a = si.allocState()  # Python's to free (never freeState)
         self._b = si.allocState()
+        self._s = si.allocState()
 
-    def motion_free(self, a: np.ndarray, b: np.ndarray) -> bool:
-        """Whether the motion from row ``a`` to row ``b`` is valid."""
-        self.adapter.assign(self._a, a)
-        self.adapter.assign(self._b, b)
+    def motion_free(self, a: np.ndarray, b: np.ndarray, fine: bool = True) -> bool:
+        """Whether the motion from row ``a`` to row ``b`` is valid (``fine``: also at
+        :data:`FINER` times the resolution)."""
+        sa, sb, s = self._a, self._b, self._s
+        self.adapter.assign(sa, a)
+        self.adapter.assign(sb, b)
         self.calls += 1
-        return bool(self.si.checkMotion(self._a, self._b))
+        if not self.si.checkMotion(sa, sb):
+            return False
+        if not fine:
+            return True
+        n = FINER * max(int(self.space.validSegmentCount(sa, sb)), 1)
+        interpolate, valid = self.space.interpolate, self.si.isValid
+        for k in range(1, n):
+            if k % FINER == 0:
+                continue  # a state checkMotion looked at
+            interpolate(sa, sb, k / n, s)
+            if not valid(s):
+                return False
+        return True
 
-    def path_free(self, rows: np.ndarray, stop: Callable[[], bool] | None = None) -> bool | None:
+    def path_free(self, rows: np.ndarray, stop: Callable[[], bool] | None = None,
+                  fine: bool = True) -> bool | None:  # fmt: skip
         """Whether every motion of the path is valid; None when ``stop`` fired first."""
         for k in range(len(rows) - 1):
             if stop is not None and stop():
                 return None
-            if not self.motion_free(rows[k], rows[k + 1]):
+            if not self.motion_free(rows[k], rows[k + 1], fine):
                 return False
         return True
 
@@ -317,6 +349,7 @@ class _CheckedLength:
         self.k = len(rows) - 2
         self.seed_length = adapter.length(rows)
         self.known = np.full(n, np.inf)  # each particle's best checked length
+        self.best = self.seed_length  # the swarm's best (checked finely)
         self.seen = 0  # rows of the first evaluation seen so far
 
     def path_of(self, x: np.ndarray) -> np.ndarray:
@@ -345,13 +378,16 @@ class _CheckedLength:
             target = np.full(p, self.seed_length)
         hopeful = np.flatnonzero(length < target * (1.0 - _RELATIVE_GAIN))
         for j in hopeful[np.argsort(length[hopeful], kind="stable")][:CHECKED_PER_EVALUATION]:
-            free = self.checker.path_free(paths[j], self.stop)
+            fine = bool(length[j] < self.best * (1.0 - _RELATIVE_GAIN))
+            free = self.checker.path_free(paths[j], self.stop, fine)
             if free is None:
                 break  # out of time: the rest stay unknown
             if free:
                 out[j] = length[j]
                 i = idx[j] % self.n
                 self.known[i] = min(self.known[i], length[j])
+                if fine:
+                    self.best = float(length[j])
         return out
 
 
