@@ -161,9 +161,14 @@ def solve_in_space(planner: Any, adapter: SpaceAdapter, ptc: ob.PlannerTerminati
     stats.rrt_length, stats.rrt_waypoints = adapter.length(rows), len(rows)
     stats.rrt_path = rows.tolist()
     deadline = t0 + (1.0 - FINISH_RESERVE) * values["budget"] if values["budget"] > 0 else None
-    seed = rows
+    simplified = None
     if values["simplify"]:
-        seed = _simplified(si, pdef, raw, rows, adapter, deadline, stats)
+        simplified = _simplified(si, pdef, raw, rows, adapter, deadline, stats)
+    seed = _checked_seed(si, adapter, simplified, rows)
+    if seed is None:  # RRT*'s own path fails checkMotion (asymmetric spaces): no answer
+        pdef.clearSolutionPaths()
+        stats.stages.append("refused")
+        return ob.PlannerStatus(ob.PlannerStatus.TIMEOUT)
     stats.seed_source = stats.first_solution
     stats.seed_length, stats.seed_path = adapter.length(seed), seed.tolist()
     best = _swarm(si, adapter, seed, values, rng, ptc, deadline, stats)
@@ -178,8 +183,23 @@ def solve_in_space(planner: Any, adapter: SpaceAdapter, ptc: ob.PlannerTerminati
     return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
 
 
+def _checked_seed(si, adapter: SpaceAdapter, simplified, rows) -> np.ndarray | None:
+    """The swarm's seed: the simplifier's path when every motion of it passes (finely), else
+    RRT*'s when every motion of it passes ``si.checkMotion``, else None.
+
+    The simplifier checks its shortcuts' motions, but the pieces it keeps of a motion are not
+    the motion it checked (a shortcut from a point inside one segment to a point inside another
+    leaves two part-segments, sampled at other states): measured, one simplified R^3 path in
+    seven failed ``path.check()``. RRT*'s own path can fail too where the space's distance is
+    not symmetric (plain Dubins: RRT* checks some motions the other way round; OMPL warns)."""
+    checker = MotionChecker(si, adapter)
+    if simplified is not None and checker.path_free(simplified):
+        return simplified
+    return rows if checker.path_free(rows, fine=False) else None
+
+
 def _simplified(si, pdef, raw, rows, adapter: SpaceAdapter, deadline, stats: SpaceStats):
-    """OMPL's simplifier on a copy of RRT*'s path, the shorter of the two as rows.
+    """OMPL's simplifier on a copy of RRT*'s path, as rows when shorter (else None).
 
     ``simplifyMax`` without a budget; with one, its steps in small batches for at most half of
     what is left (:func:`~rrtpso_ompl.planners.post.simplify_until`)."""
@@ -193,17 +213,11 @@ def _simplified(si, pdef, raw, rows, adapter: SpaceAdapter, deadline, stats: Spa
     candidate = adapter.path_to_array(copy)
     stats.simplify_time += time.perf_counter() - t1
     stats.stages.append("simplify")
-    # The simplifier checks its shortcuts' motions, but the pieces it keeps of a motion are not
-    # the motion it checked (a shortcut from a point inside one segment to a point inside
-    # another leaves two part-segments, sampled at other states): measured, one simplified
-    # R^3 path in seven failed ``path.check()``. Kept only when every motion passes again.
-    if adapter.length(candidate) < adapter.length(rows) and MotionChecker(si, adapter).path_free(
-        candidate
-    ):
+    if adapter.length(candidate) < adapter.length(rows):
         stats.simplified_length = adapter.length(candidate)
         return candidate
     stats.simplified_length = adapter.length(rows)
-    return rows
+    return None
 
 
 def _swarm(si, adapter: SpaceAdapter, seed: np.ndarray, values, rng, ptc, deadline,
