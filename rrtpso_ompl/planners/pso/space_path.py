@@ -130,6 +130,9 @@ class MotionChecker:
     ----------
     calls : int
         Motions checked (one ``checkMotion`` each).
+    fine_seconds, fine_motions : float, int
+        Time spent in the finer checks and how many motions it checked (the checker's measured
+        cost, which sizes the time kept back for the last check).
     """
 
     def __init__(self, si: ob.SpaceInformation, adapter: SpaceAdapter) -> None:
@@ -137,6 +140,8 @@ class MotionChecker:
         self.adapter = adapter
         self.space = si.getStateSpace()
         self.calls = 0
+        self.fine_seconds = 0.0
+        self.fine_motions = 0
         self._a = si.allocState()  # Python's to free (never freeState)
         self._b = si.allocState()
         self._s = si.allocState()
@@ -152,6 +157,14 @@ class MotionChecker:
             return False
         if not fine:
             return True
+        t0 = time.perf_counter()
+        try:
+            return self._between(sa, sb, s)
+        finally:
+            self.fine_seconds += time.perf_counter() - t0
+            self.fine_motions += 1
+
+    def _between(self, sa, sb, s) -> bool:
         n = FINER * max(int(self.space.validSegmentCount(sa, sb)), 1)
         interpolate, valid = self.space.interpolate, self.si.isValid
         for k in range(1, n):
@@ -161,6 +174,10 @@ class MotionChecker:
             if not valid(s):
                 return False
         return True
+
+    def fine_mean(self) -> float:
+        """Measured seconds of the finer check per motion (0 before any)."""
+        return self.fine_seconds / self.fine_motions if self.fine_motions else 0.0
 
     def path_free(self, rows: np.ndarray, stop: Callable[[], bool] | None = None,
                   fine: bool = True) -> bool | None:  # fmt: skip
@@ -208,30 +225,67 @@ def optimize_space_path(
     seed = np.array(rows, dtype=float).reshape(-1, adapter.dim)
     checker = MotionChecker(si, adapter)
     input_length = adapter.length(seed)
-
-    def stop() -> bool:
-        late = deadline is not None and time.perf_counter() >= deadline
-        return late or (terminate is not None and bool(terminate()))
-
-    best = seed
-    if options.prune and len(best) > 2:
-        best = _prune(best, adapter, checker, stop)
+    stop = _Stop(terminate, deadline, checker, len(seed) - 1)
     history: list[float] = []
     counts = [0, 0, 0]  # iterations, evaluations, rounds
-    plan = ["swarm"] + ["refine"] * options.refine_rounds
-    for kind in plan + (["polish"] * options.polish_rounds if deadline is not None else []):
-        if stop() or len(best) <= 2:  # out of time, or a single motion: nothing to move
-            break
-        before = adapter.length(best)
-        best = _round(kind, best, adapter, checker, options, rng, stop, deadline, history, counts)
-        if kind == "polish" and before - adapter.length(best) <= options.polish_tolerance * before:
-            break
+    best = seed  # no time to check a result: the input comes back as it is
+    if stop.room_for_a_check(seed):
+        best = _improve(seed, adapter, checker, options, rng, stop, deadline, history, counts)
     best = _final(seed, best, adapter, checker, input_length)
     length = adapter.length(best)
     return SpacePathResult(path=best, length=length, input_length=input_length,
                            improved=best is not seed, history=np.asarray(history),
                            n_iterations=counts[0], n_evaluations=counts[1], rounds=counts[2],
                            motion_checks=checker.calls, time=time.perf_counter() - t0)  # fmt: skip
+
+
+def _improve(seed, adapter, checker, options, rng, stop, deadline, history, counts):
+    """The greedy shortcut, then the rounds: the best path found (``seed`` itself when none)."""
+    best = seed
+    if options.prune and len(best) > 2:
+        best = _prune(best, adapter, checker, stop)
+    plan = ["swarm"] + ["refine"] * options.refine_rounds
+    for kind in plan + (["polish"] * options.polish_rounds if deadline is not None else []):
+        if stop() or len(best) <= 2:  # out of time, or a single motion: nothing to move
+            break
+        before = adapter.length(best)
+        best = _round(kind, best, adapter, checker, options, rng, stop, deadline, history, counts)
+        stop.motions = len(best) - 1
+        if kind == "polish" and before - adapter.length(best) <= options.polish_tolerance * before:
+            break
+    return best
+
+
+#: The time kept back for the last check of the path is this many times its measured cost.
+FINAL_CHECK_MARGIN = 1.5
+
+
+class _Stop:
+    """When the work stops: the caller's condition, or ``deadline`` less the time the last check
+    of a path of ``motions`` motions needs (:data:`FINAL_CHECK_MARGIN` times the finer check's
+    measured cost per motion: a user's checker may take a millisecond a state)."""
+
+    def __init__(self, terminate, deadline: float | None, checker: MotionChecker,
+                 motions: int) -> None:  # fmt: skip
+        self.terminate, self.deadline, self.checker = terminate, deadline, checker
+        self.motions = motions
+
+    def __call__(self) -> bool:
+        if self.terminate is not None and self.terminate():
+            return True
+        if self.deadline is None:
+            return False
+        reserve = FINAL_CHECK_MARGIN * self.checker.fine_mean() * self.motions
+        return time.perf_counter() >= self.deadline - reserve
+
+    def room_for_a_check(self, rows: np.ndarray) -> bool:
+        """With a deadline: time one finer check of the first motion; False when checking the
+        whole path that way would not fit twice in the time left."""
+        if self.deadline is None or len(rows) <= 2:
+            return True
+        self.checker.motion_free(rows[0], rows[1])
+        need = 2.0 * self.checker.fine_mean() * (len(rows) - 1)
+        return time.perf_counter() + need <= self.deadline
 
 
 def _round(kind, rows, adapter, checker, options, rng, stop, deadline, history, counts):

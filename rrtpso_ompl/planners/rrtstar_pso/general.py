@@ -164,7 +164,7 @@ def solve_in_space(planner: Any, adapter: SpaceAdapter, ptc: ob.PlannerTerminati
     simplified = None
     if values["simplify"]:
         simplified = _simplified(si, pdef, raw, rows, adapter, deadline, stats)
-    seed = _checked_seed(si, adapter, simplified, rows)
+    seed = _checked_seed(si, adapter, simplified, rows, deadline)
     if seed is None:  # RRT*'s own path fails checkMotion (asymmetric spaces): no answer
         pdef.clearSolutionPaths()
         stats.stages.append("refused")
@@ -183,7 +183,7 @@ def solve_in_space(planner: Any, adapter: SpaceAdapter, ptc: ob.PlannerTerminati
     return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
 
 
-def _checked_seed(si, adapter: SpaceAdapter, simplified, rows) -> np.ndarray | None:
+def _checked_seed(si, adapter: SpaceAdapter, simplified, rows, deadline) -> np.ndarray | None:
     """The swarm's seed: the simplifier's path when every motion of it passes (finely), else
     RRT*'s when every motion of it passes ``si.checkMotion``, else None.
 
@@ -191,11 +191,28 @@ def _checked_seed(si, adapter: SpaceAdapter, simplified, rows) -> np.ndarray | N
     the motion it checked (a shortcut from a point inside one segment to a point inside another
     leaves two part-segments, sampled at other states): measured, one simplified R^3 path in
     seven failed ``path.check()``. RRT*'s own path can fail too where the space's distance is
-    not symmetric (plain Dubins: RRT* checks some motions the other way round; OMPL warns)."""
+    not symmetric (plain Dubins: RRT* checks some motions the other way round; OMPL warns).
+    With a ``deadline``, the simplifier's path is only checked (and used) when its first
+    motion's check, timed, says the whole check fits in half of the time left."""
     checker = MotionChecker(si, adapter)
-    if simplified is not None and checker.path_free(simplified):
+    if (
+        simplified is not None
+        and _check_fits(checker, simplified, deadline)
+        and (checker.path_free(simplified))
+    ):
         return simplified
     return rows if checker.path_free(rows, fine=False) else None
+
+
+def _check_fits(checker: MotionChecker, rows: np.ndarray, deadline: float | None) -> bool:
+    """Whether checking every motion of ``rows`` finely fits in half of the time left (timed on
+    its first motion: a user's checker may take a millisecond a state)."""
+    if deadline is None:
+        return True
+    if not checker.motion_free(rows[0], rows[1]):
+        return False
+    need = checker.fine_mean() * (len(rows) - 1)
+    return need <= 0.5 * (deadline - time.perf_counter())
 
 
 def _simplified(si, pdef, raw, rows, adapter: SpaceAdapter, deadline, stats: SpaceStats):
