@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import logging
+import time
 
 import numpy as np
 import pytest
@@ -20,6 +21,7 @@ from rrtpso_ompl.errors import UnsupportedSpaceError
 from rrtpso_ompl.ompl_setup import seed_ompl
 from rrtpso_ompl.ompl_setup.spaces import space_adapter
 from rrtpso_ompl.planners import PSOPathOptimizer, RRTstarPSO
+from rrtpso_ompl.planners.post import run_post
 from rrtpso_ompl.planners.pso.path_optimizer import PathOptimizerOptions
 from rrtpso_ompl.planners.pso.space_path import optimize_space_path
 
@@ -194,3 +196,29 @@ def test_an_unsupported_space_is_refused_with_its_name(caplog):
     assert planner.unsupported in [r.getMessage() for r in caplog.records]
     with pytest.raises(UnsupportedSpaceError, match=r"^PSOPathOptimizer: .*SE3StateSpace"):
         PSOPathOptimizer(ss.getSpaceInformation())
+
+
+def test_the_pso_post_pass_after_ompl_s_rrtstar_in_r6():
+    """``run_post(..., ["simplify", "pso"])``, as ``+pso`` runs it, on og.RRTstar's path in R^6:
+    valid, exact ends, no longer than before each step."""
+    seed_ompl(3)
+    scene = Scene("R^6")
+    rrt = og.RRTstar(scene.si)
+    scene.ss.setPlanner(rrt)
+    iterations = []
+
+    def enough() -> bool:
+        iterations.append(1)
+        return len(iterations) > 800  # bounded by iterations, not seconds
+
+    assert scene.ss.solve(ob.PlannerTerminationCondition(enough))
+    path = scene.ss.getProblemDefinition().getSolutionPath()
+    steps = run_post(scene.si, path, ["simplify", "pso"], time.perf_counter() + 60.0,
+                     values={"iterations": 30, "polish_rounds": 0},
+                     rng=np.random.default_rng(2))  # fmt: skip
+    assert [s.step for s in steps] == ["simplify", "pso"]
+    assert all(s.length_after <= s.length_before + 1e-9 for s in steps)
+    assert path.check() and scene.dense_invalid(path) == []
+    states = path.getStates()
+    assert scene.coords(states[0]) == scene.coords(scene.start)
+    assert scene.coords(states[-1]) == scene.coords(scene.goal)
