@@ -16,6 +16,9 @@ space                     row          distance of a segment ``a -> b``         
                                                                                         ``distance``
 ========================  ===========  ===============================================  ==========
 
+(The closed forms are in :mod:`.curves`; Reeds-Shepp's 48 words there are exact but slower in
+numpy than OMPL's C++ called once a segment, so the adapter loops.)
+
 Every distance equals ``space.distance`` (tested to 1e-9 on thousands of random pairs); a user's
 Python subclass of one of these spaces may override ``distance``, so there the adapter asks the
 space itself, one segment at a time. Anything else (SE(3), SO(2) alone, a compound space of the
@@ -38,6 +41,7 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from ..errors import UnsupportedSpaceError
+from .curves import dubins_lengths, reeds_shepp_lengths
 from .space import describe_space
 
 __all__ = [
@@ -48,7 +52,6 @@ __all__ = [
     "ReedsSheppAdapter",
     "SE2Adapter",
     "SpaceAdapter",
-    "dubins_lengths",
     "space_adapter",
     "unsupported_space",
     "wrap_angle",
@@ -279,7 +282,7 @@ class DubinsAdapter(SE2Adapter):
         if not self.vectorised:
             return self._looped(a, b)
         rho = self.turning_radius
-        forward = dubins_lengths(a, b, rho)
+        forward = dubins_lengths(a, b, rho)  # in turning radii
         if self.symmetric:
             forward = np.minimum(forward, dubins_lengths(b, a, rho))
         return rho * forward
@@ -287,8 +290,12 @@ class DubinsAdapter(SE2Adapter):
 
 class ReedsSheppAdapter(SE2Adapter):
     """``ob.ReedsSheppStateSpace(rho)``: rows ``(x, y, yaw)``; the distance from the space itself,
-    one segment at a time (its 48 words are not ported to numpy yet: about a microsecond and a
-    half per segment, measured in docs/spaces.md)."""
+    one segment at a time.
+
+    OMPL's 48 words in numpy (:func:`~rrtpso_ompl.ompl_setup.curves.reeds_shepp_lengths`, equal
+    to ``space.distance`` to 1e-14) are slower than this loop: measured 14 us a segment in the
+    swarm's batches of 210 (6 us in batches of 20,000) against 4.4 us for the loop, on a loaded
+    2-core VM (docs/spaces.md). Set ``vectorised = True`` to use them all the same."""
 
     kind = "Reeds-Shepp"
 
@@ -299,98 +306,9 @@ class ReedsSheppAdapter(SE2Adapter):
 
     def distances(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         a, b = np.broadcast_arrays(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
-        return self._looped(a, b)
-
-
-# -- Dubins in numpy -------------------------------------------------------------------------------
-_DUBINS_EPS = 1e-6
-_DUBINS_ZERO = -1e-7
-
-
-def _mod2pi(x: np.ndarray) -> np.ndarray:
-    """OMPL's ``mod2pi`` of DubinsStateSpace.cpp (tiny negatives and near-2pi values to 0)."""
-    xm = x - _TWO_PI * np.floor(x / _TWO_PI)
-    xm = np.where(_TWO_PI - xm < 0.5 * _DUBINS_EPS, 0.0, xm)
-    return np.where((x < 0) & (x > _DUBINS_ZERO), 0.0, xm)
-
-
-def _dubins_words(d: np.ndarray, alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
-    """Lengths (in turning radii) of OMPL's six Dubins words, ``inf`` where a word does not
-    exist; shape ``(6, ...)`` in OMPL's order LSL, RSR, RSL, LSR, RLR, LRL."""
-    ca, sa, cb, sb = np.cos(alpha), np.sin(alpha), np.cos(beta), np.sin(beta)
-    inf = np.inf
-    out = []
-    with np.errstate(invalid="ignore"):
-        # LSL
-        tmp = 2.0 + d * d - 2.0 * (ca * cb + sa * sb - d * (sa - sb))
-        theta = np.arctan2(cb - ca, d + sa - sb)
-        p = np.sqrt(np.maximum(tmp, 0.0))
-        length = _mod2pi(-alpha + theta) + p + _mod2pi(beta - theta)
-        out.append(np.where(tmp >= _DUBINS_ZERO, length, inf))
-        # RSR
-        tmp = 2.0 + d * d - 2.0 * (ca * cb + sa * sb - d * (sb - sa))
-        theta = np.arctan2(ca - cb, d - sa + sb)
-        p = np.sqrt(np.maximum(tmp, 0.0))
-        length = _mod2pi(alpha - theta) + p + _mod2pi(-beta + theta)
-        out.append(np.where(tmp >= _DUBINS_ZERO, length, inf))
-        # RSL
-        tmp = d * d - 2.0 + 2.0 * (ca * cb + sa * sb - d * (sa + sb))
-        p = np.sqrt(np.maximum(tmp, 0.0))
-        theta = np.arctan2(ca + cb, d - sa - sb) - np.arctan2(2.0, p)
-        length = _mod2pi(alpha - theta) + p + _mod2pi(beta - theta)
-        out.append(np.where(tmp >= _DUBINS_ZERO, length, inf))
-        # LSR
-        tmp = -2.0 + d * d + 2.0 * (ca * cb + sa * sb + d * (sa + sb))
-        p = np.sqrt(np.maximum(tmp, 0.0))
-        theta = np.arctan2(-ca - cb, d + sa + sb) - np.arctan2(-2.0, p)
-        length = _mod2pi(-alpha + theta) + p + _mod2pi(-beta + theta)
-        out.append(np.where(tmp >= _DUBINS_ZERO, length, inf))
-        # RLR
-        tmp = 0.125 * (6.0 - d * d + 2.0 * (ca * cb + sa * sb + d * (sa - sb)))
-        p = _TWO_PI - np.arccos(np.clip(tmp, -1.0, 1.0))
-        theta = np.arctan2(ca - cb, d - sa + sb)
-        t = _mod2pi(alpha - theta + 0.5 * p)
-        length = t + p + _mod2pi(alpha - beta - t + p)
-        out.append(np.where(np.abs(tmp) < 1.0, length, inf))
-        # LRL
-        tmp = 0.125 * (6.0 - d * d + 2.0 * (ca * cb + sa * sb - d * (sa - sb)))
-        p = _TWO_PI - np.arccos(np.clip(tmp, -1.0, 1.0))
-        theta = np.arctan2(-ca + cb, d + sa - sb)
-        t = _mod2pi(-alpha + theta + 0.5 * p)
-        length = t + p + _mod2pi(beta - alpha - t + p)
-        out.append(np.where(np.abs(tmp) < 1.0, length, inf))
-    return np.stack(out)
-
-
-def dubins_lengths(a: np.ndarray, b: np.ndarray, rho: float) -> np.ndarray:
-    """Length of the shortest forward Dubins path from each pose of ``a`` to the matching one of
-    ``b``, in turning radii (OMPL's ``getPath(a, b).length()``).
-
-    Parameters
-    ----------
-    a, b : ndarray, shape (..., 3)
-        Poses ``(x, y, yaw)``: units, units, rad.
-    rho : float
-        Turning radius, units.
-
-    Returns
-    -------
-    ndarray, shape (...)
-        The shortest of the six words (LSL, RSR, RSL, LSR, RLR, LRL), as OMPL computes them.
-        OMPL picks the word of a long path by Shkel and Lumelsky's classification rather than
-        by trying all six; both give the shortest word (they agree to 1e-9 on random pairs,
-        tests/ompl_setup/test_spaces.py).
-    """
-    dx = b[..., 0] - a[..., 0]
-    dy = b[..., 1] - a[..., 1]
-    d = np.sqrt(dx * dx + dy * dy) / rho
-    th = np.arctan2(dy, dx)
-    alpha = _mod2pi(a[..., 2] - th)
-    beta = _mod2pi(b[..., 2] - th)
-    # OMPL's degenerate case: the same pose, to 1e-6 (a straight "path" of length d).
-    same = (d < _DUBINS_EPS) & (np.abs(alpha - beta) < _DUBINS_EPS)
-    best = _dubins_words(d, alpha, beta).min(axis=0)
-    return np.where(same, d, best)
+        if not self.vectorised or type(self.space) is not ob.ReedsSheppStateSpace:
+            return self._looped(a, b)
+        return self.turning_radius * reeds_shepp_lengths(a, b, self.turning_radius)
 
 
 # -- choosing an adapter ---------------------------------------------------------------------------

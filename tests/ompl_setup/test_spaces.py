@@ -11,6 +11,7 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from rrtpso_ompl.errors import PlannerError, UnsupportedSpaceError
+from rrtpso_ompl.ompl_setup.curves import reeds_shepp_lengths
 from rrtpso_ompl.ompl_setup.spaces import (
     MAX_DIMENSION,
     DubinsAdapter,
@@ -79,6 +80,16 @@ def test_se2_like_distances_equal_ompl_s(kind):
     paths = np.stack([a[:30], b[:30], a[30:60]], axis=1)  # (30, 3, 3)
     expected = theirs[:30] + _ompl_distances(adapter, b[:30], a[30:60])
     np.testing.assert_allclose(adapter.lengths(paths), expected, rtol=0, atol=1e-9)
+
+
+def test_reeds_shepp_s_48_words_in_numpy_equal_ompl_s():
+    """Not what the adapter uses (OMPL's loop is faster), but exact all the same."""
+    adapter = space_adapter(_bounded(ob.ReedsSheppStateSpace(0.6)))
+    a, b = _poses(np.random.default_rng(11), PAIRS)
+    theirs = _ompl_distances(adapter, a, b)
+    np.testing.assert_allclose(0.6 * reeds_shepp_lengths(a, b, 0.6), theirs, rtol=0, atol=1e-9)
+    adapter.vectorised = True
+    np.testing.assert_allclose(adapter.distances(a, b), theirs, rtol=0, atol=1e-9)
 
 
 def test_the_kinds_and_what_is_numpy():
