@@ -32,7 +32,8 @@ OMPL, one property per check:
                           planner may not support (R^3, R^6, SE(2), Reeds-Shepp): it
                           refuses (an exception before ``solve``, or a status without a path),
                           or every path it leaves starts at the start, is valid by the user's
-                          checker along every motion and, if exact, ends in the goal
+                          checker along every motion and, if exact, ends in the goal (and
+                          is no longer than the seed its stats name, as RRTstarPSO's do)
 ========================  =================================================================
 
 Each check is a plain function ``check(entry_or_name, *, problem=None, budget=BUDGET, seed=1,
@@ -377,6 +378,9 @@ def check_other_spaces(
     checker on states from the space's own ``interpolate`` at the space's resolution (the states
     OMPL's own motion validators check, so a planner OMPL accepts passes by property); an exact
     one must end in the goal (``goal.isSatisfied``), and an exact status needs an exact path.
+    A planner whose stats name the length of the path it was seeded from (``seed_length``, as
+    RRTstarPSO's do in these spaces) must return an exact path no longer than that, by the
+    space's own distance.
 
     The objective's cost threshold is infinite, so optimizing planners stop at their first path
     (this checks answers, not their quality). ``problem`` and ``budget`` are not used (the
@@ -678,7 +682,8 @@ def _other_space_failure(case: _Case, kind: str) -> str | None:
     objective.setCostThreshold(ob.Cost(math.inf))  # any path will do: stop at the first
     ss.setOptimizationObjective(objective)
     try:
-        ss.setPlanner(request.entry.make(si, request.values))
+        planner = request.entry.make(si, request.values)
+        ss.setPlanner(planner)
         ss.setup()
     except Exception:  # refused before any solve: no answer, so no wrong one
         return None
@@ -696,6 +701,11 @@ def _other_space_failure(case: _Case, kind: str) -> str | None:
     exact = not pdef.hasApproximateSolution()
     path = pdef.getSolutionPath()
     wrong = _other_path_wrong(scene, si, pdef, path, start, exact)
+    seed_length = getattr(getattr(planner, "last_stats", None), "seed_length", None)
+    longer = seed_length is not None and path.length() > seed_length * (1 + _RTOL) + 1e-12
+    if wrong is None and exact and longer:  # by the space's own distance
+        wrong = (f"its length {path.length():.6g} is more than that of the seed path its stats "
+                 f"name ({seed_length:.6g})")  # fmt: skip
     if wrong is None:
         return None
     what = "exact" if exact else "approximate"

@@ -24,6 +24,8 @@ from rrtpso_ompl.planners import PSOPathOptimizer, RRTstarPSO
 from rrtpso_ompl.planners.post import run_post
 from rrtpso_ompl.planners.pso.path_optimizer import PathOptimizerOptions
 from rrtpso_ompl.planners.pso.space_path import optimize_space_path
+from rrtpso_ompl.planners.registry import PlannerEntry
+from rrtpso_ompl.testing import OTHER_SPACES, check_other_spaces
 
 #: Circular obstacles (centre x, centre y, radius) in the 0..10 box; in R^n they are cylinders
 #: along the other axes.
@@ -222,3 +224,27 @@ def test_the_pso_post_pass_after_ompl_s_rrtstar_in_r6():
     states = path.getStates()
     assert scene.coords(states[0]) == scene.coords(scene.start)
     assert scene.coords(states[-1]) == scene.coords(scene.goal)
+
+
+class _Inflating(RRTstarPSO):
+    """Reports a seed shorter than the path it returns (a swarm that made its path longer).
+    Bounded by iterations, not by the kit's 0.1 s, so that it answers on any machine."""
+
+    def solve(self, ptc):
+        self.set_params(budget=0.0, rrt_max_iterations=300, iterations=20)
+        status = super().solve(ob.plannerNonTerminatingCondition())
+        if self.last_stats is not None and self.last_stats.seed_length is not None:
+            self.last_stats.seed_length *= 0.5
+        return status
+
+
+def test_the_kit_checks_the_planners_in_these_spaces_and_catches_a_longer_path():
+    """The conformance kit's other-space check: RRTstarPSO's answers pass it (it plans there
+    now, it used to refuse), and a path longer than the seed its stats name fails it."""
+    check_other_spaces("RRTstarPSO")
+    with pytest.raises(AssertionError) as exc:
+        check_other_spaces(PlannerEntry("Inflating", factory=_Inflating))
+    lines = str(exc.value).splitlines()
+    assert len(lines) == len(OTHER_SPACES)
+    assert all("is more than that of the seed path its stats name" in line for line in lines)
+    assert lines[0].startswith("Inflating in a user's R^3 SimpleSetup: reported 'Exact solution'")
