@@ -305,9 +305,10 @@ class PythonPlanner(ob.Planner):
 
     Subclasses define ``PARAMS`` (a :class:`~rrtpso_ompl.params.ParamTable`) and
     implement ``_solve(ptc)`` returning an ``ob.PlannerStatus``; the statistics of the last solve
-    (a :class:`PlannerStats`) go to ``self.last_stats``. ``_solve`` is only called in the plane
-    (``ob.RealVectorStateSpace(2)``): a subclass's ``setup`` does nothing of its own when
-    :attr:`unsupported` is set.
+    (a :class:`PlannerStats`) go to ``self.last_stats``. ``_solve`` is only called where
+    :attr:`unsupported` is None: the plane (``ob.RealVectorStateSpace(2)``), unless a subclass's
+    constructor accepts more spaces and resets it (RRTstarPSO does for R^n, SE(2), Dubins and
+    Reeds-Shepp); a subclass's ``setup`` does nothing of its own when it is set.
 
     Attributes
     ----------
