@@ -402,6 +402,7 @@ class _CheckedLength:
         self.adapter, self.checker, self.n, self.stop = adapter, checker, n, stop
         self.k = len(rows) - 2
         self.seed_length = adapter.length(rows)
+        self.seed = np.vstack([rows[:1], adapter.normalised(rows[1:-1]), rows[-1:]])
         self.known = np.full(n, np.inf)  # each particle's best checked length
         self.best = self.seed_length  # the swarm's best (checked finely)
         self.seen = 0  # rows of the first evaluation seen so far
@@ -424,7 +425,7 @@ class _CheckedLength:
         length = self.adapter.lengths(paths)
         out = np.full(p, np.inf)
         idx = base + np.arange(p)
-        if first and base == 0:
+        if first and base == 0 and np.array_equal(paths[0], self.seed):
             out[0] = length[0]  # the seed: the input path, not re-checked
             self.known[0] = length[0]
         target = np.minimum(self.known[idx % self.n], self.seed_length)
