@@ -693,6 +693,7 @@ def test_stopped_searches_say_so():
     assert not shortest_path(problem).stopped
 
 
+@pytest.mark.slow  # seconds of work: the full run only
 def test_six_library_maps_keep_their_written_optima():
     """The optima written in the headers of problems/maps (computed by the old formulation)."""
     import re

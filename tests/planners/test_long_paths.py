@@ -57,6 +57,7 @@ def test_the_stages_of_a_long_path_add_up_and_end_near_the_budget(maze_problem, 
         assert world.path_valid(np.array(r.path))
 
 
+@pytest.mark.slow  # seconds of work: the full run only
 def test_a_point_robot_squeezing_through_a_random_field_gets_a_taut_path(tmp_path):
     # A 256 x 256 field, 30 % of the cells blocked, a point robot: the funnel's path grazes
     # corners between touching cells (before issue 25's fix the check refused it and the run
