@@ -528,10 +528,10 @@ def _lonely_circles(world: World) -> np.ndarray:
         return np.zeros(0, dtype=bool)
     thr = world.threshold
     reach = (c[:, 2] + 2.0 * thr + 8.0 * world.tol)[:, None]
-    query, ids = world._grid.pairs_in_boxes(c[:, :2] - reach, c[:, :2] + reach)
+    query, ids = world.index.grid.pairs_in_boxes(c[:, :2] - reach, c[:, :2] + reach)
     other = ids != query  # circles come first among the ids: id == own index
     query, ids = query[other], ids[other]
-    kind = world._kind_of(ids)
+    kind = world.index.kind_of(ids)
     near = np.zeros(len(c), dtype=bool)
     near[query[kind != 0]] = True
     k = kind == 0
@@ -942,15 +942,15 @@ class _TangentSearch:
         c, rho = self.circles[circles, :2], self.circles[circles, 2]
         bins = np.full((2, len(circles), _SHADOW_BINS), np.inf)
         if w.n_obstacles:
-            reach = (rho + _SHADOW_CELLS * w._grid.h)[:, None]
-            query, ids = w._grid.pairs_in_boxes(c - reach, c + reach)
-            kind = w._kind_of(ids)
+            reach = (rho + _SHADOW_CELLS * w.index.grid.h)[:, None]
+            query, ids = w.index.grid.pairs_in_boxes(c - reach, c + reach)
+            kind = w.index.kind_of(ids)
             disc = np.empty((len(ids), 3))
             x = kind == 0
             disc[x] = w.circles[ids[x]]
             disc[x, 2] += w.threshold
             x = kind == 1
-            box = w.boxes[ids[x] - w._n_circles]
+            box = w.boxes[ids[x] - w.index.n_circles]
             disc[x, :2] = 0.5 * (box[:, :2] + box[:, 2:])
             disc[x, 2] = 0.5 * np.minimum(box[:, 2] - box[:, 0], box[:, 3] - box[:, 1])
             disc[x, 2] += w.threshold
@@ -991,8 +991,8 @@ class _TangentSearch:
             return blocked  # few obstacles: the world's own test is as cheap
         circles, inverse = np.unique(cand.i, return_inverse=True)
         c, rho = self.circles[circles, :2], self.circles[circles, 2]
-        reach = (rho + 2.0 * w._grid.h)[:, None]
-        query, ids = w._grid.pairs_in_boxes(c - reach, c + reach)
+        reach = (rho + 2.0 * w.index.grid.h)[:, None]
+        query, ids = w.index.grid.pairs_in_boxes(c - reach, c + reach)
         count = np.bincount(query, minlength=len(circles))
         first = np.concatenate([[0], np.cumsum(count)])[:-1]
         n = count[inverse]
@@ -1001,7 +1001,7 @@ class _TangentSearch:
         seg = np.repeat(np.arange(len(cand.j)), n)
         k = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
         obs = ids[np.repeat(first[inverse], n) + k]
-        d = w._pair_distance(seg, obs, cand.p, cand.q)
+        d = w.index.pair_distance(seg, obs, cand.p, cand.q)
         blocked[seg[d < w.threshold]] = True
         return blocked
 
@@ -1180,8 +1180,11 @@ def _arcs_free(world: World, center, rho, a0, sweep) -> np.ndarray:
     # Obstacles near each arc's circle (its bounding box, grown by the reach in the index).
     lo = center - rho[:, None]
     hi = center + rho[:, None]
-    arc, ids = world._grid.pairs_in_boxes(lo, hi) if world.n_obstacles else (np.empty(0, int),) * 2
-    kind = world._kind_of(ids)
+    if world.n_obstacles:
+        arc, ids = world.index.grid.pairs_in_boxes(lo, hi)
+    else:
+        arc, ids = (np.empty(0, int),) * 2
+    kind = world.index.kind_of(ids)
     c = kind == 0
     if c.any():
         obs = world.circles[ids[c]]
@@ -1205,14 +1208,14 @@ def _edges_of(world: World, arc: np.ndarray, ids: np.ndarray, kind: np.ndarray):
     arcs, edges = [], []
     x = kind == 1
     if x.any():
-        b = world.boxes[ids[x] - world._n_circles]
+        b = world.boxes[ids[x] - world.index.n_circles]
         for e in (b[:, [0, 1, 2, 1]], b[:, [2, 1, 2, 3]], b[:, [2, 3, 0, 3]], b[:, [0, 3, 0, 1]]):
             arcs.append(arc[x])
             edges.append(e)
     p = kind == 2
     if p.any():
         arcs.append(arc[p])
-        edges.append(world._edges[ids[p] - world._first_edge])
+        edges.append(world.index.edges[ids[p] - world.index.first_edge])
     if not arcs:
         return np.empty(0, dtype=int), np.empty((0, 4))
     return np.concatenate(arcs), np.vstack(edges)
