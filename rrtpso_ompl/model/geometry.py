@@ -245,11 +245,9 @@ def shortcut(
         ahead = window
         while True:
             j = np.arange(i + 1, min(last, i + ahead) + 1)
+            chunks = np.array_split(j, max(1, math.ceil(len(j) / _CHUNK)))
             sight = np.concatenate(
-                [
-                    segments_free(np.broadcast_to(p[i], (len(chunk), 2)), p[chunk])
-                    for chunk in np.array_split(j, max(1, math.ceil(len(j) / _CHUNK)))
-                ]
+                [segments_free(np.broadcast_to(p[i], (len(c), 2)), p[c]) for c in chunks]
             )
             # The next vertex is in sight on a valid input; on an invalid one, step to it anyway.
             seen = np.flatnonzero(sight)
