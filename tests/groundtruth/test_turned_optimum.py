@@ -80,8 +80,11 @@ def test_the_optimum_of_a_turned_map_is_the_unturned_optimum_turned(
     assert world.path_valid(path)
     blocked = map_shapes(turned)
     if shapes:
-        blocked = blocked.union(shapely.Point(turned.obstacles[0].center)
-                                .buffer(turned.obstacles[0].radius, quad_segs=256))
+        blocked = blocked.union(
+            shapely.Point(turned.obstacles[0].center).buffer(
+                turned.obstacles[0].radius, quad_segs=256
+            )
+        )
         blocked = blocked.union(shapely.Polygon(turned.obstacles[1].points))
     d = shapely.distance(blocked, shapely.linestrings(np.stack([path[:-1], path[1:]], axis=1)))
     assert d.min() >= turned.robot.radius - 1e-6  # the circle is a 1024-gon inside it
