@@ -37,10 +37,10 @@ from typing import Any
 
 import numpy as np
 from scipy import ndimage
-from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from ...model.geometry import path_length, shortcut
+from ...model.grid_graph import MOVES_16, entry_cell, grid_graph, move_pairs, walk
 from ...model.raster import Lattice
 from ...model.world import MarkingStopped
 
@@ -104,20 +104,6 @@ __all__ = [
     "search",
 ]
 
-#: Moves of the 16-connected lattice (half of them; the graph is undirected): the cells next to
-#: the way that must be free too, and those the channel goes through (each sharing an edge with
-#: the one before).
-_MOVES = (
-    ((1, 0), (), ()),
-    ((0, 1), (), ()),
-    ((1, 1), ((1, 0), (0, 1)), ((1, 0),)),
-    ((1, -1), ((1, 0), (0, -1)), ((1, 0),)),
-    ((2, 1), ((1, 0), (1, 1)), ((1, 0), (1, 1))),
-    ((1, 2), ((0, 1), (1, 1)), ((0, 1), (1, 1))),
-    ((2, -1), ((1, 0), (1, -1)), ((1, 0), (1, -1))),
-    ((1, -2), ((0, -1), (1, -1)), ((0, -1), (1, -1))),
-)
-
 
 @dataclass(frozen=True)
 class CorridorResult:
@@ -161,33 +147,12 @@ def lattice_graph(free: np.ndarray):
     """The 16-connected graph of the free cells (CSR, undirected; cell ``(i, j)`` is node
     ``i * ny + j``; move lengths in cells)."""
     nx, ny = free.shape
-    index = np.arange(nx * ny).reshape(nx, ny)
-    rows, cols, weights = [], [], []
-    for (di, dj), passed, _ in _MOVES:
-        # Cells (i, j) whose move to (i + di, j + dj) stays on the lattice.
-        i0, i1 = max(0, -di), nx - max(0, di)
-        j0, j1 = max(0, -dj), ny - max(0, dj)
-        if i0 >= i1 or j0 >= j1:
-            continue
-        ok = free[i0:i1, j0:j1] & free[i0 + di : i1 + di, j0 + dj : j1 + dj]
-        for pi, pj in passed:
-            ok &= free[i0 + pi : i1 + pi, j0 + pj : j1 + pj]
-        a = index[i0:i1, j0:j1][ok]
-        rows.append(a)
-        cols.append(a + di * ny + dj)
-        weights.append(np.full(len(a), math.hypot(di, dj)))
-    n = nx * ny
-    return coo_matrix(
-        (np.concatenate(weights), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)
-    ).tocsr()
-
-
-def _walk(pred: np.ndarray, node: int) -> list[int]:
-    """Nodes from the root of a predecessor tree to ``node`` (at most as many steps as nodes)."""
-    out = [node]
-    while pred[out[-1]] >= 0:
-        out.append(int(pred[out[-1]]))
-    return out[::-1]
+    index = np.where(free, np.arange(nx * ny).reshape(nx, ny), -1)
+    pairs = [move_pairs(index, step, passed) for step, passed, _ in MOVES_16]
+    weights = [np.full(len(a), math.hypot(*step)) for (a, _), (step, _, _) in
+               zip(pairs, MOVES_16, strict=True)]  # fmt: skip
+    return grid_graph(nx * ny, np.concatenate([a for a, _ in pairs]),
+                      np.concatenate([b for _, b in pairs]), np.concatenate(weights))  # fmt: skip
 
 
 def lattice_route(free: np.ndarray, source: tuple[int, int], target: tuple[int, int]):
@@ -200,7 +165,7 @@ def lattice_route(free: np.ndarray, source: tuple[int, int], target: tuple[int, 
                           return_predecessors=True)  # fmt: skip
     if not np.isfinite(dist[t]):
         return None
-    return [(v // ny, v % ny) for v in _walk(pred, t)]
+    return [(v // ny, v % ny) for v in walk(pred, t)]
 
 
 def alternative_routes(
@@ -223,7 +188,7 @@ def alternative_routes(
     if not np.isfinite(best):
         return []
     through = dist[0] + dist[1]
-    routes = [_walk(pred[0], t)]
+    routes = [walk(pred[0], t)]
     near = np.zeros(nx * ny, dtype=bool)
     for _ in range(count):
         mask = np.ones((nx, ny), dtype=bool)
@@ -235,7 +200,7 @@ def alternative_routes(
         if not ok.any():
             break
         v = int(np.flatnonzero(ok)[np.argmin(through[ok])])
-        routes.append(_walk(pred[0], v) + _walk(pred[1], v)[::-1][1:])
+        routes.append(walk(pred[0], v) + walk(pred[1], v)[::-1][1:])
     return [[(v // ny, v % ny) for v in r] for r in routes]
 
 
@@ -245,7 +210,7 @@ def channel(route: list[tuple[int, int]]) -> list[tuple[int, int]]:
     out = [route[0]]
     for (i0, j0), (i1, j1) in itertools.pairwise(route):
         di, dj = i1 - i0, j1 - j0
-        for (mi, mj), _, via in _MOVES:
+        for (mi, mj), _, via in MOVES_16:
             for sign in (1, -1):
                 if (di, dj) == (sign * mi, sign * mj):
                     out.extend((i0 + sign * pi, j0 + sign * pj) for pi, pj in via)
@@ -402,28 +367,6 @@ def funnel(start, goal, portals) -> np.ndarray:
     return np.asarray(path, dtype=float)
 
 
-def _entry(model: Any, lat: Lattice, free: np.ndarray, point, reach: int):
-    """The free cell to enter the lattice from ``point``: its own cell when free, else the
-    nearest free cell within ``reach`` cells whose centre it sees (exact segment test)."""
-    cell = lat.cell_of(point)
-    if free[cell]:
-        return cell, False
-    ci, cj = cell
-    cand = [(i, j) for i in range(ci - reach, ci + reach + 1)
-            for j in range(cj - reach, cj + reach + 1)
-            if 0 <= i < lat.nx and 0 <= j < lat.ny and free[i, j]]  # fmt: skip
-    if not cand:
-        return None, False
-    centres = np.array([lat.centre(c) for c in cand])
-    order = np.argsort(np.hypot(*(centres - np.asarray(point, dtype=float)).T))
-    for chunk in np.array_split(order, max(1, math.ceil(len(order) / 16))):
-        sees = model.segments_free(np.broadcast_to(np.asarray(point, float), (len(chunk), 2)),
-                                   centres[chunk])  # fmt: skip
-        if sees.any():
-            return cand[int(chunk[np.flatnonzero(sees)[0]])], True
-    return None, False
-
-
 def corridor_path(
     model: Any,
     start,
@@ -486,8 +429,8 @@ def _route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0
                               **kw)  # fmt: skip
 
     n_free = int(free.sum())
-    s_cell, s_hop = _entry(model, lat, free, start, 2)
-    g_cell, g_hop = _entry(model, lat, free, goal, 2)
+    s_cell, s_hop = entry_cell(lat, free, start, 2, model.segments_free)
+    g_cell, g_hop = entry_cell(lat, free, goal, 2, model.segments_free)
     if s_cell is None or g_cell is None:
         return done("start or goal is not next to a free lattice cell", lattice=lat,
                     cells=n_free)  # fmt: skip
@@ -766,8 +709,8 @@ def centre_route(model: Any, start, goal, max_cells: int = 65_536, terminate=Non
     free = model.centres_free(lat)
     if within is not None:
         free &= within
-    s_cell, s_hop = _entry(model, lat, free, start, 2)
-    g_cell, g_hop = _entry(model, lat, free, goal, 2)
+    s_cell, s_hop = entry_cell(lat, free, start, 2, model.segments_free)
+    g_cell, g_hop = entry_cell(lat, free, goal, 2, model.segments_free)
     if s_cell is None or g_cell is None:
         return CorridorResult(None, lattice=lat, time=time.perf_counter() - t0,
                               reason="start or goal is not next to a free cell centre")  # fmt: skip
@@ -782,7 +725,7 @@ def centre_route(model: Any, start, goal, max_cells: int = 65_536, terminate=Non
         dist, pred = dijkstra(graph, directed=False, indices=s, return_predecessors=True)
         if not dist[t] < _CUT:
             break
-        nodes = np.array(_walk(pred, t))
+        nodes = np.array(walk(pred, t))
         ok = model.segments_free(centres[nodes[:-1]], centres[nodes[1:]])
         if ok.all():
             inner = centres[nodes]
