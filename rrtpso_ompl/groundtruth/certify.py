@@ -22,7 +22,7 @@ from scipy.sparse.csgraph import dijkstra
 from ..errors import GenerationError
 from ..model.geometry import shortcut as shortcut_path
 from ..model.grid_graph import grid_graph, move_pairs, walk
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from ..model.world import World
 from ..validation import check_number
 

@@ -65,7 +65,7 @@ from scipy.sparse.csgraph import dijkstra
 from ..errors import RrtpsoError
 from ..model.grid_graph import MOVES_16, grid_graph, move_pairs, walk
 from ..model.objective import InflationCost
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from ..model.raster import Lattice
 from ..model.world import World
 from ..validation import check_number
@@ -216,7 +216,7 @@ def cost_reference(
     else:
         explicit = resolution is not None
     return cost_reference_in_world(
-        world, InflationCost.of(problem.robot), problem.start[:2], problem.goal[:2],
+        world, problem.objective, problem.start[:2], problem.goal[:2],
         float(problem.goal_tolerance), resolution=resolution, explicit=explicit, anchor=anchor,
         smooth=smooth, name=problem.name,
     )  # fmt: skip

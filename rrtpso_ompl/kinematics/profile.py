@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RrtpsoError
-from ..model.problem import Robot
+from ..model.problem_types import Robot
 from ..validation import MAX_STEPS
 from .diffdrive import wheel_speeds
 from .reference import ReferenceCurve

@@ -52,7 +52,7 @@ from .geometry import GridFrame, bounding_box, is_axis_aligned_rectangle
 from .local_violation import LocalViolation, local_model
 from .marking import MarkingStopped, clear_cells, free_cells, lattice_of
 from .obstacle_index import SMALL_WORLD, ObstacleIndex
-from .problem import Circle, Polygon, Problem, clearance_threshold, touch_tolerance
+from .problem_types import Circle, Polygon, Problem, clearance_threshold, touch_tolerance
 from .raster import Lattice, MapRaster
 from .scalar_checks import ScalarChecks
 

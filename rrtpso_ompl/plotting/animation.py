@@ -17,7 +17,7 @@ from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Patch
 from matplotlib.text import Text
 
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from ..outputs import atomic_path
 from .canvas import fit_layout, plt
 from .styles import DETOUR, MOVING, PATH_COLOUR, RRT_COLOUR

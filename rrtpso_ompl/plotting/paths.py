@@ -12,7 +12,7 @@ from matplotlib import ticker
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from ..planners.result import SolveResult
 from .canvas import fit_layout, plt
 from .styles import PATH_COLOUR, RRT_COLOUR
@@ -93,9 +93,7 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
     ax.set_title(title)
     world_legend(ax, key)
     if history:
-        inflated = bool(problem.robot.inflation_radius
-                        and problem.robot.inflation_radius > problem.robot.radius)  # fmt: skip
-        _draw_pso_history(axes[0, 1], history, problem.units, inflated)
+        _draw_pso_history(axes[0, 1], history, problem.units, problem.objective.active)
     fit_layout(fig)
     return fig
 

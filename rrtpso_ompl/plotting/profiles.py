@@ -12,7 +12,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from .canvas import plt
 from .styles import COSTMAP, LEGEND_WIDTH, SAFETY
 
@@ -44,11 +44,10 @@ def plot_clearance_profile(problem: Problem, paths: dict[str, Any], world: Any =
     :data:`PROFILE_SAMPLES`), plus its vertices, where it turns round corners and its clearance is
     least. Clearances above 2.5 times the larger radius are drawn at the top of the axes.
     """
-    from ..model.objective import InflationCost
     from ..model.world import World
 
     world = world if world is not None else World.from_problem(problem)
-    cost = InflationCost.of(problem.robot)
+    cost = problem.objective
     r = problem.robot.radius
     (xmin, ymin), (xmax, ymax) = problem.bounds
     top = 2.5 * max(cost.inflation_radius if cost.active else 0.0, r)

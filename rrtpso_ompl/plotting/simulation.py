@@ -14,7 +14,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Patch
 
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from .canvas import fit_layout, plt
 from .styles import DETOUR, MOVING, PATH_COLOUR, RRT_COLOUR
 from .world import draw_world, world_legend, world_width

@@ -22,7 +22,7 @@ from matplotlib.patches import Patch, Rectangle
 from matplotlib.patches import Polygon as PolygonPatch
 from matplotlib.transforms import Affine2D
 
-from ..model.problem import Circle, Polygon, Problem
+from ..model.problem_types import Circle, Polygon, Problem
 from . import canvas  # noqa: F401 - chooses the Agg backend before anything is drawn
 from .styles import (
     COSTMAP,
@@ -210,10 +210,9 @@ def draw_costmap(ax: Axes, problem: Problem, world: Any = None,
     Inside obstacles nothing is shaded (they are drawn). Returns the legend handles (none without
     inflation).
     """
-    from ..model.objective import InflationCost
     from ..model.world import World
 
-    cost = InflationCost.of(problem.robot)
+    cost = problem.objective
     if not cost.active:
         return []
     world = world if world is not None else World.from_problem(problem)

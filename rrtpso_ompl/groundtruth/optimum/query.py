@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...model.problem import Problem
+from ...model.problem_types import Problem
 from ...model.world import World
 from ..free_grid import FreeGrid, Stopped
 from .circles import NodeCircles
