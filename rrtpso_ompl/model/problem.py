@@ -161,11 +161,7 @@ def problem_from_dict(
     ProblemError
         For anything that is not a valid problem (the same checks as :func:`load_problem`).
     """
-    if not isinstance(source, str):
-        raise ArgumentError(f"problem_from_dict: source must be a str naming where the data came "
-                            f"from, got {describe(source)}")  # fmt: skip
-    if name is not None and not isinstance(name, str):
-        raise ArgumentError(f"problem_from_dict: name must be a str, got {describe(name)}")
+    _check_arguments(source, name)
     v = _Validator(source)
     doc = v.document(data)
     if base is None:  # a map path is relative to the problem file, when there is one
@@ -175,9 +171,6 @@ def problem_from_dict(
     obstacles = v.each(doc, "obstacles", v.obstacle)
     moving = v.each(doc, "moving_obstacles", v.moving)
     units = v.string(_get(doc, "units", "m" if occupancy else ""), "units", empty=True)
-    if robot.inflation_radius and robot.cost_scaling_factor is None:
-        # Nav2's default is per metre: the same falling cost in the problem's units.
-        robot = dataclasses.replace(robot, cost_scaling_factor=default_scaling(units))
     problem = Problem(
         name=v.string(_get(doc, "name", name or "problem"), "name"),
         description=v.string(_get(doc, "description", ""), "description", empty=True),
@@ -187,7 +180,7 @@ def problem_from_dict(
         goal=v.point(doc["goal"], "goal"),
         goal_tolerance=v.number(_get(doc, "goal_tolerance", 0.0), "goal_tolerance", low=0.0),
         goal_yaw=v.degrees(doc.get("goal_yaw"), "goal_yaw"),
-        robot=robot,
+        robot=_with_default_scaling(robot, units),
         obstacles=obstacles,
         moving_obstacles=moving,
         planner=v.planner(_get(doc, "planner", {}), "planner"),
@@ -197,6 +190,23 @@ def problem_from_dict(
     for key in ("start", "goal"):
         v.free_position(problem, key)
     return problem
+
+
+def _check_arguments(source: Any, name: Any) -> None:
+    """:func:`problem_from_dict`'s own arguments (a caller's mistake, not the file's)."""
+    if not isinstance(source, str):
+        raise ArgumentError(f"problem_from_dict: source must be a str naming where the data came "
+                            f"from, got {describe(source)}")  # fmt: skip
+    if name is not None and not isinstance(name, str):
+        raise ArgumentError(f"problem_from_dict: name must be a str, got {describe(name)}")
+
+
+def _with_default_scaling(robot: Robot, units: str) -> Robot:
+    """The robot with an inflation radius but no ``cost_scaling_factor`` given Nav2's default,
+    which is per metre: the same falling cost in the problem's units."""
+    if robot.inflation_radius and robot.cost_scaling_factor is None:
+        return dataclasses.replace(robot, cost_scaling_factor=default_scaling(units))
+    return robot
 
 
 # ----------------------------------------------------------------------------------------------
