@@ -12,6 +12,7 @@ the parts of the bounds outside a map, which block the robot when unknown space 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from collections.abc import Callable, Mapping
@@ -22,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from .format import ROBOT
 from .geometry import GridFrame
 from .objective import InflationCost
 from .occupancy import OccupancyMap
@@ -103,26 +105,31 @@ class MovingObstacle:
         return np.asarray(self.start, dtype=float) + t[..., None] * self.velocity
 
 
-@dataclass(frozen=True)
-class Robot:
-    """The robot: a disc of radius ``radius`` (the safety zone SR) plus drive parameters.
+def _robot_class() -> type:
+    """The :class:`Robot` dataclass, its fields derived from the format's robot keys
+    (:data:`~rrtpso_ompl.model.format.ROBOT`): a robot key is declared once, there, with its
+    kind, unit and meaning, and is a field here at once (``radius`` required, the others
+    ``None`` when not given)."""
+    fields: list[Any] = []
+    for key in ROBOT.keys:
+        if key.required:
+            fields.append((key.name, float))
+        else:
+            fields.append((key.name, float | None, field(default=None)))
+    cls = dataclasses.make_dataclass("Robot", fields, frozen=True)
+    cls.__module__ = __name__  # pickled with the problem (batch workers): found by this name
+    cls.__doc__ = """The robot: a disc of radius ``radius`` (the safety zone SR) plus drive
+    parameters, one field per key of the format's ``robot`` section (docs/problem-format.md).
 
-    Attributes are in problem units (lengths), units per second (speed) and seconds
-    (sample_time). The drive parameters are optional until velocities or simulations are asked for.
+    Attributes are in problem units (lengths), units per second (speeds), seconds
+    (sample_time); the drive parameters are None until given, and needed only for velocities
+    and simulations, the inflation keys only for the clearance cost.
     """
+    return cls
 
-    radius: float
-    wheel_radius: float | None = None
-    track_width: float | None = None
-    speed: float | None = None
-    sample_time: float | None = None
-    sensor_range: float | None = None
-    max_speed: float | None = None
-    max_wheel_speed: float | None = None
-    max_accel: float | None = None
-    inflation_radius: float | None = None
-    cost_scaling_factor: float | None = None
-    cost_travel_multiplier: float | None = None
+
+#: The robot (:func:`_robot_class`): ``Robot(radius=0.2, speed=0.5, ...)``.
+Robot = _robot_class()
 
 
 @dataclass(frozen=True)
