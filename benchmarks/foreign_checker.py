@@ -37,7 +37,7 @@ def run(env: str, planner: str, budget: float, seed: int) -> dict:
     from test_foreign_checker import geo_env, penetration, square_env
 
     from rrtpso_ompl.ompl_setup import path_to_array
-    from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSO
+    from rrtpso_ompl.planners.rrtstar_pso.planner import RRTstarPSO
 
     ou.RNG.setSeed(seed)
     ou.setLogLevel(ou.LOG_WARN)

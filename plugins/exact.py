@@ -1,6 +1,6 @@
 """Registers Exact: the exact shortest path (the reference optimum) as a planner."""
 
-from rrtpso_ompl.planners.exact import ExactPlanner
+from rrtpso_ompl.planners.baselines.exact import ExactPlanner
 from rrtpso_ompl.planners.registry import Capabilities, PlannerEntry
 
 PLANNERS = [

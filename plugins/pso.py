@@ -1,6 +1,6 @@
 """Registers PSO: the paper's particle-swarm-only baseline (random initial waypoints)."""
 
-from rrtpso_ompl.planners.pso_baseline import PSOPlanner
+from rrtpso_ompl.planners.baselines.pso_baseline import PSOPlanner
 from rrtpso_ompl.planners.registry import Capabilities, PlannerEntry
 
 PLANNERS = [

@@ -1,7 +1,7 @@
 """Registers RRTstarPSO: OMPL's RRT* followed by the particle swarm over its waypoints."""
 
 from rrtpso_ompl.planners.registry import Capabilities, PlannerEntry
-from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSO
+from rrtpso_ompl.planners.rrtstar_pso.planner import RRTstarPSO
 
 PLANNERS = [
     PlannerEntry(

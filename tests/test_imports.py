@@ -13,7 +13,7 @@ from helpers import PROBLEMS
 
 def test_the_pure_stages_import_no_ompl():
     code = (
-        "import rrtpso_ompl.planners.swarm, rrtpso_ompl.planners.params, rrtpso_ompl.plotting, "
+        "import rrtpso_ompl.planners.pso.swarm, rrtpso_ompl.params, rrtpso_ompl.plotting, "
         "rrtpso_ompl.groundtruth; import sys; assert 'ompl' not in sys.modules"
     )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,

@@ -105,15 +105,7 @@ def run(args: argparse.Namespace) -> int:
     set_ompl_log_level(args.verbose)
     choice = choose_planner(args)
     problem = choice.problem
-    src = args.problem
-    for key in ("speed", "sample_time", "sensor_range"):
-        if getattr(problem.robot, key) is None:
-            raise UsageError(f"{src}: robot.{key}: required for simulate")
-    check_positive_seconds(args.time, "--time", src)
-    check_positive_seconds(args.replan_time, "--replan-time", src)
-    check_seed_flag(args.seed)
-    if not (args.heading_changes >= 0 and math.isfinite(args.heading_changes)):
-        raise UsageError(f"{src}: --heading-changes: must be >= 0, got {args.heading_changes}")
+    _check_flags(args, problem)
     outputs = [
         Output("--json", args.json),
         Output("--plot", args.plot, "image"),
@@ -160,6 +152,19 @@ def run(args: argparse.Namespace) -> int:
         f"time {sim.total_time:.1f}s, length {sim.path_length:.1f}",
     )
     return EXIT_OK if sim.success else EXIT_UNSOLVED
+
+
+def _check_flags(args: argparse.Namespace, problem: Any) -> None:
+    """The robot keys a simulation needs and the flags' values (UsageError naming them)."""
+    src = args.problem
+    for key in ("speed", "sample_time", "sensor_range"):
+        if getattr(problem.robot, key) is None:
+            raise UsageError(f"{src}: robot.{key}: required for simulate")
+    check_positive_seconds(args.time, "--time", src)
+    check_positive_seconds(args.replan_time, "--replan-time", src)
+    check_seed_flag(args.seed)
+    if not (args.heading_changes >= 0 and math.isfinite(args.heading_changes)):
+        raise UsageError(f"{src}: --heading-changes: must be >= 0, got {args.heading_changes}")
 
 
 def _failed(args: argparse.Namespace, problem: Any, options: Any, seed: Any, box: Any) -> int:

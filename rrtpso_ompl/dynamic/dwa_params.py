@@ -3,7 +3,7 @@ listing them (the strategy registry, the command line) loads neither its grid no
 
 from __future__ import annotations
 
-from ..planners.params import Rule, declared, param
+from ..params import Rule, declared, param
 
 __all__ = ["DWAParams"]
 

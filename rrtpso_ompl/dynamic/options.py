@@ -15,8 +15,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import RrtpsoError
-from ..model.problem import Problem
-from ..planners.params import Rule, declared, param
+from ..model.problem_types import Problem
+from ..params import Rule, declared, param
 from ..validation import MAX_STEPS as _MAX_STEPS
 
 __all__ = [

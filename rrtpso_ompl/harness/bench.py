@@ -217,9 +217,8 @@ def run_bench(
     planners = list(dict.fromkeys(planners))  # one block per planner in the logs
     tasks = bench_tasks(items, planners, runs, times, seed, params, simplify)  # checked first
     out = Path(out_dir)
-    batch = dict(jobs=jobs, resume=resume, overwrite=overwrite, executor=executor,
-                 scheduler=scheduler, progress=progress, on_start=on_start,
-                 notice=notice)  # fmt: skip
+    batch = dict(jobs=jobs, resume=resume, overwrite=overwrite, executor=executor, notice=notice,
+                 scheduler=scheduler, progress=progress, on_start=on_start)  # fmt: skip
     return _write_outputs(_run_in_folder(tasks, out, batch), out, planners, runs, seed, command)
 
 

@@ -1,9 +1,10 @@
 """Lattices over the workspace and which of their cells are wholly free.
 
 A *lattice* is a grid of square cells of side ``h`` laid over the bounds. The corridor search of
-:mod:`rrtpso_ompl.planners.corridor` walks from cell to cell, so it needs to know which cells the
-robot's centre may occupy *everywhere*: a path that stays inside such cells is valid without a
-single further check. Two ways to answer, both conservative (a cell reported free is free):
+:mod:`rrtpso_ompl.planners.rrtstar_pso.corridor` walks from cell to cell, so it needs to know
+which cells the robot's centre may occupy *everywhere*: a path that stays inside such cells is
+valid without a single further check. Two ways to answer, both conservative (a cell reported
+free is free):
 
 * an occupancy-grid map (:class:`MapRaster`) answers exactly, with array operations on its
   blocked cells: the distance from a lattice cell to the nearest blocked square is a Euclidean

@@ -1,6 +1,6 @@
 """What every Python planner of this project shares on top of ``ob.Planner``.
 
-* Parameters by name from its declared :class:`~rrtpso_ompl.planners.params.ParamTable`
+* Parameters by name from its declared :class:`~rrtpso_ompl.params.ParamTable`
   (scikit-learn's ``get_params()`` and ``set_params(**params)``), because ``Planner.params()``
   is unusable from Python.
 * Typed statistics of the last solve (:class:`PlannerStats`), which know their own part in OMPL's
@@ -33,12 +33,12 @@ from ompl import base as ob
 from ompl import util as ou
 
 from ..errors import UnsupportedSpaceError
-from ..model.problem import touch_tolerance
+from ..model.problem_types import touch_tolerance
 from ..model.raster import Lattice
 from ..model.world import MarkingStopped
 from ..ompl_setup.space import plane_space_problem, require_plane_space
+from ..params import ParamSpec, ParamTable
 from ..validation import MAX_SECONDS, SEED_MAX
-from .params import ParamSpec, ParamTable
 from .result import BenchmarkRun
 
 __all__ = [
@@ -303,7 +303,7 @@ def refusing_motions_after(model: Any, deadline: float | None) -> Iterator[None]
 class PythonPlanner(ob.Planner):
     """Base class: declared parameters, crash-safe ``solve`` and per-solve statistics.
 
-    Subclasses define ``PARAMS`` (a :class:`~rrtpso_ompl.planners.params.ParamTable`) and
+    Subclasses define ``PARAMS`` (a :class:`~rrtpso_ompl.params.ParamTable`) and
     implement ``_solve(ptc)`` returning an ``ob.PlannerStatus``; the statistics of the last solve
     (a :class:`PlannerStats`) go to ``self.last_stats``. ``_solve`` is only called in the plane
     (``ob.RealVectorStateSpace(2)``): a subclass's ``setup`` does nothing of its own when

@@ -33,7 +33,7 @@ from ..ompl_setup import InflationObjective, assign_path, path_to_array
 from ..ompl_setup.objective import path_cost
 from ..ompl_setup.space import require_plane_space
 from .base import SpaceInformationCollisionModel, collision_model_for, refusing_motions_after
-from .path_optimizer import PathOptimizationResult, PathOptimizerOptions, optimize_path
+from .pso.path_optimizer import PathOptimizationResult, PathOptimizerOptions, optimize_path
 from .request import POST_PARAMS, POST_STEPS, parse_steps, split_spec
 
 __all__ = [

@@ -31,7 +31,7 @@ from typing import Any
 
 from ..errors import ParameterError, UnknownPlannerError, did_you_mean, shown
 from ..foreign import contained
-from .params import ParamSpec, ParamTable
+from ..params import ParamSpec, ParamTable
 
 __all__ = [
     "ENTRY_POINT_GROUP",

@@ -48,10 +48,10 @@ from ..errors import (
     did_you_mean,
     shown,
 )
-from ..model.problem import PlannerConfig, Problem
+from ..model.problem_types import PlannerConfig, Problem
+from ..params import ParamSpec, ParamTable
 from ..validation import check_seconds, check_seed, describe
-from .params import ParamSpec, ParamTable
-from .path_optimizer import PathOptimizerOptions
+from .pso.path_optimizer import PathOptimizerOptions
 from .registry import PlannerEntry, PlannerRegistry, default_registry
 
 __all__ = [
@@ -300,8 +300,10 @@ def resolve(
         origins["post"] = sources.label("post")
     limit = _time_limit(time_limit, cfg, src, sources, origins)
     seed = _seed(seed, cfg, src, sources, origins)
-    mine, theirs = _params(entry, steps, cfg, src, params or {}, sources, origins)
-    request = PlannerRequest(problem, entry, steps, spec_post, mine, theirs, limit, seed, origins)
+    planner_params, post_params = _params(entry, steps, cfg, src, params or {}, sources, origins)
+    request = PlannerRequest(
+        problem, entry, steps, spec_post, planner_params, post_params, limit, seed, origins
+    )
     _check_rules(request, origins)
     return request
 
@@ -413,28 +415,28 @@ def _params(
     (typed YAML: ``"30"`` in quotes is text there, as everywhere in it) under the caller's (text
     is converted, as from the command line)."""
     table = post_table() if steps else ParamTable()
-    mine: dict[str, Any] = {}
-    theirs: dict[str, Any] = {}
+    planner_params: dict[str, Any] = {}
+    post_params: dict[str, Any] = {}
     for text, values in ((False, cfg.params), (True, given)):
         for key, value in values.items():
             label = shown(key)
             origin = sources.label("param", key) if text else f"{src}: planner.params.{label}"
             try:
                 if entry.takes(key) or key not in table:
-                    mine[key] = _spec(entry, table, key).convert(value, entry.name, text)
+                    planner_params[key] = _spec(entry, table, key).convert(value, entry.name, text)
                 else:
-                    theirs[key] = table[key].convert(value, "post-pass", text)
+                    post_params[key] = table[key].convert(value, "post-pass", text)
             except ParameterError as exc:
                 if not text:
                     raise ProblemError(src, f"planner.params.{label}", str(exc)) from None
                 raise ParameterError(exc.detail, exc.name, origin) from None
             origins[f"params.{key}"] = origin
-    if entry.takes("budget") and "budget" not in mine:
+    if entry.takes("budget") and "budget" not in planner_params:
         share = " (the planner's share)" if steps else ""
         origins["params.budget"] = origins["time_limit"] + share
-    if entry.takes("seed") and "seed" not in mine:
+    if entry.takes("seed") and "seed" not in planner_params:
         origins["params.seed"] = origins["seed"]
-    return mine, theirs
+    return planner_params, post_params
 
 
 def _spec(entry: PlannerEntry, post: ParamTable, key: str) -> ParamSpec:

@@ -189,24 +189,9 @@ def simulation_records(problem: Any, frame: RosFrame, sim: Any, msgs: Messages) 
     v, omega = commands(sim.motion, samples[:, 0])
     v = v * frame.scale  # m/s; omega is rad/s in every unit
     robot = problem.robot
-    wheels = None
-    if robot.wheel_radius and robot.track_width:
-        from ..kinematics.diffdrive import wheel_speeds
-
-        # Eqs. 9-12: the wheels' angular speeds, rad/s (units cancel).
-        _, _, w_right, w_left = wheel_speeds(
-            v, omega, robot.track_width * frame.scale, robot.wheel_radius * frame.scale
-        )
-        wheels = np.column_stack([w_right, w_left])
+    wheels = _wheel_speeds(robot, frame, v, omega)
     xy = frame.metres(samples[:, 1:3])
-    stride = max(1, math.ceil(n * len(sim.tracks) / MAX_MOVING))
-    shown = np.zeros(n, dtype=bool)
-    if sim.tracks:
-        shown[::stride] = True
-        shown[-1] = True
-    centres = (
-        np.stack([tr.position(samples[:, 0]) for tr in sim.tracks], axis=1) if sim.tracks else None
-    )
+    shown, centres = _moving_samples(sim.tracks, samples[:, 0])
     radii = [tr.radius for tr in sim.tracks]
     for k, (t, yaw) in enumerate(zip(samples[:, 0].tolist(), samples[:, 3].tolist(), strict=True)):
         add(t, "/odom", msgs.odometry(xy[k], yaw, v[k], omega[k], t))
@@ -221,6 +206,31 @@ def simulation_records(problem: Any, frame: RosFrame, sim: Any, msgs: Messages) 
                 moving_markers(msgs, centres[k], radii, robot.radius, frame.scale, t),
             )
     return records
+
+
+def _wheel_speeds(robot: Any, frame: RosFrame, v: np.ndarray, omega: np.ndarray):
+    """Eqs. 9-12: the right and left wheels' angular speeds, rad/s, as ``(n, 2)`` (units
+    cancel); None when the robot has no ``wheel_radius`` and ``track_width``."""
+    if not (robot.wheel_radius and robot.track_width):
+        return None
+    from ..kinematics.diffdrive import wheel_speeds
+
+    _, _, w_right, w_left = wheel_speeds(
+        v, omega, robot.track_width * frame.scale, robot.wheel_radius * frame.scale
+    )
+    return np.column_stack([w_right, w_left])
+
+
+def _moving_samples(tracks: list, times: np.ndarray):
+    """Which samples carry ``/moving_obstacles`` (every k-th, and the last, so that at most
+    :data:`MAX_MOVING` positions are written) and the obstacles' centres at every sample."""
+    n = len(times)
+    shown = np.zeros(n, dtype=bool)
+    if not tracks:
+        return shown, None
+    shown[:: max(1, math.ceil(n * len(tracks) / MAX_MOVING))] = True
+    shown[-1] = True
+    return shown, np.stack([tr.position(times) for tr in tracks], axis=1)
 
 
 def plan_poses(frame: RosFrame, path: Any) -> Any:

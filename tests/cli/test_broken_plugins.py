@@ -79,11 +79,11 @@ class Crash(ob.Planner):
         return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
 
 
-from rrtpso_ompl.dynamic.strategies import Blind
+from rrtpso_ompl.dynamic.strategies import NoReplanning
 from rrtpso_ompl.planners.registry import PlannerEntry
 
 
-class Crashy(Blind):
+class Crashy(NoReplanning):
     """Raises in its simulation (a plugin)."""
 
     name = "crashy"

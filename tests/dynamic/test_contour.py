@@ -68,12 +68,12 @@ def test_a_shorter_wait_would_collide():
 def test_global_replanning_has_no_wait_candidate():
     problem = corridor([{"radius": 28.5, "start": [250, 440], "speed": 20, "heading_deg": -90}])
     from rrtpso_ompl.dynamic import ReplanningManager
-    from rrtpso_ompl.dynamic.strategies import Global
+    from rrtpso_ompl.dynamic.strategies import WholePath
 
     _, turn = manager_for(problem)
     opts = DynamicOptions(replan_time=0.6, planner="RRTstar")
     manager = ReplanningManager(problem, opts, 20.0, turn, 5.7, np.random.default_rng(0),
-                                policy=Global.policy)  # fmt: skip
+                                policy=WholePath.policy)  # fmt: skip
     plan = Motion.from_path(np.array([problem.start, problem.goal]), 0.0, None, 20.0, turn)
     obs = observe(problem, 3.0)
     _, rec = manager.react(3.0, plan, obs, predict_threats(plan, 3.0, obs, 28.5, 2.85))

@@ -23,7 +23,7 @@ from rrtpso_ompl.dynamic import (
     simulate,
 )
 from rrtpso_ompl.dynamic.manager import FALLBACK_KINDS
-from rrtpso_ompl.dynamic.strategies import DWA, Blind, Contour, DWAOptions, Global
+from rrtpso_ompl.dynamic.strategies import DWA, Contour, DWAOptions, NoReplanning, WholePath
 from rrtpso_ompl.errors import ParameterError
 from rrtpso_ompl.model.problem import load_problem
 
@@ -36,7 +36,7 @@ DYNAMIC = REPO / "rrtpso_ompl" / "dynamic"
 def test_first_party_strategies_are_registered_in_order():
     reg = default_strategies()
     assert reg.names()[:4] == ["contour", "global", "none", "dwa"]
-    assert [reg.get(n) for n in reg.names()[:4]] == [Contour, Global, Blind, DWA]
+    assert [reg.get(n) for n in reg.names()[:4]] == [Contour, WholePath, NoReplanning, DWA]
     for name in reg.names()[:4]:
         assert reg.description(name) and "\n" not in reg.description(name)
 
@@ -45,7 +45,7 @@ def test_a_taken_name_and_a_non_strategy_are_refused():
     reg = StrategyRegistry()
     reg.load_first_party()
 
-    class Shadow(Blind):
+    class Shadow(NoReplanning):
         name = "contour"
 
     with pytest.raises(ValueError, match="'contour' is already registered"):
@@ -53,7 +53,7 @@ def test_a_taken_name_and_a_non_strategy_are_refused():
     with pytest.raises(TypeError, match="strategy class"):
         reg.register(object, "a plugin")
 
-    class BadOptions(Blind):
+    class BadOptions(NoReplanning):
         name = "bad_options"
         options = dict
 
@@ -87,7 +87,7 @@ def test_a_broken_plugin_is_skipped_with_a_warning(monkeypatch, caplog):
         def load(self):
             raise ImportError("no module named nowhere")
 
-    class Good(Blind):
+    class Good(NoReplanning):
         name = "good_plugin"
 
     class GoodEP:

@@ -302,7 +302,7 @@ def test_a_kind_is_one_class_and_one_registration(tmp_path):
     """A new kind (a field of squares) declared and registered here is generated, named in
     headers, and has its flags, like the built-in ones."""
     from rrtpso_ompl.groundtruth.generate import GeneratorOptions, register_kind
-    from rrtpso_ompl.planners.params import declared, param
+    from rrtpso_ompl.params import declared, param
 
     @register_kind
     @declared

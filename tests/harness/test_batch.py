@@ -81,24 +81,6 @@ def test_only_a_solved_row_gets_a_ratio():
     assert solved.ratio == pytest.approx(210.0 / solved.optimum)
 
 
-def test_the_old_evaluation_package_still_imports_and_warns():
-    """rrtpso_ompl.evaluation was split into harness and groundtruth; old imports keep working."""
-    import importlib
-    import sys
-    import warnings
-
-    sys.modules.pop("rrtpso_ompl.evaluation", None)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        old = importlib.import_module("rrtpso_ompl.evaluation")
-        from rrtpso_ompl.evaluation.optimum import shortest_path
-    from rrtpso_ompl.groundtruth import shortest_path as new
-    from rrtpso_ompl.harness import run_batch
-
-    assert shortest_path is new and old.run_batch is run_batch
-    assert any(issubclass(w.category, DeprecationWarning) for w in caught)
-
-
 # -- issue 32: nothing skipped, duplicated or mixed without a word ------------------------------
 def test_a_folder_names_every_entry_that_looks_like_a_problem_and_is_none(folder, tmp_path):
     """A fifo, a socket, a link to nothing, a loop of links and a directory named like a problem

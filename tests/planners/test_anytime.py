@@ -11,8 +11,8 @@ from rrtpso_ompl.groundtruth.generate import generate
 from rrtpso_ompl.model import World, load_problem, problem_from_dict
 from rrtpso_ompl.model.geometry import path_length, shortcut
 from rrtpso_ompl.planners import solve
-from rrtpso_ompl.planners.path_optimizer import PathOptimizerOptions, _refine, optimize_path
-from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSO
+from rrtpso_ompl.planners.pso.path_optimizer import PathOptimizerOptions, _refine, optimize_path
+from rrtpso_ompl.planners.rrtstar_pso.planner import RRTstarPSO
 
 
 def test_refinement_fires_for_a_point_robot():
@@ -57,15 +57,16 @@ def test_shortcut_stops_when_told_and_stays_valid():
 
 
 def test_stall_is_relative_and_looks_back_only_since_a_resume():
-    p = RRTstarPSO.__new__(RRTstarPSO)
-    p._values = {"stall_fraction": 0.25}
+    from rrtpso_ompl.planners.rrtstar_pso.rrtstar_stage import stalled
+
     flat = [(0.1, 100.0), (0.2, 99.99), (0.4, 99.98)]
-    assert p._stalled(flat, 0.4, 1.0, 0.0)  # less than 0.1 % over the last quarter
-    assert not p._stalled(flat, 0.4, 1.0, 0.3)  # resumed at 0.3: not a quarter yet
+    assert stalled(flat, 0.4, 1.0, 0.0, 0.25)  # less than 0.1 % over the last quarter
+    assert not stalled(flat, 0.4, 1.0, 0.3, 0.25)  # resumed at 0.3: not a quarter yet
     falling = [(0.1, 100.0), (0.2, 95.0), (0.4, 90.0)]
-    assert not p._stalled(falling, 0.4, 1.0, 0.0)
+    assert not stalled(falling, 0.4, 1.0, 0.0, 0.25)
     scaled = [(t, c * 1e-3) for t, c in flat]  # the same world at another scale
-    assert p._stalled(scaled, 0.4, 1.0, 0.0)
+    assert stalled(scaled, 0.4, 1.0, 0.0, 0.25)
+    assert not stalled(flat, 0.4, 1.0, 0.0, 0.0)  # stall_fraction 0: never
 
 
 #: Issue 13's narrow maze: corridors 1.3 % of the width, a point robot (RRT* alone finds no path
@@ -90,12 +91,13 @@ def test_the_corridor_stage_finds_a_path_through_a_narrow_maze():
 
 
 def test_without_a_corridor_path_bitstar_finds_the_first_path_through_a_narrow_maze():
-    """The fallback itself (``_connect``), bounded by its first path (BIT* stops there), not
-    by seconds: the end it is given is a cap two orders of magnitude away."""
+    """The fallback itself (``connect_with_bitstar``), bounded by its first path (BIT* stops
+    there), not by seconds: the end it is given is a cap two orders of magnitude away."""
     from ompl import base as ob
 
     from rrtpso_ompl.ompl_setup import make_context, path_to_array, seed_ompl
-    from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSOStats
+    from rrtpso_ompl.planners.rrtstar_pso.planner import RRTstarPSOStats
+    from rrtpso_ompl.planners.rrtstar_pso.rrtstar_stage import connect_with_bitstar
 
     maze = _narrow_maze()
     seed_ompl(1)
@@ -104,9 +106,9 @@ def test_without_a_corridor_path_bitstar_finds_the_first_path_through_a_narrow_m
     ctx.ss.setPlanner(planner)
     ctx.ss.setup()
     stats = RRTstarPSOStats()
-    planner._connect(ob.PlannerTerminationCondition(lambda: False), time.perf_counter() + 120,
-                     stats)  # fmt: skip
     pdef = ctx.ss.getProblemDefinition()
+    connect_with_bitstar(ctx.si, pdef, ob.PlannerTerminationCondition(lambda: False),
+                         time.perf_counter() + 120, stats)  # fmt: skip
     assert stats.first_solution == "BITstar" and pdef.hasExactSolution()
     assert World.from_problem(maze).path_valid(path_to_array(pdef.getSolutionPath()))
 
@@ -128,7 +130,7 @@ def test_rrtstarpso_gives_its_swarm_the_rest_of_the_budget(monkeypatch):
     they pay: ``test_a_budget_is_used_by_further_rounds_while_they_pay``) and a deadline at the
     budget's end less the reserve for handing the path over, both from the planner's own start."""
     from rrtpso_ompl.planners import post
-    from rrtpso_ompl.planners.rrtstar_pso import FINISH_RESERVE
+    from rrtpso_ompl.planners.rrtstar_pso.planner import FINISH_RESERVE
 
     calls = []
     original = post.PSOPathOptimizer.optimize_array

@@ -19,7 +19,7 @@ from ompl import geometric as og
 
 from rrtpso_ompl.errors import PlannerError, UnsupportedSpaceError
 from rrtpso_ompl.planners import PSOPlanner, RRTstarPSO, default_registry
-from rrtpso_ompl.planners.exact import ExactPlanner
+from rrtpso_ompl.planners.baselines.exact import ExactPlanner
 
 PLANNERS = [RRTstarPSO, PSOPlanner, ExactPlanner]
 #: The logger that reports a refusal (the base class's).

@@ -8,7 +8,7 @@ import numpy as np
 from helpers import PROBLEMS
 
 from rrtpso_ompl.model import World, load_problem
-from rrtpso_ompl.planners.rrtstar_pso import RANGE_PER_CLEARANCE, clutter_range
+from rrtpso_ompl.planners.rrtstar_pso.planner import RANGE_PER_CLEARANCE, clutter_range
 
 
 def _lattice(n: int) -> World:

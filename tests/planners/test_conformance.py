@@ -15,9 +15,9 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from rrtpso_ompl.model import problem_from_dict
+from rrtpso_ompl.params import ParamSpec, ParamTable
 from rrtpso_ompl.planners import default_registry
 from rrtpso_ompl.planners.base import PlannerStats, PythonPlanner
-from rrtpso_ompl.planners.params import ParamSpec, ParamTable
 from rrtpso_ompl.planners.registry import PlannerEntry
 from rrtpso_ompl.testing import (
     CHECKS,

@@ -10,7 +10,7 @@ from rrtpso_ompl.groundtruth import shortest_path
 from rrtpso_ompl.model import World, load_problem
 from rrtpso_ompl.model.objective import InflationCost
 from rrtpso_ompl.model.problem import problem_from_dict
-from rrtpso_ompl.planners.costroute import cost_route, drop_waypoints
+from rrtpso_ompl.planners.rrtstar_pso.costroute import cost_route, drop_waypoints
 
 DOOR = INFLATED_DOOR
 

@@ -15,7 +15,7 @@ from ompl import geometric as og
 from rrtpso_ompl.groundtruth.optimum import shortest_path
 from rrtpso_ompl.model.problem import load_problem, problem_from_dict
 from rrtpso_ompl.planners import default_registry, solve
-from rrtpso_ompl.planners.exact import ExactPlanner
+from rrtpso_ompl.planners.baselines.exact import ExactPlanner
 
 
 def test_registered_by_name():

@@ -21,7 +21,7 @@ from ompl import geometric as og
 from rrtpso_ompl.ompl_setup import array_to_path, path_to_array
 from rrtpso_ompl.planners import PSOPathOptimizer
 from rrtpso_ompl.planners.base import SpaceInformationCollisionModel
-from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSO
+from rrtpso_ompl.planners.rrtstar_pso.planner import RRTstarPSO
 
 # The deadlines below are the conformance kit's, ``DEADLINE_FACTOR x budget + DEADLINE_SLACK``
 # (1.5 x budget + 1 s): a loaded machine holds them. The 5 % is measured by

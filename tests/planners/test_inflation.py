@@ -15,8 +15,8 @@ from rrtpso_ompl.model.objective import InflationCost
 from rrtpso_ompl.model.problem import problem_from_dict
 from rrtpso_ompl.ompl_setup import array_to_path, make_context, path_to_array
 from rrtpso_ompl.planners import solve
-from rrtpso_ompl.planners.path_optimizer import optimize_path
 from rrtpso_ompl.planners.post import run_post
+from rrtpso_ompl.planners.pso.path_optimizer import optimize_path
 
 DOOR = INFLATED_DOOR
 

@@ -7,10 +7,10 @@ import dataclasses
 import pytest
 
 from rrtpso_ompl.errors import ParameterError, RrtpsoError
+from rrtpso_ompl.params import ParamSpec, ParamTable, Rule
 from rrtpso_ompl.planners import PathOptimizerOptions, PSOOptions, default_registry
-from rrtpso_ompl.planners.params import ParamSpec, ParamTable, Rule
-from rrtpso_ompl.planners.path_optimizer import OPTIMIZER_PARAMS
-from rrtpso_ompl.planners.swarm import SWARM_PARAMS
+from rrtpso_ompl.planners.pso.path_optimizer import OPTIMIZER_PARAMS
+from rrtpso_ompl.planners.pso.swarm import SWARM_PARAMS
 
 TABLE = ParamTable(
     ParamSpec("a", float, 1.0, "first", low=0.0, high=3.0),
@@ -100,7 +100,7 @@ def test_markdown_lists_every_parameter_in_order():
 
 
 def test_declared_option_sets_are_dataclasses_with_one_declaration_per_field():
-    from rrtpso_ompl.planners.params import Rule, declared, param
+    from rrtpso_ompl.params import Rule, declared, param
 
     @declared(rules=[Rule(("lo", "hi"), lambda lo, hi: lo <= hi, "lo <= hi")])
     class Window:
@@ -139,7 +139,7 @@ def test_declared_fields_may_be_optional_or_fixed_tuples():
     """A default that depends on other values is None (the doc says what it stands for), and a
     range is a pair, each value checked against the declared range (issue 23: the generator's
     radius_range and vertices)."""
-    from rrtpso_ompl.planners.params import declared, param
+    from rrtpso_ompl.params import declared, param
 
     @declared
     class Field:

@@ -11,7 +11,7 @@ from helpers import SINGLE_CIRCLE_OPTIMUM
 
 from rrtpso_ompl.model.geometry import path_length, shortcut
 from rrtpso_ompl.model.world import World
-from rrtpso_ompl.planners.path_optimizer import (
+from rrtpso_ompl.planners.pso.path_optimizer import (
     PathOptimizerOptions,
     optimize_path,
     turning_angles,

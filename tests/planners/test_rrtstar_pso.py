@@ -15,7 +15,7 @@ from rrtpso_ompl.errors import ParameterError
 from rrtpso_ompl.ompl_setup import make_context
 from rrtpso_ompl.planners import PSOPathOptimizer, solve
 from rrtpso_ompl.planners.registry import default_registry
-from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSO
+from rrtpso_ompl.planners.rrtstar_pso.planner import RRTstarPSO
 
 REGISTRY = default_registry()
 
@@ -72,7 +72,7 @@ def test_the_rrtstar_stage_stops_when_its_share_of_the_budget_ends(single_circle
     a fresh budget it returns by itself (the outer condition still never fires)."""
     import time
 
-    from rrtpso_ompl.planners.rrtstar_pso import RRTstarPSOStats
+    from rrtpso_ompl.planners.rrtstar_pso.planner import RRTstarPSOStats
 
     _ctx, planner = _make(single_circle, "RRTstarPSO", 0.2)
     never = ob.PlannerTerminationCondition(lambda: False)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from rrtpso_ompl.errors import ParameterError
-from rrtpso_ompl.planners.swarm import SWARM_PARAMS, PSOOptions, minimize
+from rrtpso_ompl.planners.pso.swarm import SWARM_PARAMS, PSOOptions, minimize
 
 
 def sphere(x):
@@ -476,7 +476,7 @@ def test_the_first_evaluation_of_a_swarm_with_a_deadline_stops_between_particles
 def test_blocks_are_independent_swarms_that_beat_one_swarm_over_everything():
     """A separable cost: 12 blocks of 2 coordinates each with its own minimum. Per-block bests
     reach every minimum; one swarm over all 24 coordinates, same evaluations, does worse."""
-    from rrtpso_ompl.planners.swarm import PSOOptions, minimize
+    from rrtpso_ompl.planners.pso.swarm import PSOOptions, minimize
 
     k, d = 12, 2
     target = np.random.default_rng(0).uniform(-5, 5, size=(k, d))

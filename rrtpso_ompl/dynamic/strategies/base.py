@@ -2,7 +2,7 @@
 
 A strategy is a class with a ``name`` (what ``rrtpso simulate --strategy`` and
 ``DynamicOptions.strategy`` take), a docstring (its description in listings), ``options`` (the
-option set of its own, a class declared with :func:`~rrtpso_ompl.planners.params.declared`, or
+option set of its own, a class declared with :func:`~rrtpso_ompl.params.declared`, or
 None when :class:`~rrtpso_ompl.dynamic.options.DynamicOptions` says all it needs) and one method,
 :meth:`Strategy.simulate`, that drives one run. Its constructor takes an instance of ``options``
 (or None for the defaults). The registry (:mod:`rrtpso_ompl.dynamic.registry`) holds the
@@ -16,7 +16,7 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
-from ...model.problem import Problem
+from ...model.problem_types import Problem
 from ..options import DynamicOptions
 from ..result import SimulationResult
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from ..replanning import ReplanningStrategy
 
-__all__ = ["Blind"]
+__all__ = ["NoReplanning"]
 
 
-class Blind(ReplanningStrategy):
+class NoReplanning(ReplanningStrategy):
     """Never replan: drive the static path blindly (a baseline)."""
 
     name = "none"

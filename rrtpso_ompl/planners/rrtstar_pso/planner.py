@@ -1,6 +1,6 @@
 """RRTstarPSO: OMPL's RRT* followed by the particle swarm over its waypoints (the paper's RRT*PSO).
 
-0. The corridor stage (:mod:`rrtpso_ompl.planners.corridor`) looks at every way round the
+0. The corridor stage (:mod:`.corridor`) looks at every way round the
    obstacles at once, on a lattice of the free space, and pulls the best route taut: a first
    path in milliseconds, in the right corridor, also through mazes that RRT*'s tree would not
    cross in time.
@@ -36,10 +36,11 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from ..model.geometry import path_length, shortcut
-from ..model.world import World
-from ..ompl_setup import array_to_path, path_to_array
-from .base import (
+from ...model.geometry import path_length, shortcut
+from ...model.world import World
+from ...ompl_setup import array_to_path, path_to_array
+from ...params import ParamSpec, ParamTable
+from ..base import (
     BUDGET,
     SEED,
     PlannerStats,
@@ -48,14 +49,14 @@ from .base import (
     collision_model_for,
     refusing_motions_after,
 )
-from .corridor import search
+from ..baselines.ompl_planners import RRTSTAR_PARAMS
+from ..post import PSOPathOptimizer, inflation_of, simplify_until
+from ..pso.path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
+from ..pso.swarm import SWARM_PARAMS
+from ..result import BenchmarkRun
+from .corridor import find_corridor_path
 from .costroute import cost_route
-from .ompl_planners import RRTSTAR_PARAMS
-from .params import ParamSpec, ParamTable
-from .path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
-from .post import PSOPathOptimizer, inflation_of, simplify_until
-from .result import BenchmarkRun
-from .swarm import SWARM_PARAMS
+from .rrtstar_stage import INFLATION_RRT_MIN, INFLATION_RRT_SHARE, grow_rrtstar
 
 #: The RRT* parameters RRTstarPSO passes on to its inner og.RRTstar.
 _INNER = ("range", "goal_bias", "rewire_factor", "informed_sampling", "tree_pruning")
@@ -126,7 +127,7 @@ class RRTstarPSOStats(PlannerStats):
     describe the corridor stage (``corridor_cells``: its lattice's cells; ``corridor_reason``:
     why it has no path);
     ``costroute_time`` the re-routing of the best candidate through the cheapest cells under an
-    inflation cost (:mod:`~rrtpso_ompl.planners.costroute`; its path is a candidate,
+    inflation cost (:mod:`~rrtpso_ompl.planners.rrtstar_pso.costroute`; its path is a candidate,
     ``"costroute"``).
     ``range_used`` is the inner RRT*'s range, the one chosen for the world when the ``range``
     parameter is 0 (the parameter itself stays as the user set it).
@@ -209,11 +210,6 @@ _CORRIDOR_NO_ROUTE_SHARE = 0.5
 #: Share of the budget kept back for handing the path over (the last checks, OMPL's path): the
 #: stages aim to be done by the rest.
 FINISH_RESERVE = 0.03
-
-#: RRT*'s share of the budget under an inflation cost when the corridor stage has a path.
-INFLATION_RRT_SHARE = 0.1
-#: ... and none when that share is under this many seconds (:meth:`RRTstarPSO._rrt_futile`).
-INFLATION_RRT_MIN = 0.05
 
 #: RRT*'s automatic range is at most this many times the median clearance of free points.
 RANGE_PER_CLEARANCE = 10.0
@@ -332,21 +328,21 @@ class RRTstarPSO(PythonPlanner):
         return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
 
     def _corridor(self, ptc, t0: float, stats: RRTstarPSOStats) -> np.ndarray | None:
-        """Stage 0: the corridor stage's path (:func:`~rrtpso_ompl.planners.corridor.search`
+        """Stage 0: the corridor stage's path (:func:`.corridor.find_corridor_path`
         within ``corridor_fraction`` of the budget; with no route at all, up to
         :data:`_CORRIDOR_NO_ROUTE_SHARE` of it), or None."""
-        v = self._values
-        if v["corridor_cells"] <= 0:
+        params = self._values
+        if params["corridor_cells"] <= 0:
             stats.corridor_reason = "off"
             return None
         start, goal = self._start_and_goal(ptc)
         if start is None or goal is None:
             stats.corridor_reason = "no start or goal state"
             return None
-        budget = v["budget"]
-        cells = v["corridor_cells"]
-        seconds = v["corridor_fraction"] * budget if budget > 0 else None
-        if v["rrt_max_iterations"] > 0:
+        budget = params["budget"]
+        cells = params["corridor_cells"]
+        seconds = params["corridor_fraction"] * budget if budget > 0 else None
+        if params["rrt_max_iterations"] > 0:
             # Iteration-bounded (reproducible) runs: a lattice sized by the clock would differ
             # from run to run; a fixed one does not.
             seconds, cells = None, min(cells, REPRODUCIBLE_CORRIDOR_CELLS)
@@ -360,8 +356,16 @@ class RRTstarPSO(PythonPlanner):
                 return None
         t1 = time.perf_counter()
         more = None if seconds is None else t0 + _CORRIDOR_NO_ROUTE_SHARE * budget - t1
-        result = search(self._model, start, goal, seconds, cells, ptc, v["corridor_alternatives"],
-                        no_route_seconds=more)  # fmt: skip
+        result = find_corridor_path(
+            self._model,
+            start,
+            goal,
+            seconds,
+            cells,
+            ptc,
+            params["corridor_alternatives"],
+            no_route_seconds=more,
+        )
         stats.corridor_time = time.perf_counter() - t1
         stats.corridor_cells = result.lattice.n_cells if result.lattice else 0
         stats.corridor_routes = result.routes
@@ -546,50 +550,14 @@ class RRTstarPSO(PythonPlanner):
     def _resumable(self, t0: float, ptc) -> bool:
         """Whether the anytime loop may grow RRT* again: a time budget with time left that the
         swarm did not use, and no iteration cap (which keeps runs reproducible)."""
-        v = self._values
-        if v["budget"] <= 0 or v["stall_fraction"] <= 0 or v["rrt_max_iterations"] > 0:
+        budget = self._values["budget"]
+        if budget <= 0 or self._values["stall_fraction"] <= 0:
             return False
-        if self._inflation is not None and INFLATION_RRT_SHARE * v["budget"] < INFLATION_RRT_MIN:
+        if self._values["rrt_max_iterations"] > 0:
+            return False
+        if self._inflation is not None and INFLATION_RRT_SHARE * budget < INFLATION_RRT_MIN:
             return False  # RRT* cannot help in what is left (:meth:`_rrt_futile`)
-        return not ptc() and time.perf_counter() < t0 + 0.98 * v["budget"]
-
-    def _has_exact(self) -> bool:
-        pdef = self.getProblemDefinition()
-        return pdef.hasSolution() and not pdef.hasApproximateSolution()
-
-    def _stalled(
-        self, progress: list[tuple[float, float]], elapsed: float, budget: float, since: float
-    ) -> bool:
-        """Whether RRT*'s best cost fell by less than 0.1 % over the last ``stall_fraction`` of
-        the budget (relative, so the same on every scale), looking no further back than
-        ``since`` (seconds into the solve)."""
-        window = self._values["stall_fraction"] * budget
-        if window <= 0 or not progress or elapsed < max(progress[0][0], since) + window:
-            return False
-        then = [c for t, c in progress if t <= elapsed - window]
-        if not then:
-            return False
-        now = progress[-1][1]
-        return then[-1] - now <= 1e-3 * now
-
-    def _connect(self, ptc, end: float, stats: RRTstarPSOStats) -> None:
-        """OMPL's BIT* on the same problem until ``end`` or its first path: through narrow
-        passages that RRT*'s single tree has not crossed yet.
-
-        Measured on narrow unique-solution mazes (point robot, corridors 1-2 % of the width):
-        RRTConnect found no path in 4 s where BIT*, whose batches of samples are searched as a
-        graph, found one in under a second (docs/benchmarking.md).
-        """
-        pdef = self.getProblemDefinition()
-        pdef.clearSolutionPaths()  # RRT*'s approximate path, if any
-        connect = og.BITstar(self.getSpaceInformation())
-        connect.setStopOnSolnImprovement(True)  # the first path is all it is asked for
-        connect.setProblemDefinition(pdef)
-        connect.setup()
-        left = max(end - time.perf_counter(), 1e-4)
-        connect.solve(ob.plannerOrTerminationCondition(
-            ptc, ob.timedPlannerTerminationCondition(left)))  # fmt: skip
-        stats.first_solution = "BITstar"
+        return not ptc() and time.perf_counter() < t0 + 0.98 * budget
 
     def _rrt_futile(self, corridor) -> bool:
         """Under an inflation cost with the corridor stage's path in hand, RRT* is left out when
@@ -608,64 +576,8 @@ class RRTstarPSO(PythonPlanner):
         resume: bool = False,
         fallback: bool = True,
     ) -> None:
-        """Grow RRT* until its share of the budget, its iteration cap or the outer condition, or
-        until its best cost stalls (the swarm gets the rest); with no path at ``connect_after``
-        of its share (and ``fallback``: no corridor path either), BIT* looks for the first one.
-        ``resume`` grows the tree on after a swarm run, for at most 70 % of the time left.
-
-        The tree is grown in short slices (repeated ``solve`` calls continue the same tree) so that
-        the best cost can be sampled over time: OMPL's progress properties are not reachable from
-        Python.
-        """
-        values = self._values
-        budget = values["budget"]
-        t_begin = time.perf_counter()
-        # RRT*'s share of what the corridor stage left.
-        share = values["rrt_time_fraction"]
-        if self._inflation is not None and not fallback:
-            # With the corridor's path in hand and every motion's cost a Python call (10-30
-            # times fewer vertices a second), the cost route and the swarm make better use of it.
-            share = min(share, INFLATION_RRT_SHARE)
-        rrt_end = t_begin + share * max(t0 + budget - t_begin, 0.0) if budget > 0 else None
-        if resume:  # grown on after a swarm run: until a stall again, or 70 % of what is left
-            rrt_end = t_begin + 0.7 * max(t0 + budget - t_begin, 0.0)
-        max_iter = values["rrt_max_iterations"]
-        start_iter = self.inner.numIterations()
-        inner_cost = self.inner.bestCost
-
-        if max_iter > 0:
-            # Iteration-bounded: one call with a Python condition that RRT* polls once per
-            # iteration (no period, so no checker thread and no GIL deadlock).
-            def stop() -> bool:
-                return (
-                    self.inner.numIterations() - start_iter >= max_iter
-                    or ptc()
-                    or (rrt_end is not None and time.perf_counter() >= rrt_end)
-                )
-
-            self.inner.solve(ob.PlannerTerminationCondition(stop))
-        else:
-            slice_s = 0.05 if budget <= 0 else max(0.01, values["rrt_time_fraction"] * budget / 20)
-            connect_at = None
-            if rrt_end is not None and values["connect_after"] < 1.0 and not resume:
-                connect_at = t_begin + values["connect_after"] * (rrt_end - t_begin)
-            while not ptc():
-                now = time.perf_counter()
-                if rrt_end is not None and now >= rrt_end:
-                    break
-                if connect_at is not None and now >= connect_at and not self._has_exact():
-                    if fallback:
-                        self._connect(ptc, rrt_end, stats)
-                    break  # with the corridor's path in hand, the swarm gets the time instead
-                if self._stalled(stats.rrt_progress, now - t0, budget, t_begin - t0):
-                    break
-                step = slice_s if rrt_end is None else min(slice_s, rrt_end - now)
-                sub = ob.plannerOrTerminationCondition(
-                    ptc, ob.timedPlannerTerminationCondition(max(step, 1e-4))
-                )
-                self.inner.solve(sub)
-                cost = inner_cost().value()
-                if np.isfinite(cost):
-                    stats.rrt_progress.append((time.perf_counter() - t0, float(cost)))
-        stats.rrt_time += time.perf_counter() - t_begin
-        stats.rrt_iterations += self.inner.numIterations() - start_iter
+        """Stage 1: :func:`.rrtstar_stage.grow_rrtstar` on this planner's inner RRT*."""
+        grow_rrtstar(
+            self.inner, self.getProblemDefinition(), self._values, ptc, t0, stats,
+            inflation=self._inflation is not None, resume=resume, fallback=fallback,
+        )  # fmt: skip

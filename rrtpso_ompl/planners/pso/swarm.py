@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .params import Rule, declared, param
+from ...params import Rule, declared, param
 
 __all__ = ["SWARM_PARAMS", "PSOOptions", "PSOResult", "minimize"]
 
@@ -140,12 +140,11 @@ def minimize(
     init : (n_particles, dims) array_like, optional
         Initial positions; uniform in the box when omitted. Its rows are clipped to the box.
     init_velocity : (n_particles, dims) array_like, optional
-        Initial velocities; zero when omitted (the paper's step 1 uses random velocities; zero is
-        the standard choice when the swarm is seeded around a known solution, as RRT*PSO does).
+        Initial velocities; zero when omitted (the paper's step 1 draws them; zero is standard
+        when the swarm is seeded around a known solution, as RRT*PSO's is).
     v_max : float, optional
-        Velocity clamp per dimension, in the unit of the positions (``|V| <= v_max``); None for
-        no clamp. It depends on the problem's scale, so the caller derives it (it is not one of
-        the swarm's declared parameters).
+        Velocity clamp per dimension (``|V| <= v_max``), in the unit of the positions, derived
+        by the caller from the problem's scale; None for no clamp.
     terminate : callable, optional
         Polled once per iteration; the run stops when it returns True (e.g. OMPL's
         ``PlannerTerminationCondition``).
@@ -153,15 +152,40 @@ def minimize(
         Independent blocks of ``dims / blocks`` coordinates (see the module docstring); the cost
         then returns ``(n_particles, blocks)``.
     deadline : float, optional
-        ``time.perf_counter()`` seconds: the run stops before an iteration whose evaluation,
-        as long as the last one, would end after it (an evaluation cannot be interrupted, and
-        near a detailed polygon one can take a sizeable share of a short budget).
+        ``time.perf_counter()`` seconds: the run stops before an iteration whose evaluation, as
+        long as the last one, would end after it (an evaluation cannot be interrupted).
 
     Returns
     -------
     PSOResult
     """
     t0 = time.perf_counter()
+    lower, upper = _checked_box(lower, upper, blocks, v_max)
+    x, v = _initial_swarm(lower, upper, options.swarm_size, rng, init, init_velocity)
+
+    def evaluate(pos: np.ndarray) -> np.ndarray:
+        return np.asarray(cost(pos), dtype=float).reshape(len(pos), blocks)
+
+    f, cut, t_eval = _first_evaluation(evaluate, x, deadline, blocks)
+    best = _Bests.start(x, f, blocks)
+    history = [best.cost]
+    stopped_by = "deadline"
+    if not cut:
+        stopped_by = _iterate(evaluate, x, v, best, history, options, rng, (lower, upper, v_max),
+                              (terminate, deadline, t_eval))  # fmt: skip
+    return PSOResult(
+        position=best.gbest_x,
+        cost=best.cost,
+        history=np.asarray(history),
+        n_iterations=len(history) - 1,
+        n_evaluations=len(x) * len(history),  # the first swarm, then one per iteration
+        time=time.perf_counter() - t0,
+        stopped_by=stopped_by,
+    )
+
+
+def _checked_box(lower, upper, blocks: int, v_max: float | None):
+    """``(lower, upper)`` as float arrays, once ``blocks`` and ``v_max`` are checked."""
     lower = np.asarray(lower, dtype=float)
     upper = np.asarray(upper, dtype=float)
     dims = lower.shape[0]
@@ -169,50 +193,43 @@ def minimize(
         raise ValueError(f"blocks must divide the {dims} dimensions, got {blocks}")
     if v_max is not None and not v_max > 0:
         raise ValueError(f"v_max must be > 0 or None, got {v_max}")
-    x, v = _initial_swarm(lower, upper, options.swarm_size, rng, init, init_velocity)
+    return lower, upper
 
-    def evaluate(pos: np.ndarray) -> np.ndarray:
-        return np.asarray(cost(pos), dtype=float).reshape(len(pos), blocks)
 
+def _first_evaluation(evaluate, x: np.ndarray, deadline: float | None, blocks: int):
+    """The first swarm's costs, whether the deadline cut it short, and its seconds."""
     t_eval = time.perf_counter()
     cut = False
     if deadline is None:
         f = evaluate(x)
     else:
         f, cut = _first_costs(evaluate, x, deadline, blocks)
-    t_eval = time.perf_counter() - t_eval
-    best = _Bests.start(x, f, blocks)
-    history = [best.cost]
-    n_eval = len(x)
+    return f, cut, time.perf_counter() - t_eval
+
+
+def _iterate(evaluate, x, v, best: _Bests, history: list, options: PSOOptions, rng, box,
+             stop) -> str:  # fmt: skip
+    """The iterations of eqs. 4-5 after the first evaluation, appending each iteration's best
+    cost to ``history``; returns why they stopped. ``box = (lower, upper, v_max)``, ``stop =
+    (terminate, deadline, seconds the last evaluation took)``."""
+    lower, upper, v_max = box
+    terminate, deadline, t_eval = stop
     w = options.w
-    stopped_by = "deadline" if cut else "iterations"
-    for k in range(1, 0 if cut else options.iterations + 1):
+    for k in range(1, options.iterations + 1):
         if terminate is not None and terminate():
-            stopped_by = "terminate"
-            break
+            return "terminate"
         if deadline is not None and time.perf_counter() + t_eval > deadline:
-            stopped_by = "deadline"
-            break
+            return "deadline"
         x, v = _move(x, v, best, w, options, rng, lower, upper, v_max)
         t_eval = time.perf_counter()
         f = evaluate(x)
         t_eval = time.perf_counter() - t_eval
-        n_eval += len(x)
         best.update(x, f)
         history.append(best.cost)
         w *= options.w_damping
         if _converged(history, options, k):
-            stopped_by = "tolerance"
-            break
-    return PSOResult(
-        position=best.gbest_x,
-        cost=best.cost,
-        history=np.asarray(history),
-        n_iterations=len(history) - 1,
-        n_evaluations=n_eval,
-        time=time.perf_counter() - t0,
-        stopped_by=stopped_by,
-    )
+            return "tolerance"
+    return "iterations"
 
 
 def _initial_swarm(lower, upper, n: int, rng, init, init_velocity):

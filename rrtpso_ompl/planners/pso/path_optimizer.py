@@ -31,7 +31,7 @@ Stages, each optional:
 2. *PSO* over the interior waypoints, seeded around the current path: one swarm over all of
    them (the paper's), or, on longer paths, one small swarm per window of ``window``
    consecutive waypoints (a fixed waypoint between two windows makes their costs independent,
-   so every window keeps a best of its own, :func:`~rrtpso_ompl.planners.swarm.minimize` with
+   so every window keeps a best of its own, :func:`~rrtpso_ompl.planners.pso.swarm.minimize` with
    ``blocks``); the windows shift from round to round so that every waypoint moves;
 3. *refine*: where a segment runs along an obstacle (a polyline can only approximate an arc by its
    chords' tangents), insert mid-points and run the swarm again, up to ``max_waypoints``;
@@ -52,11 +52,11 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..model.geometry import path_length, shortcut, turning_angles
-from ..model.objective import ClearanceField, InflationCost
-from ..model.world import World
+from ...model.geometry import path_length, shortcut, turning_angles
+from ...model.objective import ClearanceField, InflationCost
+from ...model.world import World
+from ...params import declared, param
 from . import swarm as pso
-from .params import declared, param
 from .swarm import SWARM_PARAMS, PSOOptions
 
 __all__ = [
@@ -450,34 +450,11 @@ def _window_boxes(seed_path: np.ndarray, world, options: PathOptimizerOptions, o
     return win, slot_idx, lo, hi, before, after, seg_len, violation
 
 
-def _window_round(
-    seed_path: np.ndarray,
-    cost_model: PathCost,
-    options: PathOptimizerOptions,
-    rng: np.random.Generator,
-    terminate: Callable[[], bool] | None,
-    offset: int,
-    deadline: float | None = None,
-) -> tuple[np.ndarray, pso.PSOResult]:
-    """One round of a small swarm per window of ``options.window`` waypoints, all windows in one
-    array operation (:func:`~rrtpso_ompl.planners.swarm.minimize` with ``blocks``).
+def _window_terms(cost_model: PathCost, before, after, violation, n_win: int, width: int):
+    """The swarm's cost terms of :func:`_window_round`: ``terms(x)`` gives, per particle and
+    window, the chain's length (plus smoothness and inflation) and its collision violation.
 
-    Window ``k`` is the chain ``fixed, q_1 .. q_W, fixed``; a short window's empty slots are
-    pinned to its closing fixed waypoint (zero-length segments, no cost). Its cost is the
-    chain's length (and smoothness), and, when a segment intrudes, the seed chain's cost plus
-    the penalty: no window's best is ever worse or colliding. Returns the path with every
-    window's best in place, and the swarm's result.
-    """
-    world = cost_model.world
-    width = options.window
-    win, slot_idx, lo, hi, before, after, seg_len, violation = _window_boxes(
-        seed_path, world, options, offset, deadline
-    )
-    if violation is None:  # no time to build the culled check: the seed as it is
-        x0 = seed_path[1:-1].reshape(-1)
-        return seed_path, _unstarted(x0, _cost_of(cost_model, seed_path), time.perf_counter())
-    real = win >= 0
-    n_win = len(win)
+    Window ``k`` is the chain ``before[k], q_1 .. q_W, after[k]`` (``x`` holds the ``q``)."""
 
     def chains(x: np.ndarray) -> np.ndarray:
         n = x.shape[0]
@@ -501,6 +478,38 @@ def _window_round(
         v = violation(ch[:, :, :-1].reshape(n, -1, 2), ch[:, :, 1:].reshape(n, -1, 2))
         return length, v.reshape(n, n_win, width + 1).sum(axis=2)
 
+    return terms
+
+
+def _window_round(
+    seed_path: np.ndarray,
+    cost_model: PathCost,
+    options: PathOptimizerOptions,
+    rng: np.random.Generator,
+    terminate: Callable[[], bool] | None,
+    offset: int,
+    deadline: float | None = None,
+) -> tuple[np.ndarray, pso.PSOResult]:
+    """One round of a small swarm per window of ``options.window`` waypoints, all windows in one
+    array operation (:func:`~rrtpso_ompl.planners.pso.swarm.minimize` with ``blocks``).
+
+    Window ``k`` is the chain ``fixed, q_1 .. q_W, fixed``; a short window's empty slots are
+    pinned to its closing fixed waypoint (zero-length segments, no cost). Its cost is the
+    chain's length (and smoothness), and, when a segment intrudes, the seed chain's cost plus
+    the penalty: no window's best is ever worse or colliding. Returns the path with every
+    window's best in place, and the swarm's result.
+    """
+    world = cost_model.world
+    width = options.window
+    win, slot_idx, lo, hi, before, after, seg_len, violation = _window_boxes(
+        seed_path, world, options, offset, deadline
+    )
+    if violation is None:  # no time to build the culled check: the seed as it is
+        x0 = seed_path[1:-1].reshape(-1)
+        return seed_path, _unstarted(x0, _cost_of(cost_model, seed_path), time.perf_counter())
+    real = win >= 0
+    n_win = len(win)
+    terms = _window_terms(cost_model, before, after, violation, n_win, width)
     x0 = seed_path[slot_idx].reshape(-1)
     local = np.minimum(seg_len[:-1], seg_len[1:])
     spread = np.where(real, options.init_spread * np.maximum(local[np.maximum(win - 1, 0)],

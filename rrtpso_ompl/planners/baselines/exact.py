@@ -25,11 +25,11 @@ from typing import Any
 
 from ompl import base as ob
 
-from ..model.geometry import path_length
-from ..ompl_setup import array_to_path
-from .base import BUDGET, PlannerStats, PythonPlanner
-from .params import ParamTable
-from .result import BenchmarkRun
+from ...model.geometry import path_length
+from ...ompl_setup import array_to_path
+from ...params import ParamTable
+from ..base import BUDGET, PlannerStats, PythonPlanner
+from ..result import BenchmarkRun
 
 __all__ = ["EXACT_PARAMS", "ExactPlanner", "ExactStats"]
 
@@ -99,7 +99,7 @@ class ExactPlanner(PythonPlanner):
         super().__init__(si, name, **params)
 
     def _solve(self, ptc: ob.PlannerTerminationCondition) -> ob.PlannerStatus:
-        from ..groundtruth.optimum import shortest_path_in_world
+        from ...groundtruth.optimum import shortest_path_in_world
 
         t0 = time.perf_counter()
         stats = ExactStats()

@@ -14,10 +14,10 @@ from typing import Any
 
 from ompl import geometric as og
 
-from .base import PlannerStats
-from .params import ParamSpec, ParamTable
-from .registry import Capabilities, PlannerEntry
-from .result import BenchmarkRun
+from ...params import ParamSpec, ParamTable
+from ..base import PlannerStats
+from ..registry import Capabilities, PlannerEntry
+from ..result import BenchmarkRun
 
 __all__ = ["PLANNERS", "RRTSTAR_PARAMS", "UNAVAILABLE", "AnytimeStats"]
 

@@ -18,14 +18,14 @@ from typing import Any
 import numpy as np
 from ompl import base as ob
 
-from ..model.geometry import path_length, shortcut
-from ..ompl_setup import array_to_path
-from . import swarm as pso
-from .base import BUDGET, SEED, PlannerStats, PythonPlanner, collision_model_for
-from .params import ParamSpec, ParamTable
-from .path_optimizer import OPTIMIZER_PARAMS, PathCost
-from .result import BenchmarkRun
-from .swarm import SWARM_PARAMS, PSOOptions
+from ...model.geometry import path_length, shortcut
+from ...ompl_setup import array_to_path
+from ...params import ParamSpec, ParamTable
+from ..base import BUDGET, SEED, PlannerStats, PythonPlanner, collision_model_for
+from ..pso import swarm as pso
+from ..pso.path_optimizer import OPTIMIZER_PARAMS, PathCost
+from ..pso.swarm import SWARM_PARAMS, PSOOptions
+from ..result import BenchmarkRun
 
 __all__ = ["PSO_PARAMS", "PSOPlanner", "PSOPlannerStats"]
 

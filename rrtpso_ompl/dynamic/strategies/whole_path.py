@@ -5,10 +5,10 @@ from __future__ import annotations
 from ..manager import ReplanPolicy
 from ..replanning import ReplanningStrategy
 
-__all__ = ["Global"]
+__all__ = ["WholePath"]
 
 
-class Global(ReplanningStrategy):
+class WholePath(ReplanningStrategy):
     """Replan the whole remaining path to the goal at each predicted collision (a baseline).
 
     One plan, no wall, no wait candidate, no re-shortening; the same prediction, sweeps,

@@ -31,8 +31,8 @@ from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
-from ..errors import ParameterError, did_you_mean, shown
-from ..validation import check_integer, check_number, describe, number_hint
+from .errors import ParameterError, did_you_mean, shown
+from .validation import check_integer, check_number, describe, number_hint
 
 __all__ = ["ParamSpec", "ParamTable", "Rule", "declared", "param"]
 
