@@ -249,9 +249,7 @@ def _result(
         params=_applied(instance, request.values),
         stages=run.stages,
         clearance=ctx.world.path_clearance(path) - ctx.world.robot_radius if len(path) else None,
-        cost=request.problem.objective.path_cost(ctx.world, path)
-        if len(path)
-        else None,
+        cost=request.problem.objective.path_cost(ctx.world, path) if len(path) else None,
         benchmark=run.benchmark,
     )
 
