@@ -16,7 +16,9 @@ Where a result goes decides how it is written (:func:`publish`):
 Everything that writes a file goes through :func:`atomic_path` (for writers that need a file
 name: matplotlib, SQLite) or :func:`write_text_atomic`; a writer that makes a folder of its own
 (a ROS 2 bag) writes inside :func:`atomic_folder`, which renames the finished folder into place
-(over nothing, or an empty folder: a folder with anything in it is never replaced).
+(over nothing, or an empty folder: a folder with anything in it is never replaced); files that
+belong together (a generated problem and its map) are written by :func:`atomic_files`, all or
+nothing.
 
 A write that fails (the disk is full, the pipe or standard output is closed, the name is too
 long) raises one :class:`~rrtpso_ompl.errors.OutputError` naming the output and the reason, after
@@ -36,7 +38,7 @@ import shutil
 import stat
 import sys
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -46,6 +48,7 @@ from .ownership import ABSENT, MOVED, inspected
 
 __all__ = [
     "STDOUT",
+    "atomic_files",
     "atomic_folder",
     "atomic_path",
     "finite",
@@ -395,6 +398,59 @@ def atomic_folder(
     finally:
         if scratch is not None:
             shutil.rmtree(scratch, ignore_errors=True)
+
+
+@contextmanager
+def atomic_files(paths: Sequence[str | Path]) -> Iterator[list[Path]]:
+    """Files that appear together or not at all: a temporary name for each of ``paths``, of the
+    same name inside one temporary folder beside them (so files that name each other relatively,
+    a problem and its map, read each other there); when the block ends without an exception each
+    is published (:func:`publish`) in the order given: put the file that names the others last.
+
+    When the block fails, or a file cannot be published, the files already published are
+    removed, and so are the temporary folder and the folders made for the files: nothing is left
+    behind.
+
+    Parameters
+    ----------
+    paths : sequence of str or Path
+        The targets, all in one folder (not streams: the caller refuses those).
+
+    Yields
+    ------
+    list of Path
+        Where to write each file, in the order of ``paths``.
+
+    Raises
+    ------
+    OutputError
+        When a file cannot be written or published (an ``OSError`` of the block included),
+        naming the last of ``paths``.
+    """
+    targets = [Path(p) for p in paths]
+    folder = targets[-1].parent
+    if any(t.parent != folder for t in targets):
+        raise ValueError(f"atomic_files: the files must lie in one folder, got {targets}")
+    made = make_folders(folder) if str(folder) else []
+    moved: list[Path] = []
+    scratch = None
+    try:
+        scratch = Path(tempfile.mkdtemp(prefix=f".{targets[-1].name[:40]}.", dir=folder))
+        yield [scratch / t.name for t in targets]
+        for target in targets:
+            publish(scratch / target.name, target)
+            moved.append(target)
+    except BaseException as exc:
+        for p in moved:
+            with contextlib.suppress(OSError):
+                p.unlink()
+        if scratch is not None:
+            shutil.rmtree(scratch, ignore_errors=True)
+        remove_folders(made)
+        if isinstance(exc, OSError) and not isinstance(exc, OutputError):
+            raise OutputError(str(targets[-1]), os_reason(exc)) from None
+        raise
+    shutil.rmtree(scratch, ignore_errors=True)
 
 
 def make_folders(folder: str | Path) -> list[Path]:

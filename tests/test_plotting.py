@@ -106,6 +106,7 @@ def legend_labels(ax) -> list[str]:
 # ----------------------------------------------------------------------------------------------
 # Worlds
 # ----------------------------------------------------------------------------------------------
+@pytest.mark.slow  # seconds of work: the full run only
 def test_the_legend_of_a_10000_circle_world_hides_nothing_and_explains_the_symbols():
     from rrtpso_ompl.groundtruth.generate import generate
 

@@ -58,7 +58,6 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..model import load_problem
-    from ..model.objective import InflationCost
 
     if args.resolution is not None:
         if not args.cost:
@@ -70,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
                *ros_outputs(args)]  # fmt: skip
     check_outputs(outputs, inputs=problem.inputs)
     frame = ros_frame(args, problem)  # the units and the pose spacing, known before the search
-    if args.cost and InflationCost.of(problem.robot).active:
+    if args.cost and problem.objective.active:
         return _cost_reference(args, problem, frame)
     return _shortest(args, problem, frame)
 

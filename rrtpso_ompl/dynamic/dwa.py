@@ -60,7 +60,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..model.geometry import cumulative_length, point_segment_distance, wrap_angle
-from ..model.problem import PlannerConfig, Problem
+from ..model.problem_types import PlannerConfig, Problem
 from ..model.world import World
 from .dwa_params import DWAParams
 from .local import simulate_local

@@ -14,7 +14,7 @@ from typing import Protocol
 import numpy as np
 
 from ..model.geometry import path_length
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from ..model.world import World
 from .motion import Motion, ObstacleTrack, arc_position
 from .options import (

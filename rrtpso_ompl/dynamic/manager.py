@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from ..model.geometry import shortcut
-from ..model.problem import Circle, PlannerConfig, Polygon, Problem
+from ..model.problem_types import Circle, PlannerConfig, Polygon, Problem
 from ..model.world import World
 from .motion import Motion, closest_approach
 from .options import DynamicOptions, Observations

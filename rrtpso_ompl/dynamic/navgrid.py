@@ -20,6 +20,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse.csgraph import dijkstra
 
+from ..model.grid_graph import MOVES_8, grid_graph, move_pairs, walk
 from ..model.world import World
 
 __all__ = ["MAX_CELLS", "OCTILE", "NavGrid"]
@@ -66,25 +67,14 @@ class NavGrid:
     def _graph(self) -> sparse.csr_matrix:
         """The symmetric adjacency of the free cells (8-connected; a diagonal step needs both
         cells beside it free, so the wavefront never slips between two blocked corners)."""
-        free, nx, ny, h = self.free, self.nx, self.ny, self.h
-        idx = np.arange(nx * ny).reshape(nx, ny)
-        rows, cols, weights = [], [], []
-        for dx, dy in ((1, 0), (0, 1), (1, 1), (1, -1)):
-            aj = slice(max(0, -dy), ny - max(0, dy))
-            bj = slice(max(0, -dy) + dy, ny - max(0, dy) + dy)
-            a = (slice(0, nx - dx), aj)
-            b = (slice(dx, nx), bj)
-            ok = free[a] & free[b]
-            if dx and dy:
-                # The two orthogonal neighbours of the diagonal step.
-                ok &= free[slice(dx, nx), aj] & free[slice(0, nx - dx), bj]
-            rows.append(idx[a][ok])
-            cols.append(idx[b][ok])
-            weights.append(np.full(int(ok.sum()), h * math.hypot(dx, dy)))
-        r, c, w = (np.concatenate(x) for x in (rows, cols, weights))
-        n = nx * ny
-        half = sparse.csr_matrix((w, (r, c)), shape=(n, n))
-        return (half + half.T).tocsr()
+        nx, ny = self.nx, self.ny
+        index = np.where(self.free, np.arange(nx * ny).reshape(nx, ny), -1)
+        pairs = [move_pairs(index, step, passed) for step, passed, _ in MOVES_8]
+        weights = [np.full(len(a), self.h * math.hypot(*step))
+                   for (a, _), (step, _, _) in zip(pairs, MOVES_8, strict=True)]  # fmt: skip
+        return grid_graph(nx * ny, np.concatenate([a for a, _ in pairs]),
+                          np.concatenate([b for _, b in pairs]), np.concatenate(weights),
+                          symmetric=True)  # fmt: skip
 
     # -- queries ------------------------------------------------------------------------------
     def cell_of(self, points: np.ndarray) -> np.ndarray:
@@ -195,12 +185,7 @@ class NavGrid:
         _, pred = dijkstra(self.graph, directed=True, indices=b, return_predecessors=True)
         if a != b and pred[a] < 0:
             return None
-        cells = [a]
-        # Predecessors lead from a to the goal cell; the chain has fewer links than cells.
-        for _ in range(self.nx * self.ny):
-            if cells[-1] == b:
-                break
-            cells.append(int(pred[cells[-1]]))
+        cells = walk(pred, a)[::-1]  # predecessors lead from a to the goal cell, the root
         pts = np.vstack([start, self.centres[cells], goal])
         d = np.diff(pts, axis=0)
         turn = np.abs(d[:-1, 0] * d[1:, 1] - d[:-1, 1] * d[1:, 0]) > 1e-12 * self.h**2

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import RrtpsoError
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from ..params import Rule, declared, param
 from ..validation import MAX_STEPS as _MAX_STEPS
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.problem import Circle, Polygon
+from ..model.problem_types import Circle, Polygon
 from .motion import Motion, first_entry
 
 __all__ = ["Threat", "capsule", "extrapolate", "predict_threats", "true_runs"]

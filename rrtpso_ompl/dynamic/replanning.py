@@ -26,7 +26,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from .manager import ReplanningManager, ReplanPolicy
 from .motion import Motion, ObstacleTrack
 from .options import MAX_REPLANS, DynamicOptions, RobotModel, default_margin

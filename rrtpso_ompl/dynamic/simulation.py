@@ -14,7 +14,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from .options import DynamicOptions
 from .registry import default_strategies
 from .result import SimulationResult

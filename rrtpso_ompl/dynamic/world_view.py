@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from ..model.geometry import path_length
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from .motion import ObstacleTrack, closest_approach
 from .options import MAX_STEPS, DynamicOptions, Observations, RobotModel, SimulationError
 from .result import SimulationResult

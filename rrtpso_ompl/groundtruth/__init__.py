@@ -6,7 +6,10 @@
   the costmap's inflation cost): a 16-connected grid search, as NavFn and Smac 2D plan;
 - :mod:`.certify`: :func:`grid_path`, a collision-checked grid path that certifies a problem
   solvable (and bounds the optimum from above);
-- :mod:`.generate`: seeded random problems with such a certificate.
+- :mod:`.generate`: seeded random problems with such a certificate, by a kind's name; the
+  kinds' registry is :mod:`.kinds`, the kinds are :mod:`.field_kinds` (circles, polygons),
+  :mod:`.maze_kind`, :mod:`.map_kinds` (occupancy-grid maps, on :mod:`.map_problem` and
+  :mod:`.map_files`) and :mod:`.shape_kinds`.
 
 The names below are imported on first use (:mod:`rrtpso_ompl.lazy`): ``rrtpso optimum`` loads
 the optimum's modules, not the generators'.
@@ -36,8 +39,8 @@ export_lazily(
         "cost_reference": ".costgrid",
         "generate": ".generate",
         "generate_to_file": ".generate",
-        "GeneratedMap": ".map_kinds",
-        "generate_map": ".map_kinds",
+        "generate_map": ".generate",
+        "GeneratedMap": ".map_files",
         "OptimumResult": ".optimum",
         "shortest_path": ".optimum",
     },

@@ -17,12 +17,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from ..errors import GenerationError
 from ..model.geometry import shortcut as shortcut_path
-from ..model.problem import Problem
+from ..model.grid_graph import grid_graph, move_pairs, walk
+from ..model.problem_types import Problem
 from ..model.world import World
 from ..validation import check_number
 
@@ -76,7 +76,7 @@ def grid_path(
     cols = np.concatenate([b, *(e[1] for e in extra)])
     # csgraph drops explicit zero weights (no edge): a start on a grid point needs a tiny weight.
     weight = np.maximum(np.concatenate([length, *(e[2] for e in extra)]), 1e-12 * grid.spacing)
-    graph = coo_matrix((weight, (rows, cols)), shape=(n_grid + 2, n_grid + 2)).tocsr()
+    graph = grid_graph(n_grid + 2, rows, cols, weight)
     dist, pred = dijkstra(graph, directed=False, indices=n_grid, return_predecessors=True)
 
     # The goal, or with a goal tolerance the nearest-by-route grid point within it.
@@ -87,10 +87,7 @@ def grid_path(
     best = min(targets, key=lambda t: dist[t])
     if not math.isfinite(dist[best]):
         return None
-    route = [best]
-    while route[-1] != n_grid:
-        route.append(int(pred[route[-1]]))
-    path = np.vstack([grid.points, ends])[route[::-1]]
+    path = np.vstack([grid.points, ends])[walk(pred, best)]  # from the start, the tree's root
     return shortcut_path(path, world.segments_free) if shortcut else path
 
 
@@ -138,16 +135,12 @@ class _Grid:
 def _grid_edges(grid: _Grid, world: World) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Free edges between free neighbours (right, up, up-right, up-left: each edge once):
     ``(a, b, length)``."""
-    nx, ny, index = grid.nx, grid.ny, grid.index
-    a_parts, b_parts = [], []
-    for dj, di in ((0, 1), (1, 0), (1, 1), (1, -1)):
-        i0, i1 = max(0, -di), nx - max(0, di)
-        a_parts.append(index[: ny - dj, i0:i1].ravel())
-        b_parts.append(index[dj:, i0 + di : i1 + di].ravel())
-    a = np.concatenate(a_parts)
-    b = np.concatenate(b_parts)
-    keep = grid.free[a] & grid.free[b]
-    a, b = a[keep], b[keep]
+    # Nodes are the free grid points; node j * nx + i sits at row j, column i of the index, so
+    # right, up, up-right and up-left are the steps (0, 1), (1, 0), (1, 1), (1, -1) there.
+    index = np.where(grid.free.reshape(grid.ny, grid.nx), grid.index, -1)
+    pairs = [move_pairs(index, step) for step in ((0, 1), (1, 0), (1, 1), (1, -1))]
+    a = np.concatenate([p[0] for p in pairs])
+    b = np.concatenate([p[1] for p in pairs])
     length = np.hypot(*(grid.points[b] - grid.points[a]).T)
     # Lipschitz bound: clearance drops by at most the distance moved, and every point of a
     # segment is within L/2 of an end. The margin `tol` keeps the bound safe from round-off.

@@ -60,12 +60,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from ..errors import RrtpsoError
+from ..model.grid_graph import MOVES_16, grid_graph, move_pairs, walk
 from ..model.objective import InflationCost
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from ..model.raster import Lattice
 from ..model.world import World
 from ..validation import check_number
@@ -87,8 +87,9 @@ TARGET_NODES = 500_000
 #: peak, mostly the edges' arrays and the graph).
 MAX_NODES = 2_000_000
 #: The 8 undirected moves of the 16-connected lattice (each edge once): right, up, the two
-#: diagonals and the four knight moves; their opposites are the same edges.
-MOVES = ((1, 0), (0, 1), (1, 1), (1, -1), (2, 1), (1, 2), (2, -1), (1, -2))
+#: diagonals and the four knight moves; their opposites are the same edges. Each edge is
+#: checked exactly, so the cells a move passes need not be nodes.
+MOVES = tuple(step for step, _, _ in MOVES_16)
 #: Most quadrature samples one call of the cost integral takes (memory: about 100 bytes each).
 _SAMPLE_CHUNK = 2_000_000
 #: Shortcut spans of the smoothing, in vertices (each round tries them all, longest first).
@@ -215,7 +216,7 @@ def cost_reference(
     else:
         explicit = resolution is not None
     return cost_reference_in_world(
-        world, InflationCost.of(problem.robot), problem.start[:2], problem.goal[:2],
+        world, problem.objective, problem.start[:2], problem.goal[:2],
         float(problem.goal_tolerance), resolution=resolution, explicit=explicit, anchor=anchor,
         smooth=smooth, name=problem.name,
     )  # fmt: skip
@@ -270,6 +271,14 @@ def cost_reference_in_world(
         grid_path = path = _search(grid, ends, a, b, weight, goal_tolerance)
         if smooth and len(path) > 2:
             path = smooth_path(world, cost, path)
+    return _result(world, cost, name, (path, grid_path), lat, coarsened, grid, len(a), t0,
+                   bool(smooth and len(grid_path) > 2))  # fmt: skip
+
+
+def _result(world, cost, name, paths, lat, coarsened, grid, n_edges, t0, smoothed):
+    """The :class:`CostGridResult` of a search: ``paths = (path, grid_path)``, both empty when
+    none was found."""
+    path, grid_path = paths
     found = len(path) > 0
     return CostGridResult(
         problem=name,
@@ -282,9 +291,9 @@ def cost_reference_in_world(
         coarsened=coarsened,
         nodes=lat.n_cells,
         free_nodes=grid.n_free,
-        edges=len(a),
+        edges=n_edges,
         time=time.perf_counter() - t0,
-        smoothed=bool(smooth and len(grid_path) > 2),
+        smoothed=smoothed,
         inflation={
             "radius": cost.radius,
             "inflation_radius": cost.inflation_radius,
@@ -302,7 +311,7 @@ def _search(grid: _Nodes, ends: np.ndarray, a, b, weight, goal_tolerance: float)
     rows = np.concatenate([a, *(e[0] for e in extra)])
     cols = np.concatenate([b, *(e[1] for e in extra)])
     weights = np.concatenate([weight, *(e[2] for e in extra)])
-    graph = coo_matrix((weights, (rows, cols)), shape=(n + 2, n + 2)).tocsr()
+    graph = grid_graph(n + 2, rows, cols, weights)
     del rows, cols, weights
     dist, pred = dijkstra(graph, directed=False, indices=n, return_predecessors=True)
     del graph
@@ -310,10 +319,8 @@ def _search(grid: _Nodes, ends: np.ndarray, a, b, weight, goal_tolerance: float)
     best = int(targets[np.argmin(dist[targets])])
     if not math.isfinite(dist[best]):
         return np.empty((0, 2))
-    route = [best]
-    while route[-1] != n:  # bounded: a shortest-path tree has no cycles
-        route.append(int(pred[route[-1]]))
-    return np.vstack([grid.points, ends])[route[::-1]]
+    route = walk(pred, best)  # from the start: the tree's root
+    return np.vstack([grid.points, ends])[route]
 
 
 def _length(path: np.ndarray) -> float:
@@ -377,15 +384,7 @@ class _Nodes:
 
     def _move(self, di: int, dj: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The free edges of one move ``(di, dj)``: node ``(i, j)`` to ``(i + di, j + dj)``."""
-        nx, ny = self.lat.nx, self.lat.ny
-        si = slice(max(0, -di), nx - max(0, di))
-        sj = slice(max(0, -dj), ny - max(0, dj))
-        ti = slice(max(0, di), nx - max(0, -di))
-        tj = slice(max(0, dj), ny - max(0, -dj))
-        a = self.index[si, sj].ravel()
-        b = self.index[ti, tj].ravel()
-        keep = (a >= 0) & (b >= 0)
-        a, b = a[keep], b[keep]
+        a, b = move_pairs(self.index, (di, dj))
         world, cost = self.world, self.cost
         length = self.lat.h * math.hypot(di, dj)
         # Lipschitz: a point of the segment at t from a has clearance >= max(d_a - t, d_b - L + t).

@@ -44,6 +44,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
+from ..model.geometry import segment_box_distance
 from ..model.world import World
 
 if TYPE_CHECKING:
@@ -303,8 +304,6 @@ class FreeGrid:
         (``World.segments_free`` is its negation, bounds apart). Only for thresholds of up to
         :data:`MAX_BAND` cells minus a half (:attr:`band_ok`).
         """
-        from ..model.world import _segment_box_distance_v
-
         a = np.asarray(a, dtype=float).reshape(-1, 2)
         b = np.asarray(b, dtype=float).reshape(-1, 2)
         out = np.zeros(len(a), dtype=bool)
@@ -349,7 +348,7 @@ class FreeGrid:
             x0 = self.x0 + ii * self.h
             y0 = self.y0 + jj * self.h
             box = np.column_stack([x0, y0, x0 + self.h, y0 + self.h])
-            dist = _segment_box_distance_v(a[ss], b[ss], box)
+            dist = segment_box_distance(a[ss], b[ss], box)
             out[ss[dist < threshold]] = True
         return out
 

@@ -15,59 +15,34 @@ PGM, free 254, occupied 0) with a problem on it:
 * ``caves_map``: cellular-automaton caves, the largest open region kept (:class:`CavesMapOptions`);
 * ``random_map``: random blocked cells at a density (:class:`RandomMapOptions`).
 
-The map is ``cells x cells`` cells over the workspace ``[0, size]^2`` (cell side ``size /
-cells``, units m); it depends on the seed only. Start and goal are centres of cells where the
-robot disc fits (the project's :class:`~rrtpso_ompl.model.World` decides: its exact point test on
-the map's cells), in the largest region the robot can move in, at least ``size / 2`` apart, drawn
-from a second stream seeded with ``(seed, query)``: ``query`` poses another start and goal on the
-same map. The robot radius defaults to a quarter of a cell, so corridors one cell wide stay
-passable.
+Each kind is its options (a :class:`~.map_problem.MapKindOptions`) and the function drawing its
+cells (True blocked, image order, every loop bounded by the map's size); what they share, the
+query on the map and its certificate, is :mod:`.map_problem`'s, the files :mod:`.map_files`'.
 
-**Certificate.** A route through the centres of free cells (4-neighbours; between two
-neighbouring free centres the straight segment is free, since the nearest blocked square of any
-point of it is at least as near one end), straightened by the world's exact segment test and
-checked again by :meth:`~rrtpso_ompl.model.World.path_valid`: a certified path in milliseconds,
-also through one-cell corridors where a general grid would need a spacing of an eighth of a cell.
-With ``exact`` the exact optimum (:func:`~rrtpso_ompl.groundtruth.optimum.shortest_path`) is
-computed too and its length stated.
+The map is ``cells x cells`` cells over the workspace ``[0, size]^2`` (cell side ``size /
+cells``, units m) and depends on the seed only; start and goal are drawn on it from a second
+stream (``query``), and certified (:mod:`.map_problem`).
 
 **Python API.** :func:`~rrtpso_ompl.groundtruth.generate.generate` returns the problem dictionary
-(its ``map`` the relative name ``<name>_map.yaml``); :func:`generate_map` returns a
-:class:`GeneratedMap`: that dictionary, the image and the map YAML dictionary, which
-:meth:`GeneratedMap.write` writes (the problem file, ``<stem>_map.yaml`` and ``<stem>_map.pgm``
-beside it). :func:`~rrtpso_ompl.groundtruth.generate.generate_to_file` does both. All three
-files are written to temporary names in a temporary folder beside them, the problem read back
-from there (map included), then renamed into place: when anything fails nothing is left behind.
+(its ``map`` the relative name ``<name>_map.yaml``);
+:func:`~rrtpso_ompl.groundtruth.generate.generate_map` returns a :class:`GeneratedMap`: that
+dictionary, the image and the map YAML dictionary, which :meth:`GeneratedMap.write` writes (the
+problem file, ``<stem>_map.yaml`` and ``<stem>_map.pgm`` beside it, all or nothing).
+:func:`~rrtpso_ompl.groundtruth.generate.generate_to_file` does both.
 """
 
 from __future__ import annotations
 
-import contextlib
-import dataclasses
-import math
-import os
-import shutil
-import stat
-import tempfile
-from pathlib import Path
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
 from scipy import ndimage
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import breadth_first_order
-from scipy.spatial import ConvexHull, QhullError
 
-from ..errors import GenerationError, ProblemError
-from ..model.geometry import path_length
-from ..model.occupancy import OccupancyMap
-from ..model.problem import problem_from_dict
-from ..model.problem_file import round_floats, write_problem
-from ..model.raster import Lattice
-from ..model.world import World
-from ..outputs import make_folders, publish, remove_folders
+from ..errors import GenerationError
 from ..params import Rule, declared, param
-from .generate import GeneratorOptions, _round_up, generate_command, register_kind
+from .kinds import register_kind
+from .map_files import GeneratedMap, map_output_paths
+from .map_problem import MAX_MAP_CELLS, MapKindOptions
 
 __all__ = [
     "MAX_MAP_CELLS",
@@ -79,466 +54,8 @@ __all__ = [
     "RandomMapOptions",
     "RoomsMapOptions",
     "WarehouseMapOptions",
-    "generate_map",
+    "map_output_paths",
 ]
-
-#: Most cells per side of a generated map (16 million cells).
-MAX_MAP_CELLS = 4096
-#: Grey values of the image (ROS map_saver's).
-FREE_GREY, OCCUPIED_GREY = 254, 0
-
-
-# ----------------------------------------------------------------------------------------------
-# What a map kind generates
-# ----------------------------------------------------------------------------------------------
-@dataclasses.dataclass(frozen=True, eq=False)
-class GeneratedMap:
-    """A generated map and the problem on it.
-
-    Attributes
-    ----------
-    problem : dict
-        The problem dictionary (file format); its ``map`` is ``map_file`` (relative).
-    blocked : ndarray of bool, shape (cells, cells)
-        Blocked cells in image order (row 0 on top).
-    map_yaml : dict
-        The map_server YAML keys (``image`` is ``image_file``).
-    map_file, image_file : str
-        The names the problem and the map YAML give them.
-    header : str
-        Comment lines for the top of the problem and map files (the command that regenerates
-        them).
-    decimals : int
-        Decimal places of the problem's coordinates.
-    """
-
-    problem: dict[str, Any]
-    blocked: np.ndarray
-    map_yaml: dict[str, Any]
-    map_file: str
-    image_file: str
-    header: str = ""
-    decimals: int = 3
-
-    @property
-    def image(self) -> np.ndarray:
-        """(cells, cells) uint8 grey image: free 254, occupied 0."""
-        return np.where(self.blocked, OCCUPIED_GREY, FREE_GREY).astype(np.uint8)
-
-    def pgm_bytes(self) -> bytes:
-        """The image as an 8-bit binary PGM (P5)."""
-        h, w = self.blocked.shape
-        return f"P5\n{w} {h}\n255\n".encode("ascii") + self.image.tobytes()
-
-    def yaml_text(self) -> str:
-        """The map YAML file's text."""
-        m = self.map_yaml
-        lines = [f"# {line}".rstrip() for line in self.header.splitlines()]
-        lines += [
-            f"image: {m['image']}",
-            f"resolution: {m['resolution']!r}",
-            f"origin: [{m['origin'][0]!r}, {m['origin'][1]!r}, {m['origin'][2]!r}]",
-            f"negate: {m['negate']}",
-            f"occupied_thresh: {m['occupied_thresh']}",
-            f"free_thresh: {m['free_thresh']}",
-            f"mode: {m['mode']}",
-        ]
-        return "\n".join(lines) + "\n"
-
-    def renamed(self, stem: str) -> GeneratedMap:
-        """The same, the map files named ``<stem>_map.yaml`` and ``<stem>_map.pgm``."""
-        map_file, image_file = f"{stem}_map.yaml", f"{stem}_map.pgm"
-        return dataclasses.replace(
-            self,
-            problem={**self.problem, "map": map_file},
-            map_yaml={**self.map_yaml, "image": image_file},
-            map_file=map_file,
-            image_file=image_file,
-        )
-
-    def write(self, out: str | Path) -> Path:
-        """Write the problem to ``out`` and the map beside it (``<out stem>_map.yaml`` and
-        ``.pgm``), all or nothing.
-
-        Existing regular files are replaced; a path that is ``-``, a symbolic link, a fifo or
-        anything but a regular file is refused before anything is written
-        (:class:`GenerationError`). The three files are written in a temporary folder beside
-        ``out``, the problem validated by reading it back (the map with it), then renamed into
-        place; when a step fails the files already moved are removed, and so is the folder.
-
-        Returns
-        -------
-        Path
-            ``out``.
-        """
-        out = Path(out)
-        named = self.renamed(out.stem if out.suffix else out.name)
-        paths = map_output_paths(out)
-        for p in paths:
-            _check_writable_place(p)
-        folder = out.parent
-        made = make_folders(folder) if str(folder) else []
-        moved: list[Path] = []
-        tmp = None
-        try:
-            tmp = Path(tempfile.mkdtemp(prefix=f".{out.name[:40]}.", dir=folder))
-            (tmp / named.image_file).write_bytes(named.pgm_bytes())
-            (tmp / named.map_file).write_text(named.yaml_text(), encoding="utf-8")
-            # write_problem reads the problem back, the map from beside it: the files are valid.
-            write_problem(named.problem, tmp / out.name, header=named.header,
-                          decimals=named.decimals)  # fmt: skip
-            for name, target in zip((named.image_file, named.map_file, out.name), paths[::-1],
-                                    strict=True):  # fmt: skip
-                _publish(tmp / name, target)
-                moved.append(target)
-        except BaseException as exc:
-            for p in moved:
-                with contextlib.suppress(OSError):
-                    p.unlink()
-            if tmp is not None:
-                shutil.rmtree(tmp, ignore_errors=True)
-            remove_folders(made)
-            if isinstance(exc, OSError):
-                raise GenerationError(f"cannot write '{out}' and its map: {exc.strerror or exc}"
-                                      ) from None  # fmt: skip
-            raise
-        shutil.rmtree(tmp, ignore_errors=True)
-        return out
-
-
-def map_output_paths(out: str | Path) -> list[Path]:
-    """``[out, <stem>_map.yaml, <stem>_map.pgm]`` beside ``out``."""
-    out = Path(out)
-    stem = out.stem if out.suffix else out.name
-    return [out, out.with_name(f"{stem}_map.yaml"), out.with_name(f"{stem}_map.pgm")]
-
-
-def _check_writable_place(path: Path) -> None:
-    """Refuse ``-`` and an existing path that is not a regular file (a link is not followed: the
-    map must lie beside the problem)."""
-    if str(path) == "-":
-        raise GenerationError("a map kind writes three files; give --out a file name, not '-'")
-    try:
-        mode = os.lstat(path).st_mode
-    except FileNotFoundError:
-        return
-    except OSError as exc:
-        raise GenerationError(f"cannot write '{path}': {exc.strerror}") from None
-    if stat.S_ISLNK(mode):
-        raise GenerationError(f"'{path}' is a symbolic link; a map kind writes regular files only")
-    if not stat.S_ISREG(mode):
-        what = "a directory" if stat.S_ISDIR(mode) else "not a regular file"
-        raise GenerationError(f"'{path}' is {what}; it is left as it is")
-
-
-def _publish(tmp: Path, target: Path) -> None:
-    """Rename a finished file into place with the permissions a new file gets (or the old
-    file's), never over a results file or a file being written
-    (:func:`~rrtpso_ompl.outputs.publish`)."""
-    publish(tmp, target)
-
-
-# ----------------------------------------------------------------------------------------------
-# The options every map kind takes
-# ----------------------------------------------------------------------------------------------
-@declared(
-    rules=(
-        Rule(("resolution",), lambda r: r is None,
-             "resolution is not used by map kinds (the map's cell side is size / cells)"),
-    )
-)  # fmt: skip
-class MapKindOptions(GeneratorOptions):
-    """An occupancy-grid map and a query on it (each map kind draws its cells)."""
-
-    robot_radius: float | None = param(
-        None,
-        "Robot radius (0: a point robot). Default: a quarter of a cell (size / cells / 4), so "
-        "corridors one cell wide stay passable.",
-        unit="length",
-        low=0.0,
-    )
-    resolution: float | None = param(
-        None,
-        "Not used by map kinds (leave it unset): the map's cell side is size / cells.",
-        unit="length",
-        low=0.0,
-    )
-    cells: int = param(128, "Cells per side of the map (the cell side is size / cells).",
-                       low=8, high=MAX_MAP_CELLS)  # fmt: skip
-    query: int = param(
-        0,
-        "Which start and goal on the map (the map depends on the seed only; start and goal on "
-        "seed and query).",
-        low=0,
-    )
-    exact: bool = param(
-        False, "Also compute the exact shortest path (slower) and state its length."
-    )
-
-    def resolved(self) -> MapKindOptions:
-        # The radius as the file will hold it (rounded to the decimals; the default rounded
-        # down), so that the certificate is checked with the radius that is written.
-        options = self._resolve(None)
-        scale = 10.0**options.decimals
-        if self.robot_radius is None:
-            robot = math.floor(0.25 * self.cell * scale) / scale
-        else:
-            robot = float(round_floats(self.robot_radius, options.decimals))
-        return dataclasses.replace(options, robot_radius=robot)
-
-    @property
-    def cell(self) -> float:
-        """Side of a map cell, m."""
-        return self.size / self.cells
-
-    # -- what each map kind provides ------------------------------------------------------------
-    def draw_cells(self, rng: np.random.Generator) -> np.ndarray:
-        """(cells, cells) booleans, True blocked, image order (row 0 on top)."""
-        raise NotImplementedError
-
-    def what(self) -> str:
-        """What the map holds, in words (the description's first sentence)."""
-        raise NotImplementedError
-
-    # -- the generator's hooks --------------------------------------------------------------------
-    def problem_dict(self, seed: int) -> dict[str, Any]:
-        return generate_map_from(self, seed).problem
-
-    @classmethod
-    def output_paths(cls, out: str | Path) -> list[Path]:
-        return map_output_paths(out)
-
-    @classmethod
-    def check_places(cls, out: str | Path) -> None:
-        """Refuse ``-`` and a link, fifo or folder at any of the three places."""
-        for p in map_output_paths(out) if str(out) != "-" else ["-"]:
-            _check_writable_place(Path(p))
-
-    def write(self, seed: int, out: str | Path) -> Path:
-        self.check_places(out)  # before the map is drawn
-        return generate_map_from(self.resolved(), seed, generate_command(self, seed)).write(out)
-
-
-def generate_map(kind: str, seed: int, **options: Any) -> GeneratedMap:
-    """The map and problem of a map kind (see the module docstring).
-
-    Parameters are those of :func:`~rrtpso_ompl.groundtruth.generate.generate`; ``kind`` must be
-    a map kind (its name ends in ``_map``).
-    """
-    from .generate import _options_of, _seed
-
-    options_ = _options_of(kind, options)
-    if not isinstance(options_, MapKindOptions):
-        raise GenerationError(f"generate_map: {kind!r} is not a map kind")
-    seed = _seed(seed)
-    return generate_map_from(options_.resolved(), seed, generate_command(options_, seed))
-
-
-def generate_map_from(options: MapKindOptions, seed: int, command: str = "") -> GeneratedMap:
-    """Draw maps from ``default_rng(seed)`` until one has a place for the query, then the query
-    from ``default_rng([seed, query])``, certified (module docstring)."""
-    kind = options.KIND
-    name = options.name or f"{kind}_{seed}"
-    rng = np.random.default_rng(seed)
-    last = ""
-    for attempt in range(1, options.max_attempts + 1):
-        blocked = np.ascontiguousarray(options.draw_cells(rng), dtype=bool)
-        world, lat = _map_world(options, blocked)
-        region, reason = _largest_region(world, lat, 0.5 * options.size)
-        if region is None:
-            last = reason
-            continue
-        query_rng = np.random.default_rng([seed, options.query])
-        start_cell, goal_cell = _draw_query(query_rng, region, lat.h, 0.5 * options.size)
-        data = {
-            "name": name,
-            "description": "",
-            "units": "m",
-            "map": f"{name}_map.yaml",
-            "start": list(lat.centre(start_cell)),
-            "goal": list(lat.centre(goal_cell)),
-            "robot": {"radius": float(options.robot_radius)},
-        }
-        data = round_floats(data, options.decimals)
-        path = _certify(world, lat, region, data["start"], data["goal"])
-        if path is None:  # rounding moved an end off its cell centre into a wall's reach
-            last = "the start or goal was not free after rounding (use more decimals)"
-            continue
-        length = _round_up(path_length(path), 4)
-        how = (
-            f"a collision-free path of length {length:g} exists (through free cell centres, "
-            "checked exactly), so the shortest path is at most that long"
-        )
-        if options.exact:
-            from .optimum import shortest_path
-
-            best = shortest_path(_problem(world, data), world, upper_bound=float(length) * 1.001)
-            if best.found:
-                how = f"the shortest path is {best.length:.6g} long (exact, rrtpso optimum)"
-        n_blocked = int(blocked.sum())
-        data["description"] = (
-            f"{options.what()} A {options.cells} x {options.cells} occupancy grid of "
-            f"{options.size:g} m x {options.size:g} m (cells of {lat.h:.4g} m, "
-            f"{100 * n_blocked / blocked.size:.0f}% blocked). Robot radius "
-            f"{options.robot_radius:g} m; start and goal are free cell centres in the largest "
-            f"region the robot can move in, {math.dist(data['start'], data['goal']):.4g} m "
-            f"apart (query {options.query}). Generated by rrtpso generate (kind {kind}, seed "
-            f"{seed}, attempt {attempt}); {how}."
-        )
-        map_yaml = {
-            "image": f"{name}_map.pgm",
-            "resolution": float(lat.h),
-            "origin": [0.0, 0.0, 0.0],
-            "negate": 0,
-            "occupied_thresh": 0.65,
-            "free_thresh": 0.196,
-            "mode": "trinary",
-        }
-        header = (f"Generated by: {command} --out FILE\n" if command else "") + (
-            "The map was drawn from numpy.random.default_rng(seed), start and goal from\n"
-            "default_rng([seed, query]); the same command writes the same bytes. Solvability\n"
-            "is certified by a collision-free path, see the description."
-        )
-        return GeneratedMap(data, blocked, map_yaml, data["map"], map_yaml["image"], header,
-                            options.decimals)  # fmt: skip
-    raise GenerationError(
-        f"generate {kind}: no map with room for the query in {options.max_attempts} attempts "
-        f"(last: {last}); use a smaller robot_radius, other options or more max_attempts"
-    )
-
-
-def _map_world(options: MapKindOptions, blocked: np.ndarray) -> tuple[World, Lattice]:
-    """The world of the map (built as ``rrtpso solve`` builds it) and the map's own lattice."""
-    res = options.size / options.cells
-    occupancy = OccupancyMap(f"<generate {options.KIND}>", "<image>", res, (0.0, 0.0),
-                             blocked.astype(np.int8))  # fmt: skip
-    n = options.cells
-    problem = _problem(None, {"start": [0.0, 0.0], "goal": [0.0, 0.0],
-                              "robot": {"radius": float(options.robot_radius)}},
-                       bounds=occupancy.extent)  # fmt: skip
-    problem = dataclasses.replace(problem, map=occupancy)
-    return World.from_problem(problem), Lattice((0.0, 0.0), res, n, n)
-
-
-def _problem(world: World | None, data: dict[str, Any], bounds=None):
-    """A problem of ``data``'s start, goal and robot over ``bounds`` (default the world's), no
-    obstacles of its own (the map is the world's)."""
-    bounds = bounds if bounds is not None else world.bounds
-    doc = {"bounds": [list(bounds[0]), list(bounds[1])], "start": data["start"],
-           "goal": data["goal"], "robot": data["robot"]}  # fmt: skip
-    try:
-        return problem_from_dict(doc, source="<generate>")
-    except ProblemError as exc:  # pragma: no cover - start and goal lie in the bounds
-        raise GenerationError(str(exc)) from None
-
-
-def _largest_region(world: World, lat: Lattice, apart: float):
-    """The cells ``(i, j)`` (i along x) of the largest 4-connected region of free cell centres,
-    as an (m, 2) array, when two of them are at least ``apart`` apart; else None and why."""
-    free = world.centres_free(lat)
-    if not free.any():
-        return None, "the robot fits nowhere on the map"
-    labels, _ = ndimage.label(free)
-    sizes = np.bincount(labels.ravel())[1:]
-    cells = np.argwhere(labels == int(np.argmax(sizes)) + 1)
-    if _diameter(cells) * lat.h < apart:
-        return None, f"the largest free region has no two cells {apart:g} m apart"
-    return cells, ""
-
-
-def _hull(cells: np.ndarray) -> np.ndarray:
-    """The cells on the convex hull of ``cells`` (all of them when degenerate)."""
-    if len(cells) < 3:
-        return cells
-    try:
-        return cells[ConvexHull(cells).vertices]
-    except QhullError:  # collinear
-        return cells
-
-
-def _diameter(cells: np.ndarray) -> float:
-    """Largest distance between two cells, in cells."""
-    hull = _hull(cells).astype(float)
-    d = np.hypot(hull[:, None, 0] - hull[None, :, 0], hull[:, None, 1] - hull[None, :, 1])
-    return float(d.max())
-
-
-def _draw_query(rng: np.random.Generator, cells: np.ndarray, h: float, apart: float):
-    """Start and goal cells of ``cells``, at least ``apart`` apart: the start uniform among the
-    cells that have such a partner (the farthest cell from any point is a hull vertex), the goal
-    uniform among its partners."""
-    hull = _hull(cells).astype(float)
-    far = np.zeros(len(cells), dtype=bool)
-    for lo in range(0, len(cells), 4096):  # memory: 4096 x hull vertices at a time
-        c = cells[lo : lo + 4096].astype(float)
-        d = np.hypot(c[:, None, 0] - hull[None, :, 0], c[:, None, 1] - hull[None, :, 1])
-        far[lo : lo + 4096] = d.max(axis=1) * h >= apart
-    starts = np.flatnonzero(far)
-    s = cells[starts[int(rng.integers(len(starts)))]]
-    goals = np.flatnonzero(np.hypot(*(cells - s).T) * h >= apart)
-    g = cells[goals[int(rng.integers(len(goals)))]]
-    return (int(s[0]), int(s[1])), (int(g[0]), int(g[1]))
-
-
-def _certify(world: World, lat: Lattice, cells: np.ndarray, start, goal) -> np.ndarray | None:
-    """A valid path from ``start`` to ``goal`` through the centres of ``cells`` (4-neighbours,
-    breadth first), shortcut with the exact segment test and checked with
-    :meth:`World.path_valid`; None when an end is not free."""
-    a, b = np.asarray(start, float), np.asarray(goal, float)
-    if not (world.point_free(*a) and world.point_free(*b)):
-        return None
-    index = np.full((lat.nx, lat.ny), -1, dtype=np.int64)
-    index[cells[:, 0], cells[:, 1]] = np.arange(len(cells))
-    rows, cols = [], []
-    for di, dj in ((1, 0), (0, 1)):
-        src = index[: lat.nx - di, : lat.ny - dj]
-        dst = index[di:, dj:]
-        ok = (src >= 0) & (dst >= 0)
-        rows.append(src[ok])
-        cols.append(dst[ok])
-    r, c = np.concatenate(rows), np.concatenate(cols)
-    graph = coo_matrix((np.ones(len(r)), (r, c)), shape=(len(cells), len(cells))).tocsr()
-    s = int(index[lat.cell_of(a)])
-    g = int(index[lat.cell_of(b)])
-    _, pred = breadth_first_order(graph, s, directed=False, return_predecessors=True)
-    route = [g]
-    for _ in range(len(cells)):  # bounded walk back along the predecessors
-        if route[-1] == s:
-            break
-        route.append(int(pred[route[-1]]))
-    if route[-1] != s:
-        return None
-    centres = lat.centres().reshape(lat.nx, lat.ny, 2)
-    picked = cells[route[::-1]]
-    path = centres[picked[:, 0], picked[:, 1]]
-    path[0], path[-1] = a, b
-    # Straight runs of centres are one free segment (the union of free unit steps): keep their
-    # ends only, so the shortcut's exact tests see the turns, not every cell.
-    step = np.diff(path, axis=0)
-    turn = np.any(step[1:] != step[:-1], axis=1)
-    path = path[np.concatenate([[True], turn, [True]])] if len(path) > 2 else path
-    path = _straighten(path, world)
-    return path if world.path_valid(path) else None
-
-
-def _straighten(path: np.ndarray, world: World, passes: int = 24) -> np.ndarray:
-    """Drop waypoints whose neighbours see each other, in vectorised passes: each pass tests
-    every ``(p[i], p[i + 2])`` at once (exact segment test) and drops ``p[i + 1]`` where it is
-    free, for ``i`` of one parity only (two dropped waypoints are never neighbours, so every
-    new segment was tested). A long maze route of thousands of turns takes a few calls, where
-    the greedy shortcut would take one per kept waypoint."""
-    for k in range(passes):
-        if len(path) < 3:
-            break
-        free = world.segments_free(path[:-2], path[2:])
-        i = np.arange(len(free))
-        drop = free & (i % 2 == k % 2)
-        if not drop.any() and not (free & (i % 2 != k % 2)).any():
-            break
-        keep = np.ones(len(path), dtype=bool)
-        keep[1:-1][drop] = False
-        path = path[keep]
-    return path
 
 
 # ----------------------------------------------------------------------------------------------
@@ -869,45 +386,50 @@ def _furnish(rng, g: np.ndarray, keep: np.ndarray, rows, cols, wall: int, clutte
             g[a0:a1, b0:b1] = True
 
 
-def _city(rng, size: int, street, block, avenue: float, plazas: float):
-    g = np.zeros((size, size), dtype=bool)
-
-    def built(h: int, w: int) -> np.ndarray:
-        b = np.ones((h, w), dtype=bool)
-        along = w >= h  # lots along the longer side, an alley (1 cell) between some
-        length = w if along else h
-        x = 0
-        for _ in range(length):
-            if x >= length:
-                break
-            lot = int(rng.integers(4, 11))
-            if rng.random() < 0.3 and x + lot < length:
-                if along:
-                    b[:, x + lot : x + lot + 1] = False
-                else:
-                    b[x + lot : x + lot + 1, :] = False
-                x += 1
-            x += lot
-        if min(h, w) > 8 and rng.random() < 0.5:  # a courtyard
-            ch, cw = int(rng.integers(2, h // 2)), int(rng.integers(2, w // 2))
-            r, c = int(rng.integers(2, h - ch - 1)), int(rng.integers(2, w - cw - 1))
-            b[r : r + ch, c : c + cw] = False
-        for _ in range(int(rng.integers(0, 4))):  # setbacks and notches on the edges
-            side = int(rng.integers(4))
-            span = w if side < 2 else h
-            d = int(rng.integers(1, 3))
-            n = int(rng.integers(2, max(3, span // 2)))
-            o = int(rng.integers(0, max(1, span - n)))
-            if side == 0:
-                b[:d, o : o + n] = False
-            elif side == 1:
-                b[h - d :, o : o + n] = False
-            elif side == 2:
-                b[o : o + n, :d] = False
+def _city_block(rng: np.random.Generator, h: int, w: int) -> np.ndarray:
+    """A built-up block of ``h x w`` cells: lots along its longer side with one-cell alleys
+    between some, perhaps a courtyard, and setbacks and notches on its edges."""
+    b = np.ones((h, w), dtype=bool)
+    along = w >= h  # lots along the longer side, an alley (1 cell) between some
+    length = w if along else h
+    x = 0
+    for _ in range(length):
+        if x >= length:
+            break
+        lot = int(rng.integers(4, 11))
+        if rng.random() < 0.3 and x + lot < length:
+            if along:
+                b[:, x + lot : x + lot + 1] = False
             else:
-                b[o : o + n, w - d :] = False
-        return b
+                b[x + lot : x + lot + 1, :] = False
+            x += 1
+        x += lot
+    if min(h, w) > 8 and rng.random() < 0.5:  # a courtyard
+        ch, cw = int(rng.integers(2, h // 2)), int(rng.integers(2, w // 2))
+        r, c = int(rng.integers(2, h - ch - 1)), int(rng.integers(2, w - cw - 1))
+        b[r : r + ch, c : c + cw] = False
+    for _ in range(int(rng.integers(0, 4))):  # setbacks and notches on the edges
+        side = int(rng.integers(4))
+        span = w if side < 2 else h
+        d = int(rng.integers(1, 3))
+        n = int(rng.integers(2, max(3, span // 2)))
+        o = int(rng.integers(0, max(1, span - n)))
+        if side == 0:
+            b[:d, o : o + n] = False
+        elif side == 1:
+            b[h - d :, o : o + n] = False
+        elif side == 2:
+            b[o : o + n, :d] = False
+        else:
+            b[o : o + n, w - d :] = False
+    return b
 
+
+def _city(rng, size: int, street, block, avenue: float, plazas: float):
+    """Blocks between streets: the map split recursively by streets until the blocks are small,
+    each block built up (:func:`_city_block`) or left an open square; perhaps a diagonal
+    avenue across it all."""
+    g = np.zeros((size, size), dtype=bool)
     lo, hi = block
     m = int(rng.integers(1, 4))
     todo = [(m, m, size - m, size - m, 0)]  # rectangles still to split (an explicit stack)
@@ -919,7 +441,7 @@ def _city(rng, size: int, street, block, avenue: float, plazas: float):
         s = int(rng.integers(street[0], street[1] + 1))
         if (h <= hi and w <= hi) or depth > 12 or max(h, w) < 2 * lo + s:
             if h > 2 and w > 2 and rng.random() >= plazas:
-                g[r0:r1, c0:c1] = built(h, w)
+                g[r0:r1, c0:c1] = _city_block(rng, h, w)
             continue
         if h >= w:
             cut = int(rng.integers(r0 + lo, r1 - lo - s + 1))

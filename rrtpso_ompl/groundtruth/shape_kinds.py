@@ -1,6 +1,6 @@
 """Generated shape problems of the families planners are usually compared on
 (``rrtpso generate slabs|combs|spiral|rooms``): obstacles as shapes in the problem file, certified
-as the other kinds are (:func:`~rrtpso_ompl.groundtruth.generate.generate`).
+as the other kinds are (:mod:`.kinds`).
 
 * ``slabs``: thin slanted rectangles (polygons) in rows across the workspace, gaps between them:
   the point-robot "slanted slabs" family (:class:`SlabsOptions`);
@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import GenerationError
 from ..params import Rule, declared, param
 from .certify import GRID_POINTS
-from .generate import GeneratorOptions, register_kind
+from .kinds import GeneratorOptions, register_kind
 
 __all__ = ["CombsOptions", "RoomsOptions", "SlabsOptions", "SpiralOptions"]
 

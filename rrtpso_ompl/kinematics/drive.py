@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.problem import Robot
+from ..model.problem_types import Robot
 from ..model.world import World
 from .diffdrive import integrate_wheels
 from .profile import Trajectory, densify, time_parametrize

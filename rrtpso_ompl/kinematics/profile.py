@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import RrtpsoError
-from ..model.problem import Robot
+from ..model.problem_types import Robot
 from ..validation import MAX_STEPS
 from .diffdrive import wheel_speeds
 from .reference import ReferenceCurve
@@ -245,17 +245,7 @@ def time_parametrize(
         When the trajectory would have more than :data:`~rrtpso_ompl.validation.MAX_STEPS`
         samples.
     """
-    for key in ("speed", "sample_time", "track_width", "wheel_radius"):
-        if getattr(robot, key) is None:
-            raise ValueError(f"robot.{key} is required to compute velocities")
-    profile = _resolve_profile(robot, profile)
-    if clearance is not None:
-        if not robot.inflation_radius or robot.inflation_radius <= robot.radius:
-            raise ValueError("robot.inflation_radius (above robot.radius) is required to slow "
-                             "near obstacles")  # fmt: skip
-        clearance = np.asarray(clearance, dtype=float).reshape(-1)
-        if len(clearance) != len(curve.s):
-            raise ValueError(f"{len(clearance)} clearances for {len(curve.s)} curve samples")
+    profile, clearance = _checked_inputs(curve, robot, profile, clearance)
     curve, clearance = _split_rests(curve, profile, clearance)
     L, ts = robot.track_width, robot.sample_time
     v, v_top = _speeds(curve, robot, profile, clearance)
@@ -273,14 +263,31 @@ def time_parametrize(
     v_out = np.append(np.diff(out["s"]) / ts, 0.0)
     w_out = np.append(np.diff(out["theta"]) / ts, 0.0)
     v_r, v_l, w_r, w_l = wheel_speeds(v_out, w_out, L, robot.wheel_radius)
-    goal_turn = (float(t_nodes[-1]), float(t_end)) if turn_dt[-1] > 0 else None
     return Trajectory(
         t=t, x=out["x"], y=out["y"], theta=out["theta"], v=v_out, omega=w_out,
         v_right=v_r, v_left=v_l, omega_right=w_r, omega_left=w_l, sample_time=ts,
         track_width=L, wheel_radius=robot.wheel_radius, profile=profile,
-        goal_turn_times=goal_turn,
+        goal_turn_times=(float(t_nodes[-1]), float(t_end)) if turn_dt[-1] > 0 else None,
         slow_near_obstacles=clearance is not None,
     )  # fmt: skip
+
+
+def _checked_inputs(curve: ReferenceCurve, robot: Robot, profile: str, clearance):
+    """:func:`time_parametrize`'s inputs checked (ValueError naming what is missing or wrong):
+    the profile resolved, and ``clearance`` as a flat array of one value per curve sample."""
+    for key in ("speed", "sample_time", "track_width", "wheel_radius"):
+        if getattr(robot, key) is None:
+            raise ValueError(f"robot.{key} is required to compute velocities")
+    profile = _resolve_profile(robot, profile)
+    if clearance is None:
+        return profile, None
+    if not robot.inflation_radius or robot.inflation_radius <= robot.radius:
+        raise ValueError("robot.inflation_radius (above robot.radius) is required to slow "
+                         "near obstacles")  # fmt: skip
+    clearance = np.asarray(clearance, dtype=float).reshape(-1)
+    if len(clearance) != len(curve.s):
+        raise ValueError(f"{len(clearance)} clearances for {len(curve.s)} curve samples")
+    return profile, clearance
 
 
 def turn_limits(robot: Robot, profile: str, v_top: float) -> tuple[float, float | None]:

@@ -1,11 +1,16 @@
 """The problem and its world: files in, exact geometry out (no OMPL, no matplotlib).
 
-- :mod:`.problem`: problem files (YAML) to frozen dataclasses, every bad input one
-  :class:`~rrtpso_ompl.errors.ProblemError` naming the file and the key;
+- :mod:`.format`: the problem-file format declared once (keys, kinds, units);
+- :mod:`.problem_types`: the problem as frozen dataclasses; :mod:`.problem`: problem files
+  (YAML) to those, every bad input one :class:`~rrtpso_ompl.errors.ProblemError` naming the
+  file and the key; :mod:`.problem_file`: the inverse; :mod:`.occupancy`: map_server maps;
 - :mod:`.world`: :class:`World`, the static obstacles prepared for exact collision checks
-  (scalar for OMPL's callbacks, vectorised for the swarm);
-- :mod:`.geometry`: polyline lengths, shortcutting and point-segment distances, used by every
-  stage.
+  (:mod:`.scalar_checks` for OMPL's callbacks, :mod:`.obstacle_index` vectorised for the swarm,
+  :mod:`.local_violation` for a swarm in boxes, :mod:`.spatial` the index);
+- :mod:`.raster`, :mod:`.marking`, :mod:`.grid_graph`: lattices of cells, which are free, and the
+  graph every grid search walks;
+- :mod:`.geometry`: polyline lengths, shortcutting and the exact distance formulas, used by
+  every stage; :mod:`.objective`: the inflation cost.
 
 The names below are imported on first use (:mod:`rrtpso_ompl.lazy`): :func:`load_problem`
 loads neither :mod:`.world` nor shapely (but for a polygon's checks).
@@ -42,11 +47,12 @@ export_lazily(
                 "PlannerConfig",
                 "Polygon",
                 "Problem",
-                "ProblemError",
                 "Robot",
-                "load_problem",
-                "problem_from_dict",
             ),
+            ".problem_types",
+        ),
+        **dict.fromkeys(
+            ("ProblemError", "load_problem", "problem_from_dict"),
             ".problem",
         ),
         "World": ".world",

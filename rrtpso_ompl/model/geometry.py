@@ -1,8 +1,10 @@
-"""Plane geometry that every stage uses: polyline lengths, shortcutting, point-segment distances.
+"""Plane geometry that every stage uses: polyline lengths, shortcutting, and the exact distances
+of the collision checks (point to segment, segment to segment, segment to axis-aligned box).
 
-Vectorised functions take numpy arrays with any leading shape and coordinates in the last axis;
-the scalar ``*_xy`` twins take plain floats, for OMPL's one-segment-at-a-time callbacks, where
-building arrays would cost more than the arithmetic.
+Vectorised functions take numpy arrays with any leading shape (or ``(k, 2)`` rows) and
+coordinates in the last axis; the scalar ``*_xy`` twins take plain floats, for OMPL's
+one-segment-at-a-time callbacks, where building arrays would cost more than the arithmetic.
+Every length is in the unit of the coordinates (the problem's, metres for maps).
 """
 
 from __future__ import annotations
@@ -15,13 +17,20 @@ import numpy as np
 
 __all__ = [
     "GridFrame",
+    "bounding_box",
     "cross",
     "cumulative_length",
     "dedupe",
+    "is_axis_aligned_rectangle",
     "path_length",
+    "point_in_polygon_xy",
     "point_segment_distance",
     "point_segment_distance_xy",
+    "segment_box_distance",
+    "segment_box_distance_xy",
     "segment_lengths",
+    "segment_segment_distance",
+    "segment_segment_distance_xy",
     "segments_cross",
     "shortcut",
     "turning_angles",
@@ -236,11 +245,9 @@ def shortcut(
         ahead = window
         while True:
             j = np.arange(i + 1, min(last, i + ahead) + 1)
+            chunks = np.array_split(j, max(1, math.ceil(len(j) / _CHUNK)))
             sight = np.concatenate(
-                [
-                    segments_free(np.broadcast_to(p[i], (len(chunk), 2)), p[chunk])
-                    for chunk in np.array_split(j, max(1, math.ceil(len(j) / _CHUNK)))
-                ]
+                [segments_free(np.broadcast_to(p[i], (len(c), 2)), p[c]) for c in chunks]
             )
             # The next vertex is in sight on a valid input; on an invalid one, step to it anyway.
             seen = np.flatnonzero(sight)
@@ -251,3 +258,128 @@ def shortcut(
         i = best
         keep.append(i)
     return p[keep]
+
+
+# ----------------------------------------------------------------------------------------------
+# Exact distances to boxes and edges (the world's collision checks)
+# ----------------------------------------------------------------------------------------------
+def segment_box_distance_xy(ax, ay, bx, by, x0, y0, x1, y1) -> float:
+    """Exact distance from segment a-b to the closed box [x0, x1] x [y0, y1] (0 when they meet)."""
+    # Liang-Barsky: does the segment meet the box?
+    dx, dy = bx - ax, by - ay
+    t0, t1 = 0.0, 1.0
+    hit = True
+    for p, q in ((-dx, ax - x0), (dx, x1 - ax), (-dy, ay - y0), (dy, y1 - ay)):
+        if p == 0.0:
+            if q < 0.0:
+                hit = False
+                break
+        else:
+            t = q / p
+            if p < 0.0:
+                t0 = t if t > t0 else t0
+            else:
+                t1 = t if t < t1 else t1
+            if t0 > t1:
+                hit = False
+                break
+    if hit:
+        return 0.0
+    # Otherwise the distance is attained at an end point of the segment or a corner of the box.
+    ex = max(x0 - ax, 0.0, ax - x1)
+    ey = max(y0 - ay, 0.0, ay - y1)
+    fx = max(x0 - bx, 0.0, bx - x1)
+    fy = max(y0 - by, 0.0, by - y1)
+    d = min(math.sqrt(ex * ex + ey * ey), math.sqrt(fx * fx + fy * fy))
+    for cx, cy in ((x0, y0), (x1, y0), (x1, y1), (x0, y1)):
+        d = min(d, point_segment_distance_xy(cx, cy, ax, ay, bx, by))
+    return d
+
+
+def segment_box_distance(a: np.ndarray, b: np.ndarray, box: np.ndarray) -> np.ndarray:
+    """:func:`segment_box_distance_xy` for arrays: ``a, b`` (k, 2), ``box`` (k, 4)."""
+    d = b - a
+    t0 = np.zeros(len(a))
+    t1 = np.ones(len(a))
+    ok = np.ones(len(a), dtype=bool)
+    for p, q in ((-d[:, 0], a[:, 0] - box[:, 0]), (d[:, 0], box[:, 2] - a[:, 0]),
+                 (-d[:, 1], a[:, 1] - box[:, 1]), (d[:, 1], box[:, 3] - a[:, 1])):  # fmt: skip
+        zero = p == 0.0
+        ok &= ~(zero & (q < 0.0))
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            t = np.where(zero, 0.0, q / np.where(zero, 1.0, p))
+        t0 = np.where(~zero & (p < 0.0), np.maximum(t0, t), t0)
+        t1 = np.where(~zero & (p > 0.0), np.minimum(t1, t), t1)
+    hit = ok & (t0 <= t1)
+
+    def to_box(pt: np.ndarray) -> np.ndarray:
+        ex = np.maximum(np.maximum(box[:, 0] - pt[:, 0], 0.0), pt[:, 0] - box[:, 2])
+        ey = np.maximum(np.maximum(box[:, 1] - pt[:, 1], 0.0), pt[:, 1] - box[:, 3])
+        return np.hypot(ex, ey)
+
+    out = np.minimum(to_box(a), to_box(b))
+    for ix, iy in ((0, 1), (2, 1), (2, 3), (0, 3)):
+        corner = np.column_stack([box[:, ix], box[:, iy]])
+        out = np.minimum(out, point_segment_distance(corner, a, b))
+    return np.where(hit, 0.0, out)
+
+
+def point_in_polygon_xy(x: float, y: float, xs: tuple[float, ...], ys: tuple[float, ...]) -> bool:
+    """Even-odd ray casting (boundary points may go either way; callers also test distance)."""
+    inside = False
+    n = len(xs)
+    j = n - 1
+    for i in range(n):
+        xi, yi, xj, yj = xs[i], ys[i], xs[j], ys[j]
+        if (yi > y) != (yj > y) and x < (xj - xi) * (y - yi) / (yj - yi) + xi:
+            inside = not inside
+        j = i
+    return inside
+
+
+def segment_segment_distance_xy(
+    ax: float, ay: float, bx: float, by: float, cx: float, cy: float, dx: float, dy: float
+) -> float:
+    """Exact distance between the segments a-b and c-d (0 when they cross)."""
+    d1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    d2 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
+    d3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
+    d4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
+    if d1 * d2 < 0.0 and d3 * d4 < 0.0:
+        return 0.0
+    # Otherwise the distance is attained at an end point of one of them.
+    return min(
+        point_segment_distance_xy(ax, ay, cx, cy, dx, dy),
+        point_segment_distance_xy(bx, by, cx, cy, dx, dy),
+        point_segment_distance_xy(cx, cy, ax, ay, bx, by),
+        point_segment_distance_xy(dx, dy, ax, ay, bx, by),
+    )
+
+
+def segment_segment_distance(a: np.ndarray, b: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """:func:`segment_segment_distance_xy` for arrays: ``a, b`` (k, 2), edges ``e`` (k, 4)."""
+    e0, e1 = e[:, :2], e[:, 2:]
+    d = np.minimum(
+        np.minimum(point_segment_distance(a, e0, e1), point_segment_distance(b, e0, e1)),
+        np.minimum(point_segment_distance(e0, a, b), point_segment_distance(e1, a, b)),
+    )
+    d[segments_cross(a, b, e0, e1)] = 0.0
+    return d
+
+
+def is_axis_aligned_rectangle(points) -> bool:
+    """Whether a ring of four ``(x, y)`` tuples is an axis-aligned rectangle (the world checks
+    it exactly by the box formulas)."""
+    if len(points) != 4:
+        return False
+    xs = sorted({p[0] for p in points})
+    ys = sorted({p[1] for p in points})
+    corners = {(x, y) for x in xs for y in ys}
+    return len(xs) == 2 and len(ys) == 2 and set(points) == corners
+
+
+def bounding_box(points) -> tuple[float, float, float, float]:
+    """``(xmin, ymin, xmax, ymax)`` of ``(x, y)`` points, in their unit."""
+    xs = [p[0] for p in points]
+    ys = [p[1] for p in points]
+    return min(xs), min(ys), max(xs), max(ys)

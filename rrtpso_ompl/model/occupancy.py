@@ -65,6 +65,7 @@ __all__ = [
     "load_map",
     "map_image_path",
     "merge_cells",
+    "read_image",
     "read_pgm",
 ]
 
@@ -273,7 +274,7 @@ def load_map(path: str | Path, unknown_blocks: bool = True) -> OccupancyMap:
     source = str(path)
     keys = _map_keys(source, _read_map_yaml(path))
     image_path = map_image_path(path, keys.image)
-    grey, alpha, maxval = _read_image(source, image_path)
+    grey, alpha, maxval = read_image(source, image_path)
     _check_extent(source, keys, grey.shape)
     state = _states(grey, alpha, maxval, keys.mode, keys.negate, keys.occupied_thresh,
                     keys.free_thresh)  # fmt: skip
@@ -462,7 +463,7 @@ def _states(grey, alpha, maxval: int, mode: str, negate: bool, occ: float, free:
 
 
 # ----------------------------------------------------------------------------------------------
-def _read_image(source: str, path: Path) -> tuple[np.ndarray, np.ndarray | None, int]:
+def read_image(source: str, path: Path) -> tuple[np.ndarray, np.ndarray | None, int]:
     """Grey values (H, W), alpha (H, W) or None, and the grey maxval, of a map image."""
     try:
         with open_input(path) as fh:  # a regular file, or why not

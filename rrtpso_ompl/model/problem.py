@@ -3,9 +3,9 @@
 A problem file describes one planning query for a disc-shaped differential-drive robot in the
 plane: the bounds of the robot's centre, start and goal, the robot, static obstacles (circles,
 rectangles, polygons), optional moving obstacles (paper eqs. 14-15) and optional planner defaults.
-
-Everything here is plain data: frozen dataclasses, no OMPL, no matplotlib. Every way a file can be
-wrong is reported by one :class:`ProblemError` that names the file, the key and the problem.
+The result is plain data (:mod:`.problem_types`, whose names are re-exported here): no OMPL, no
+matplotlib. Every way a file can be wrong is reported by one :class:`ProblemError` that names
+the file, the key and the problem.
 """
 
 from __future__ import annotations
@@ -15,7 +15,6 @@ import math
 import numbers
 import os
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any, TypeVar
@@ -33,9 +32,22 @@ from ..validation import (
     number_hint,
 )
 from .format import MAP, MOVING, OBSTACLES, PLANNER, ROBOT, TOP
-from .geometry import GridFrame
 from .objective import default_scaling
 from .occupancy import OccupancyMap, load_map, map_image_path
+from .problem_types import (
+    Circle,
+    MovingObstacle,
+    Obstacle,
+    PlannerConfig,
+    Point,
+    Polygon,
+    Problem,
+    Robot,
+    clearance_threshold,
+    normalise_degrees,
+    outside_boxes,
+    touch_tolerance,
+)
 from .yamlfile import read_yaml_file
 
 #: Why coordinates and lengths are bounded (for messages).
@@ -59,173 +71,7 @@ __all__ = [
     "touch_tolerance",
 ]
 
-Point = tuple[float, float]
 _T = TypeVar("_T")
-
-
-@dataclass(frozen=True)
-class Circle:
-    """A static circular obstacle. Clearance to it is computed exactly (never on a polygon)."""
-
-    center: Point
-    radius: float
-    kind: str = field(default="circle", init=False)
-
-
-@dataclass(frozen=True)
-class Polygon:
-    """A static polygonal obstacle (a ``rectangle`` from the file is stored as its 4 corners).
-
-    ``points`` is a simple (non-self-intersecting) ring of at least 3 vertices with non-zero area,
-    in counter-clockwise order, without the closing repeat of the first vertex.
-    """
-
-    points: tuple[Point, ...]
-    kind: str = "polygon"  # "polygon" or "rectangle": how it was written in the file
-
-
-Obstacle = Circle | Polygon
-
-
-@dataclass(frozen=True)
-class MovingObstacle:
-    """A disc moving at constant velocity (paper eqs. 14-15).
-
-    Parameters
-    ----------
-    radius : float
-        Radius of the obstacle's disc (its safety zone SO), in problem units.
-    start : (float, float)
-        Centre at t = 0.
-    speed : float
-        Speed in problem units per second, >= 0.
-    heading_deg : float
-        Direction of motion in degrees, counter-clockwise from +x.
-    """
-
-    radius: float
-    start: Point
-    speed: float
-    heading_deg: float
-
-    @property
-    def velocity(self) -> np.ndarray:
-        """Velocity vector (vx, vy) in units per second."""
-        h = math.radians(self.heading_deg)
-        return np.array([self.speed * math.cos(h), self.speed * math.sin(h)])
-
-    def position(self, t: float | np.ndarray) -> np.ndarray:
-        """Centre at time(s) ``t`` in seconds: eqs. 14-15 in closed form, shape ``(..., 2)``."""
-        t = np.asarray(t, dtype=float)
-        return np.asarray(self.start, dtype=float) + t[..., None] * self.velocity
-
-
-@dataclass(frozen=True)
-class Robot:
-    """The robot: a disc of radius ``radius`` (the safety zone SR) plus drive parameters.
-
-    Attributes are in problem units (lengths), units per second (speed) and seconds
-    (sample_time). The drive parameters are optional until velocities or simulations are asked for.
-    """
-
-    radius: float
-    wheel_radius: float | None = None
-    track_width: float | None = None
-    speed: float | None = None
-    sample_time: float | None = None
-    sensor_range: float | None = None
-    max_speed: float | None = None
-    max_wheel_speed: float | None = None
-    max_accel: float | None = None
-    inflation_radius: float | None = None
-    cost_scaling_factor: float | None = None
-    cost_travel_multiplier: float | None = None
-
-
-@dataclass(frozen=True)
-class PlannerConfig:
-    """Optional planner defaults from the file; command-line flags override them."""
-
-    type: str | None = None
-    time_limit: float | None = None
-    seed: int | None = None
-    params: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
-
-
-@dataclass(frozen=True)
-class Problem:
-    """One validated planning problem. Build it with :func:`load_problem`.
-
-    Lengths are in the problem's ``units``; ``goal_yaw`` is the heading wanted at the goal in
-    degrees, counter-clockwise from +x, normalised to (-180, 180] (None: any heading).
-    """
-
-    name: str
-    bounds: tuple[Point, Point]
-    start: Point
-    goal: Point
-    robot: Robot
-    obstacles: tuple[Obstacle, ...] = ()
-    moving_obstacles: tuple[MovingObstacle, ...] = ()
-    goal_tolerance: float = 0.0
-    goal_yaw: float | None = None
-    planner: PlannerConfig = field(default_factory=PlannerConfig)
-    description: str = ""
-    units: str = ""
-    source: str = "<dict>"
-    map: OccupancyMap | None = field(default=None, compare=False)
-
-    @property
-    def map_boxes(self) -> np.ndarray | None:
-        """(k, 4) boxes ``(xmin, ymin, xmax, ymax)`` blocked by the map, in its grid coordinates
-        (:attr:`map_frame`; the map frame's for a map that is not turned): its merged blocked
-        cells and, for a map that is not turned when unknown cells block, the parts of the bounds
-        outside the map (a turned map's are :attr:`map_outside`); None without a map."""
-        if self.map is None:
-            return None
-        boxes = self.map.boxes
-        if not self.map.unknown_blocks or self.map.frame is not None:
-            return boxes
-        outside = _outside(self.bounds, self.map.extent)
-        return np.vstack([boxes, outside]) if len(outside) else boxes
-
-    @property
-    def map_frame(self) -> GridFrame | None:
-        """The grid frame of a turned map (None without one): :attr:`map_boxes` are in its
-        coordinates. Its ``confined`` is the map's rectangle when every free configuration lies
-        in it (unknown space blocks, and the map lies within the bounds)."""
-        if self.map is None or self.map.frame is None:
-            return None
-        frame = self.map.frame
-        (bx0, by0), (bx1, by1) = self.bounds
-        tol = touch_tolerance(self.bounds)
-        c = self.map.corners
-        inside = (c[:, 0] >= bx0 - tol) & (c[:, 0] <= bx1 + tol)
-        inside &= (c[:, 1] >= by0 - tol) & (c[:, 1] <= by1 + tol)
-        if self.map.unknown_blocks and inside.all():
-            (x0, y0), (x1, y1) = self.map.extent
-            frame = replace(frame, confined=(x0, y0, x1, y1))
-        return frame
-
-    @property
-    def map_outside(self) -> tuple[Polygon, ...]:
-        """The parts of the bounds outside a turned map, as convex polygons in the map frame,
-        when unknown space blocks (there the robot's disc may not go); none otherwise (a map that
-        is not turned has them among :attr:`map_boxes`). Parts thinner than the round-off
-        allowance are left out: a disc reaching into them is within it anyway."""
-        if self.map is None or self.map.frame is None or not self.map.unknown_blocks:
-            return ()
-        return _outside_turned(self.bounds, self.map.corners, touch_tolerance(self.bounds))
-
-    @property
-    def inputs(self) -> tuple[str, ...]:
-        """The files the problem was read from, resolved (absolute, links followed): the problem
-        file, and its map's YAML and image; none for a problem built from a mapping. No output
-        may be one of them (the command line refuses it before planning)."""
-        files = [] if self.source.startswith("<") else [self.source]
-        if self.map is not None:
-            files += [self.map.source, self.map.image]
-        return tuple(dict.fromkeys(os.path.realpath(f) for f in files))
 
 
 def load_problem(path: str | Path) -> Problem:
@@ -315,11 +161,7 @@ def problem_from_dict(
     ProblemError
         For anything that is not a valid problem (the same checks as :func:`load_problem`).
     """
-    if not isinstance(source, str):
-        raise ArgumentError(f"problem_from_dict: source must be a str naming where the data came "
-                            f"from, got {describe(source)}")  # fmt: skip
-    if name is not None and not isinstance(name, str):
-        raise ArgumentError(f"problem_from_dict: name must be a str, got {describe(name)}")
+    _check_arguments(source, name)
     v = _Validator(source)
     doc = v.document(data)
     if base is None:  # a map path is relative to the problem file, when there is one
@@ -329,9 +171,6 @@ def problem_from_dict(
     obstacles = v.each(doc, "obstacles", v.obstacle)
     moving = v.each(doc, "moving_obstacles", v.moving)
     units = v.string(_get(doc, "units", "m" if occupancy else ""), "units", empty=True)
-    if robot.inflation_radius and robot.cost_scaling_factor is None:
-        # Nav2's default is per metre: the same falling cost in the problem's units.
-        robot = dataclasses.replace(robot, cost_scaling_factor=default_scaling(units))
     problem = Problem(
         name=v.string(_get(doc, "name", name or "problem"), "name"),
         description=v.string(_get(doc, "description", ""), "description", empty=True),
@@ -341,7 +180,7 @@ def problem_from_dict(
         goal=v.point(doc["goal"], "goal"),
         goal_tolerance=v.number(_get(doc, "goal_tolerance", 0.0), "goal_tolerance", low=0.0),
         goal_yaw=v.degrees(doc.get("goal_yaw"), "goal_yaw"),
-        robot=robot,
+        robot=_with_default_scaling(robot, units),
         obstacles=obstacles,
         moving_obstacles=moving,
         planner=v.planner(_get(doc, "planner", {}), "planner"),
@@ -351,6 +190,23 @@ def problem_from_dict(
     for key in ("start", "goal"):
         v.free_position(problem, key)
     return problem
+
+
+def _check_arguments(source: Any, name: Any) -> None:
+    """:func:`problem_from_dict`'s own arguments (a caller's mistake, not the file's)."""
+    if not isinstance(source, str):
+        raise ArgumentError(f"problem_from_dict: source must be a str naming where the data came "
+                            f"from, got {describe(source)}")  # fmt: skip
+    if name is not None and not isinstance(name, str):
+        raise ArgumentError(f"problem_from_dict: name must be a str, got {describe(name)}")
+
+
+def _with_default_scaling(robot: Robot, units: str) -> Robot:
+    """The robot with an inflation radius but no ``cost_scaling_factor`` given Nav2's default,
+    which is per metre: the same falling cost in the problem's units."""
+    if robot.inflation_radius and robot.cost_scaling_factor is None:
+        return dataclasses.replace(robot, cost_scaling_factor=default_scaling(units))
+    return robot
 
 
 # ----------------------------------------------------------------------------------------------
@@ -702,7 +558,7 @@ class _Validator:
             )
         if grid.unknown_blocks:
             if grid.frame is None:
-                outside = _outside(problem.bounds, grid.extent)
+                outside = outside_boxes(problem.bounds, grid.extent)
                 dx = np.maximum.reduce([outside[:, 0] - x, 0 * outside[:, 0], x - outside[:, 2]])
                 dy = np.maximum.reduce([outside[:, 1] - y, 0 * outside[:, 1], y - outside[:, 3]])
                 d = float(np.hypot(dx, dy).min(initial=math.inf))
@@ -719,68 +575,6 @@ class _Validator:
 # ----------------------------------------------------------------------------------------------
 # Small pure helpers.
 # ----------------------------------------------------------------------------------------------
-def _outside(bounds: tuple[Point, Point], extent: tuple[Point, Point]) -> np.ndarray:
-    """(k <= 4, 4) boxes covering the part of ``bounds`` outside the map's ``extent``."""
-    (bx0, by0), (bx1, by1) = bounds
-    (mx0, my0), (mx1, my1) = extent
-    boxes = [
-        (bx0, by0, min(mx0, bx1), by1),  # left of the map
-        (max(mx1, bx0), by0, bx1, by1),  # right
-        (max(mx0, bx0), by0, min(mx1, bx1), min(my0, by1)),  # below, between left and right
-        (max(mx0, bx0), max(my1, by0), min(mx1, bx1), by1),  # above
-    ]
-    out = np.array([b for b in boxes if b[2] > b[0] and b[3] > b[1]], dtype=float)
-    return out.reshape(-1, 4)
-
-
-def _outside_turned(bounds: tuple[Point, Point], corners: np.ndarray, tol: float):
-    """Convex polygons covering the part of ``bounds`` outside the turned rectangle ``corners``
-    ((4, 2), counter-clockwise): the part beyond its first side, then what is left beyond its
-    second side, and so on (a convex polygon clipped by half-planes each time). A vertex within
-    ``tol`` of a side's line counts as on it (so that round-off makes no sliver or repeated
-    vertex), and parts that reach no more than ``tol`` beyond their side are left out."""
-    (bx0, by0), (bx1, by1) = bounds
-    rest = [(bx0, by0), (bx1, by0), (bx1, by1), (bx0, by1)]
-    pieces = []
-    for k in range(4):
-        (ax, ay), (cx, cy) = corners[k].tolist(), corners[(k + 1) % 4].tolist()
-        ex, ey = cx - ax, cy - ay
-        n = math.hypot(ex, ey)
-
-        def inward(p, ax=ax, ay=ay, ex=ex, ey=ey, n=n) -> float:
-            """Signed distance of ``p`` into the rectangle's side of the line (left of it),
-            0 within ``tol``."""
-            d = (ex * (p[1] - ay) - ey * (p[0] - ax)) / n
-            return 0.0 if abs(d) <= tol else d
-
-        beyond = _clip_convex(rest, inward, -1.0, tol)
-        rest = _clip_convex(rest, inward, 1.0, tol)
-        if len(beyond) >= 3 and min(inward(p) for p in beyond) < 0.0:
-            pieces.append(Polygon(tuple(beyond)))
-        if len(rest) < 3:
-            break
-    return tuple(pieces)
-
-
-def _clip_convex(ring: list[Point], side: Callable[[Point], float], sign: float, tol: float):
-    """The part of a convex ring where ``sign * side`` is >= 0 (one Sutherland-Hodgman step);
-    counter-clockwise stays counter-clockwise; vertices within ``tol`` of the one before merge."""
-    out: list[Point] = []
-    for i, p in enumerate(ring):
-        q = ring[(i + 1) % len(ring)]
-        sp, sq = sign * side(p), sign * side(q)
-        if sp >= 0.0:
-            out.append(p)
-        if (sp > 0.0 > sq) or (sp < 0.0 < sq):
-            t = sp / (sp - sq)
-            out.append((p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])))
-    kept: list[Point] = []
-    for p in out:
-        if not kept or math.dist(p, kept[-1]) > tol:
-            kept.append(p)
-    while len(kept) > 1 and math.dist(kept[0], kept[-1]) <= tol:
-        kept.pop()
-    return kept
 
 
 def _too_small(bounds: tuple[Point, Point]) -> str:
@@ -798,39 +592,6 @@ def _too_small(bounds: tuple[Point, Point]) -> str:
         f"{need:g} ({MIN_EXTENT:g} of its coordinates' magnitude {magnitude:g})")  # fmt: skip
     return (f"too small to plan in: sides {xmax - xmin:g} x {ymax - ymin:g}, each must be at "
             f"least {why}")  # fmt: skip
-
-
-def normalise_degrees(angle: float) -> float:
-    """``angle`` (degrees) as the same direction in (-180, 180], exactly (``math.remainder``
-    rounds nothing, even for 1e300)."""
-    a = math.remainder(angle, 360.0)
-    return 180.0 if a == -180.0 else a + 0.0  # + 0.0: no -0.0 in outputs
-
-
-def touch_tolerance(bounds: tuple[Point, Point]) -> float:
-    """Round-off allowance for "touching is allowed" comparisons in a workspace.
-
-    ``1e-9`` of the workspace's scale: the larger of its sides and of its coordinates'
-    magnitudes (float spacing grows with both). Relative at every scale, so a workspace 1e-6
-    wide is checked as exactly as one of 500 cm; far below any physical clearance, well above
-    float round-off in the distance formulas.
-    """
-    (xmin, ymin), (xmax, ymax) = bounds
-    scale = max(xmax - xmin, ymax - ymin, abs(xmin), abs(ymin), abs(xmax), abs(ymax))
-    return 1e-9 * scale
-
-
-def clearance_threshold(robot_radius: float, tol: float) -> float:
-    """The smallest distance to an obstacle that still counts as free.
-
-    ``robot_radius - tol``: touching at exactly the radius is allowed, up to round-off. For a point
-    robot (radius 0) that would let a segment *enter* an obstacle (its distance is then 0, like a
-    touch), so the threshold never drops below ``+tol``: still within the round-off tolerance of
-    the radius, and every penetration is caught. The loader (free start and goal) and
-    :class:`~rrtpso_ompl.model.World` share this rule, so a start accepted here is never refused
-    by a planner.
-    """
-    return max(robot_radius - tol, tol)
 
 
 def _clearance(obstacle: Obstacle, x: float, y: float) -> float:

@@ -20,15 +20,8 @@ import yaml
 from ..errors import ProblemError
 from ..outputs import write_text_atomic
 from ..validation import check_integer
-from .problem import (
-    _MOVING_KEYS,
-    _OBSTACLE_KEYS,
-    _PLANNER_KEYS,
-    _ROBOT_KEYS,
-    _TOP_KEYS,
-    Problem,
-    problem_from_dict,
-)
+from .format import MOVING, OBSTACLES, PLANNER, ROBOT, TOP
+from .problem import Problem, problem_from_dict
 
 __all__ = ["default_decimals", "round_floats", "write_problem"]
 
@@ -121,8 +114,9 @@ def default_decimals(size: float) -> int:
 
 def _format_problem(data: Mapping[str, Any], header: str | None) -> str:
     lines = [f"# {line}".rstrip() for line in header.splitlines()] if header else []
-    nested = {"robot": _ROBOT_KEYS, "planner": _PLANNER_KEYS}
-    for key in _ordered(data, _TOP_KEYS):
+    # The format's key order, declared once in format.py (the loader reads the same tables).
+    nested = {"robot": ROBOT.names(), "planner": PLANNER.names()}
+    for key in _ordered(data, TOP.names()):
         value = data[key]
         if value is None:
             continue
@@ -135,9 +129,7 @@ def _format_problem(data: Mapping[str, Any], header: str | None) -> str:
                 continue
             lines.append(f"{key}:")
             for item in value:
-                order = (
-                    _OBSTACLE_KEYS.get(item.get("type"), ()) if key == "obstacles" else _MOVING_KEYS
-                )
+                order = _obstacle_keys(item.get("type")) if key == "obstacles" else MOVING.names()
                 lines.append(f"  - {_flow({k: item[k] for k in _ordered(item, order)})}")
         elif key == "description" and isinstance(value, str):
             lines.append(_folded(key, value))
@@ -203,3 +195,9 @@ def round_floats(value: Any, decimals: int) -> Any:
     if isinstance(value, float) and math.isfinite(value):
         return round(value, decimals) + 0.0
     return value
+
+
+def _obstacle_keys(kind: Any) -> tuple[str, ...]:
+    """The declared keys of an obstacle of ``kind``, in order (none for an unknown kind)."""
+    section = OBSTACLES.get(kind) if isinstance(kind, str) else None
+    return tuple(section.names()) if section is not None else ()

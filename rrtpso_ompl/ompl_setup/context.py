@@ -18,8 +18,7 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from ..model.objective import InflationCost
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from ..model.world import World
 from .objective import objective_for
 
@@ -118,6 +117,6 @@ def make_context(problem: Problem, world: World | None = None) -> PlanningContex
     # scale, relative as every exact check; a path ending at the sampled goal state has d = 0).
     threshold = max(problem.goal_tolerance, world.tol)
     ss.setStartAndGoalStates(start, goal, threshold)
-    objective = objective_for(si, InflationCost.of(problem.robot), world)
+    objective = objective_for(si, problem.objective, world)
     ss.setOptimizationObjective(objective)
     return PlanningContext(problem, world, ss, si, space, checker, validator, objective)

@@ -33,7 +33,7 @@ from ompl import base as ob
 from ompl import util as ou
 
 from ..errors import UnsupportedSpaceError
-from ..model.problem import touch_tolerance
+from ..model.problem_types import touch_tolerance
 from ..model.raster import Lattice
 from ..model.world import MarkingStopped
 from ..ompl_setup.space import plane_space_problem, require_plane_space

@@ -48,7 +48,7 @@ from ..errors import (
     did_you_mean,
     shown,
 )
-from ..model.problem import PlannerConfig, Problem
+from ..model.problem_types import PlannerConfig, Problem
 from ..params import ParamSpec, ParamTable
 from ..validation import check_seconds, check_seed, describe
 from .pso.path_optimizer import PathOptimizerOptions

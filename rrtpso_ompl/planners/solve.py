@@ -24,8 +24,7 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..model.geometry import path_length
-from ..model.objective import InflationCost
-from ..model.problem import Problem
+from ..model.problem_types import Problem
 from ..model.world import World
 from ..validation import describe
 from .registry import PlannerRegistry
@@ -250,9 +249,7 @@ def _result(
         params=_applied(instance, request.values),
         stages=run.stages,
         clearance=ctx.world.path_clearance(path) - ctx.world.robot_radius if len(path) else None,
-        cost=InflationCost.of(request.problem.robot).path_cost(ctx.world, path)
-        if len(path)
-        else None,
+        cost=request.problem.objective.path_cost(ctx.world, path) if len(path) else None,
         benchmark=run.benchmark,
     )
 

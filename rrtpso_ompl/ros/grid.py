@@ -49,9 +49,9 @@ def occupancy_values(grid: Any) -> np.ndarray:
     values[state == BLOCKED] = OCCUPIED
     if grid.mode == "trinary":
         return values
-    from ..model.occupancy import _read_image  # the same reader, so the same grey values
+    from ..model.occupancy import read_image  # the same reader, so the same grey values
 
-    grey, alpha, maxval = _read_image(grid.source, Path(grid.image))
+    grey, alpha, maxval = read_image(grid.source, Path(grid.image))
     opaque = np.ones(state.shape, dtype=bool) if alpha is None else alpha == 255
     if grid.mode == "raw":
         raw = grey.astype(np.int64)

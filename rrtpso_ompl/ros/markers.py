@@ -74,7 +74,7 @@ def obstacle_markers(
     t : float
         Stamp, seconds.
     """
-    from ..model.problem import Circle
+    from ..model.problem_types import Circle
 
     b = _Builder(msgs, t, line_width)
     b.delete_all()

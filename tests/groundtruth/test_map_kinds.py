@@ -16,8 +16,8 @@ from helpers import rrtpso_exe
 
 from rrtpso_ompl.errors import GenerationError
 from rrtpso_ompl.groundtruth import generate, generate_to_file, map_kinds, shortest_path
-from rrtpso_ompl.groundtruth.generate import GENERATORS
-from rrtpso_ompl.groundtruth.map_kinds import MapKindOptions, generate_map
+from rrtpso_ompl.groundtruth.generate import GENERATORS, generate_map
+from rrtpso_ompl.groundtruth.map_kinds import MapKindOptions
 from rrtpso_ompl.model import load_problem
 from rrtpso_ompl.model.occupancy import load_map
 from rrtpso_ompl.model.world import World
@@ -216,16 +216,22 @@ def test_a_read_only_folder_is_refused_and_nothing_is_left(tmp_path):
 def test_a_write_that_fails_midway_leaves_nothing_behind(tmp_path, monkeypatch):
     """The pgm and the map YAML are in place when the problem's rename fails: both are removed,
     as is the temporary folder and the folder made for the files."""
-    real = map_kinds._publish
+    from rrtpso_ompl import outputs
+
+    real = outputs.publish
+    problem = tmp_path / "new" / "p.yaml"
+    published = []
 
     def failing(tmp, target):
-        if target.name == "p.yaml":
+        if target == problem:  # the last of the three, into place (not inside the scratch folder)
             raise OSError(28, "No space left on device")
         real(tmp, target)
+        published.append(target)
 
-    monkeypatch.setattr(map_kinds, "_publish", failing)
+    monkeypatch.setattr(outputs, "publish", failing)
     with pytest.raises(GenerationError, match="No space left"):
-        generate_to_file("rooms_map", 1, tmp_path / "new" / "p.yaml", cells=32)
+        generate_to_file("rooms_map", 1, problem, cells=32)
+    assert set(three(problem)[1:]) <= set(published)  # the map's two files were in place
     assert list(tmp_path.iterdir()) == []
 
 

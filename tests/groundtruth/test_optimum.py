@@ -467,21 +467,23 @@ def test_the_cheap_filters_never_drop_a_free_tangent(seed):
     """The raster's rejection and the near-obstacle pass only remove tangents the exact check
     would reject, and between them they remove most of the blocked ones."""
     from rrtpso_ompl.groundtruth.free_grid import FreeGrid
-    from rrtpso_ompl.groundtruth.optimum import _NodeCircles, _tangents_from, _TangentSearch
+    from rrtpso_ompl.groundtruth.optimum.circles import NodeCircles
+    from rrtpso_ompl.groundtruth.optimum.graph import TangentGraph
+    from rrtpso_ompl.groundtruth.optimum.tangents import tangents_from
 
     problem = problem_from_dict(_cluttered(seed, 0.8, 40, (1.5, 4)))
     world = World.from_problem(problem)
     start, goal = np.array(problem.start[:2]), np.array(problem.goal[:2])
     grid = FreeGrid.for_world(world, start, goal)
-    nodes = _NodeCircles.build(world, grid, start, goal, world.robot_radius)
-    search = _TangentSearch(world, grid, nodes, 0.0, math.inf, "t", None)
-    n = len(search.circles)
+    nodes = NodeCircles.build(world, grid, start, goal, world.robot_radius)
+    graph = TangentGraph(world, grid, nodes, 0.0, math.inf)
+    n = len(graph.circles)
     i, j = np.nonzero(~np.eye(n, dtype=bool))
     pick = np.random.default_rng(seed).choice(len(i), 2000, replace=False)
-    cand = _tangents_from(search.circles, i[pick], j[pick])
+    cand = tangents_from(graph.circles, i[pick], j[pick])
     free = world.segments_free(cand.p, cand.q)
     raster = grid.blocked_segments(cand.p, cand.q)
-    near = search._blocked_near(cand)
+    near = graph.blocked_near(cand)
     assert not (free & (raster | near)).any()
     assert (raster | near).sum() > 0.5 * (~free).sum()
 
@@ -693,6 +695,7 @@ def test_stopped_searches_say_so():
     assert not shortest_path(problem).stopped
 
 
+@pytest.mark.slow  # seconds of work: the full run only
 def test_six_library_maps_keep_their_written_optima():
     """The optima written in the headers of problems/maps (computed by the old formulation)."""
     import re

@@ -80,8 +80,11 @@ def test_the_optimum_of_a_turned_map_is_the_unturned_optimum_turned(
     assert world.path_valid(path)
     blocked = map_shapes(turned)
     if shapes:
-        blocked = blocked.union(shapely.Point(turned.obstacles[0].center)
-                                .buffer(turned.obstacles[0].radius, quad_segs=256))
+        blocked = blocked.union(
+            shapely.Point(turned.obstacles[0].center).buffer(
+                turned.obstacles[0].radius, quad_segs=256
+            )
+        )
         blocked = blocked.union(shapely.Polygon(turned.obstacles[1].points))
     d = shapely.distance(blocked, shapely.linestrings(np.stack([path[:-1], path[1:]], axis=1)))
     assert d.min() >= turned.robot.radius - 1e-6  # the circle is a 1024-gon inside it
@@ -125,10 +128,10 @@ def test_polygons_cast_no_shadow_whatever_unset_memory_holds(tmp_path, monkeypat
     polygon's index items have none (their rows are never set). Its interiors used to be read
     anyway: unset memory made the optimum of this turned map 13.09 m instead of 12.63 m in
     some runs (a polygon world's, generally). Here unset memory is made to hold ``fill``."""
-    from rrtpso_ompl.groundtruth import optimum
+    from rrtpso_ompl.groundtruth.optimum import shadows
 
     flat, turned, _ = _pair(tmp_path, "lab_diagonal", 0.3, (-4.0, 2.0))
     assert len(World.from_problem(turned).polygons) == 4  # the unknown corners
     want = shortest_path(flat).length
-    monkeypatch.setattr(optimum, "np", _AdversarialNumpy(fill))
+    monkeypatch.setattr(shadows, "np", _AdversarialNumpy(fill))
     assert shortest_path(turned).length == pytest.approx(want, abs=1e-6)

@@ -58,6 +58,7 @@ def test_the_pool_goes_on_after_crashes_and_a_dead_worker():
     assert "worker process died" in results[KILL_WORKER].message
 
 
+@pytest.mark.slow  # seconds of work: the full run only
 def test_same_seed_same_path_as_a_separate_solve(tmp_path):
     """A run in a forked child of a warm worker is seeded like a fresh process: its path is the
     path ``rrtpso solve`` gives in a process of its own."""

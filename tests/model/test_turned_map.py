@@ -138,7 +138,7 @@ def test_the_unknown_space_around_a_turned_map_is_valid_convex_pieces_for_any_tu
     corners): the pieces are valid convex polygons that cover exactly the bounds outside the
     map, up to slivers of the round-off allowance."""
     from rrtpso_ompl.model.geometry import GridFrame
-    from rrtpso_ompl.model.problem import _outside_turned
+    from rrtpso_ompl.model.problem_types import outside_polygons
 
     rng = np.random.default_rng(7)
     for k in range(300):
@@ -154,7 +154,7 @@ def test_the_unknown_space_around_a_turned_map_is_valid_convex_pieces_for_any_tu
         elif k % 3 == 2:  # bounds wider than the map's box
             lo, hi = lo - rng.uniform(0, 5, 2), hi + rng.uniform(0, 5, 2)
         tol = 1e-9 * max(np.abs(lo).max(), np.abs(hi).max(), *(hi - lo))
-        pieces = _outside_turned(((lo[0], lo[1]), (hi[0], hi[1])), corners, tol)
+        pieces = outside_polygons(((lo[0], lo[1]), (hi[0], hi[1])), corners, tol)
         shapes = [shapely.Polygon(p.points) for p in pieces]
         assert all(g.is_valid and g.area > 0 and g.convex_hull.area - g.area < 1e-9 * g.area
                    for g in shapes)  # fmt: skip

@@ -468,8 +468,14 @@ def _crowded_world(seed: int, radius: float) -> World:
 
 
 def _brute(world: World) -> World:
-    twin = World(world.bounds, world.circles, world.polygons, world.robot_radius, world.boxes)
-    twin._indexed = False
+    """The same world checked without its index (every world counts as small)."""
+    from unittest import mock
+
+    from rrtpso_ompl.model import obstacle_index
+
+    with mock.patch.object(obstacle_index, "SMALL_WORLD", math.inf):
+        twin = World(world.bounds, world.circles, world.polygons, world.robot_radius, world.boxes)
+    assert not twin.index.indexed
     return twin
 
 
@@ -478,7 +484,7 @@ def _brute(world: World) -> World:
 def test_the_index_gives_the_same_answers_as_brute_force(seed, radius):
     world = _crowded_world(seed, radius)
     brute = _brute(world)
-    assert world._indexed and world.n_obstacles > 100
+    assert world.index.indexed and world.n_obstacles > 100
     rng = np.random.default_rng(seed + 10)
     a = rng.uniform(-2, 102, (3000, 2))
     # Short, long and zero-length segments, and some along the box grid lines.
@@ -553,13 +559,13 @@ def test_a_polygon_of_thousands_of_vertices_is_checked_edge_by_edge(radius, crow
     near it only, and the answers are those of brute force and of shapely, also for segments
     wholly inside it (far from every edge) and crossing its crowded boundary. The scalar checks
     go through numpy in cells holding more than ``crowded`` items."""
-    import rrtpso_ompl.model.world as world_module
+    import rrtpso_ompl.model.scalar_checks as scalar_checks
 
-    monkeypatch.setattr(world_module, "_CROWDED", crowded)
+    monkeypatch.setattr(scalar_checks, "_CROWDED", crowded)
     gear = _gear(2000)
     world = World(BOUNDS, [(90.0, 10.0, 3.0)], [gear, L_SHAPE * 0.2], radius)
     brute = _brute(world)
-    assert world._indexed and world._grid.max_items < 2000  # no cell holds the whole ring
+    assert world.index.indexed and world.index.grid.max_items < 2000  # no cell holds the whole ring
     rng = np.random.default_rng(7)
     a = rng.uniform(0, 100, (2000, 2))
     b = a + rng.normal(0, 1, (2000, 2)) * rng.choice([0.0, 1.0, 10.0, 40.0], (2000, 1))
@@ -652,7 +658,7 @@ def test_registrations_in_boxes_count_what_the_index_holds_there(seed):
     """The summed-area count equals the registrations of the cells each box meets, and bounds
     the unique pairs ``pairs_in_boxes`` returns."""
     world = _crowded_world(seed, 1.0)
-    grid = world._grid
+    grid = world.index.grid
     rng = np.random.default_rng(seed)
     lo = rng.uniform(-10, 100, (50, 2))
     hi = lo + rng.uniform(0, 60, (50, 2))

@@ -76,11 +76,11 @@ def test_free_cells_of_circles_are_conservative():
 def test_funnel_pulls_the_string_round_the_inner_corner():
     # an L-shaped channel of unit cells: along the bottom row, then up the right column
     cells = [(0, 0), (1, 0), (2, 0), (2, 1), (2, 2)]
-    from rrtpso_ompl.planners.rrtstar_pso.corridor import _portals
+    from rrtpso_ompl.planners.rrtstar_pso.corridor.funnel import channel_portals
 
     lat = Lattice((0.0, 0.0), 1.0, 3, 3)
     rects = np.array([(i, i + 1, j, j + 1) for i, j in cells])
-    path = funnel((0.5, 0.5), (2.5, 2.5), _portals(list(range(5)), rects, lat, 0.0))
+    path = funnel((0.5, 0.5), (2.5, 2.5), channel_portals(list(range(5)), rects, lat, 0.0))
     assert np.allclose(path, [[0.5, 0.5], [2.0, 1.0], [2.5, 2.5]])
 
 
@@ -184,7 +184,7 @@ def _detailed_world() -> World:
 def test_the_corridor_stage_stops_marking_cells_when_terminated():
     """The stage's termination condition reaches into a lattice marking: fired at its fifth
     look (whatever the clock says), the stage ends without a path and says why."""
-    from rrtpso_ompl.planners.rrtstar_pso.corridor import search
+    from rrtpso_ompl.planners.rrtstar_pso.corridor import find_corridor_path
 
     looks = []
 
@@ -192,7 +192,9 @@ def test_the_corridor_stage_stops_marking_cells_when_terminated():
         looks.append(1)
         return len(looks) >= 5
 
-    result = search(_detailed_world(), (5.0, 5.0), (95.0, 95.0), 1e6, terminate=terminate)
+    result = find_corridor_path(
+        _detailed_world(), (5.0, 5.0), (95.0, 95.0), 1e6, terminate=terminate
+    )
     assert result.path is None and result.reason == "out of time marking the lattice's cells"
     assert len(looks) == 5
 
@@ -200,7 +202,7 @@ def test_the_corridor_stage_stops_marking_cells_when_terminated():
 def test_obstacles_too_detailed_to_mark_in_time_end_the_stage_at_once():
     """The probe that measures the cost of marking is cut at its share of the time: with none
     (a budget of 0 s) the stage gives up before any lattice."""
-    from rrtpso_ompl.planners.rrtstar_pso.corridor import search
+    from rrtpso_ompl.planners.rrtstar_pso.corridor import find_corridor_path
 
-    result = search(_detailed_world(), (5.0, 5.0), (95.0, 95.0), 0.0)
+    result = find_corridor_path(_detailed_world(), (5.0, 5.0), (95.0, 95.0), 0.0)
     assert result.path is None and "too slow" in result.reason and result.lattice is None

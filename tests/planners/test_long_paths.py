@@ -32,10 +32,10 @@ def test_a_one_cell_maze_map_gets_a_near_optimal_corridor_path(maze_problem):
     """RRTstarPSO's corridor stage on the maze, bounded by its lattice's cells, not by seconds (at
     0.25 s the whole solve is this path, made valid: docs/families.md, maze_map_c1, measures
     that on a quiet machine; a loaded one can cut the stage's marking short)."""
-    from rrtpso_ompl.planners.rrtstar_pso.corridor import search
+    from rrtpso_ompl.planners.rrtstar_pso.corridor import find_corridor_path
 
     problem, world, optimum = maze_problem
-    res = search(world, problem.start, problem.goal, None, 65_536)
+    res = find_corridor_path(world, problem.start, problem.goal, None, 65_536)
     assert res.path is not None and world.path_valid(res.path)
     assert optimum * (1 - 1e-9) <= res.length <= optimum * 1.001
 
@@ -57,6 +57,7 @@ def test_the_stages_of_a_long_path_add_up_and_end_near_the_budget(maze_problem, 
         assert world.path_valid(np.array(r.path))
 
 
+@pytest.mark.slow  # seconds of work: the full run only
 def test_a_point_robot_squeezing_through_a_random_field_gets_a_taut_path(tmp_path):
     # A 256 x 256 field, 30 % of the cells blocked, a point robot: the funnel's path grazes
     # corners between touching cells (before issue 25's fix the check refused it and the run

@@ -285,6 +285,7 @@ def test_solve_post_errors_exit_2(tmp_path, args, fragment):
     assert not out.exists()
 
 
+@pytest.mark.slow  # seconds of work: the full run only
 def test_bench_logs_each_spec_as_a_configuration(tmp_path):
     proc = run_cli("bench", str(PROBLEMS / "static" / "single_circle.yaml"), "--planner",
                    "RRT+simplify,RRT+simplify+pso", "--runs", "2", "--time", "0.2", "--jobs", "2",

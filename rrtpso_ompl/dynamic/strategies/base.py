@@ -16,7 +16,7 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
-from ...model.problem import Problem
+from ...model.problem_types import Problem
 from ..options import DynamicOptions
 from ..result import SimulationResult
 

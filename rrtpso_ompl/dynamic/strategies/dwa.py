@@ -6,7 +6,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ...model.problem import Problem
+from ...model.problem_types import Problem
 from ...params import declared, param
 from ..dwa_params import DWAParams
 from ..options import DynamicOptions

@@ -24,9 +24,10 @@ from typing import Any
 import numpy as np
 from scipy.sparse.csgraph import dijkstra
 
+from ...model.grid_graph import entry_cell, walk
 from ...model.objective import InflationCost
 from ...model.raster import Lattice
-from .corridor import _entry, _walk, band, lattice_graph
+from .corridor import band, lattice_graph
 
 __all__ = [
     "BAND_RADII",
@@ -137,8 +138,8 @@ def _route_on_lattice(world, inflation: InflationCost, path, h: float, deadline)
     # The end points may lie near a wall, where the conservative cells leave a gap: look a few
     # cells (the inflated band's width) round them.
     reach = math.ceil(radius / h) + 2
-    s_cell, _ = _entry(world, lat, free, path[0], reach)
-    g_cell, _ = _entry(world, lat, free, path[-1], reach)
+    s_cell, _ = entry_cell(lat, free, path[0], reach, world.segments_free)
+    g_cell, _ = entry_cell(lat, free, path[-1], reach, world.segments_free)
     if s_cell is None or g_cell is None:
         return None
     if deadline is not None and time.perf_counter() >= deadline:
@@ -157,7 +158,7 @@ def _route_on_lattice(world, inflation: InflationCost, path, h: float, deadline)
     if not np.isfinite(dist[g]):
         return None
     # Into the first cell and out of the last: the end points lie in them or see their centres.
-    centres = np.array([lat.centre((v // ny, v % ny)) for v in _walk(pred, g)])
+    centres = np.array([lat.centre((v // ny, v % ny)) for v in walk(pred, g)])
     route = np.vstack([path[:1], centres, path[-1:]])
     return route if world.path_valid(route) else None
 

@@ -54,7 +54,7 @@ from ..post import PSOPathOptimizer, inflation_of, simplify_until
 from ..pso.path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
 from ..pso.swarm import SWARM_PARAMS
 from ..result import BenchmarkRun
-from .corridor import search
+from .corridor import find_corridor_path
 from .costroute import cost_route
 from .general import solve_in_space, space_of_planner
 from .rrtstar_stage import INFLATION_RRT_MIN, INFLATION_RRT_SHARE, grow_rrtstar
@@ -341,21 +341,21 @@ class RRTstarPSO(PythonPlanner):
         return ob.PlannerStatus(ob.PlannerStatus.EXACT_SOLUTION)
 
     def _corridor(self, ptc, t0: float, stats: RRTstarPSOStats) -> np.ndarray | None:
-        """Stage 0: the corridor stage's path (:func:`.corridor.search`
+        """Stage 0: the corridor stage's path (:func:`.corridor.find_corridor_path`
         within ``corridor_fraction`` of the budget; with no route at all, up to
         :data:`_CORRIDOR_NO_ROUTE_SHARE` of it), or None."""
-        v = self._values
-        if v["corridor_cells"] <= 0:
+        params = self._values
+        if params["corridor_cells"] <= 0:
             stats.corridor_reason = "off"
             return None
         start, goal = self._start_and_goal(ptc)
         if start is None or goal is None:
             stats.corridor_reason = "no start or goal state"
             return None
-        budget = v["budget"]
-        cells = v["corridor_cells"]
-        seconds = v["corridor_fraction"] * budget if budget > 0 else None
-        if v["rrt_max_iterations"] > 0:
+        budget = params["budget"]
+        cells = params["corridor_cells"]
+        seconds = params["corridor_fraction"] * budget if budget > 0 else None
+        if params["rrt_max_iterations"] > 0:
             # Iteration-bounded (reproducible) runs: a lattice sized by the clock would differ
             # from run to run; a fixed one does not.
             seconds, cells = None, min(cells, REPRODUCIBLE_CORRIDOR_CELLS)
@@ -369,8 +369,16 @@ class RRTstarPSO(PythonPlanner):
                 return None
         t1 = time.perf_counter()
         more = None if seconds is None else t0 + _CORRIDOR_NO_ROUTE_SHARE * budget - t1
-        result = search(self._model, start, goal, seconds, cells, ptc, v["corridor_alternatives"],
-                        no_route_seconds=more)  # fmt: skip
+        result = find_corridor_path(
+            self._model,
+            start,
+            goal,
+            seconds,
+            cells,
+            ptc,
+            params["corridor_alternatives"],
+            no_route_seconds=more,
+        )
         stats.corridor_time = time.perf_counter() - t1
         stats.corridor_cells = result.lattice.n_cells if result.lattice else 0
         stats.corridor_routes = result.routes

@@ -1,0 +1,262 @@
+"""The tangent graph of one round of the exact optimum: its circles and their free tangents.
+
+Whether a tangent is free does not depend on the node that leaves along it, so each circle's
+free tangents are found once, for a batch of circles at a time (those the search will likely
+expand next), through filters that each drop only what no path within the bound can use,
+cheapest first: circle pairs beyond the bound or whose step counts to the goal differ by more
+than a free segment between them allows; directions outside the cones; pairs in the shadow of
+the discs near the first circle (:mod:`.shadows`); tangents beyond the bound; the raster's sound
+rejection; then the exact tests (obstacles near the circle first, then the world's). Lengths are
+in the problem's unit.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...model.world import World
+from ..free_grid import FreeGrid
+from .circles import NodeCircles
+from .shadows import shadowed
+from .tangents import ANGLE_TOL, TWO_PI, Tangents, cone_pos, tangents_from
+
+__all__ = ["TangentGraph"]
+
+#: Worlds with at most this many obstacles skip the near-obstacle pass (the world's own test,
+#: without an index, is as cheap).
+_NEAR_ALL = 24
+#: Most (tangent, obstacle) pairs of the near-obstacle pass.
+_NEAR_PAIRS = 2_000_000
+#: Most circles whose tangents one vectorised pass finds.
+_BATCH = 32
+#: The raster's rejection is run when at least this share of its cells is core.
+_RASTER_WORTH = 0.02
+
+
+class TangentGraph:
+    """The circles a path within one bound can pass, and their free tangents, found as the
+    search asks for them (package docstring, steps 2 and 4).
+
+    Parameters
+    ----------
+    world : World
+        The obstacles (robot radius at least twice the touch tolerance).
+    grid : FreeGrid
+        The conservative raster: lower bounds, step counts, sound rejections.
+    nodes : NodeCircles
+        Every circle a shortest path can wrap, start and goal first.
+    goal_tol : float
+        Radius of the goal disc (0: the goal point).
+    bound : float
+        No path longer than this is looked for (``inf``: none).
+    """
+
+    def __init__(self, world: World, grid: FreeGrid, nodes: NodeCircles, goal_tol: float,
+                 bound: float) -> None:  # fmt: skip
+        self.world = world
+        self.grid = grid
+        self.goal_tol = goal_tol
+        self.bound = _loosen(bound, world.tol)
+        #: Costs closer than this are equal (round-off), problem units.
+        self.eps = 1e-12 * max(1.0, bound if math.isfinite(bound) else 1.0)
+        c = nodes.circles
+        self.start, self.goal = c[0, :2], c[1, :2]
+        # Only circles on which a path within the bound can pass: the geodesic ellipse.
+        lb_s = grid.circle_lower_bound(0, c)
+        lb_g = grid.circle_lower_bound(1, c)
+        through = lb_s + lb_g  # inf: the circle cannot be reached at all
+        keep = np.flatnonzero(((through <= self.bound) & np.isfinite(through))
+                              | (np.arange(len(c)) < 2))  # fmt: skip
+        self.circles = c[keep]
+        self.lo, self.width, self.sure = nodes.lo[keep], nodes.width[keep], nodes.sure[keep]
+        self.lb_s, self.lb_g = lb_s[keep], lb_g[keep]
+        self.steps = grid.step_ranges(self.circles)
+        self._cache: dict[int, Tangents] = {}
+        self._cached = np.zeros(len(self.circles), dtype=bool)
+        self._cached[1] = True  # the goal: never expanded
+        self._cells_only = (grid.band_ok(world.threshold) and not len(world.circles)
+                            and not world.polygons)  # fmt: skip
+
+    def free_tangents(self, i: int, g: float, f: float) -> Tangents:
+        """The tangents from circle ``i`` that some path within the bound could use and that are
+        free (segment and end points in bounds), computed once per circle.
+
+        Whether a tangent segment is free does not depend on the node it leaves from, so each
+        circle's are found once, and together with those of the circles the search will likely
+        expand next (up to :data:`_BATCH` in one vectorised pass, which costs little more than
+        a pass over one): those whose lower bound from the start is nearest to ``g`` and whose
+        lower bound through them is below or near ``f``.
+        """
+        cached = self._cache.get(i)
+        if cached is not None:
+            return cached
+        todo = np.flatnonzero(~self._cached)
+        todo = todo[todo != i]
+        if len(todo) >= _BATCH:
+            key = np.abs(self.lb_s[todo] - g) + np.maximum(
+                self.lb_s[todo] + self.lb_g[todo] - f, 0.0)  # fmt: skip
+            todo = todo[np.argpartition(key, _BATCH - 2)[: _BATCH - 1]]
+        self._prepare(np.concatenate([[i], todo]).astype(np.intp))
+        return self._cache[i]
+
+    def _prepare(self, batch: np.ndarray) -> None:
+        """Fill the cache of each circle of ``batch`` with its usable free tangents.
+
+        The filters, cheapest first, each exact or dropping only what no path within the bound
+        can use: circle pairs too far apart for the bound; tangents leaving or reaching a vertex
+        outside its cone of free directions; tangents no path within the bound can use (lower
+        bounds from the start to the tangent and from its end to the goal); tangents with a
+        sample in a core cell of the raster; then the exact test, first against the obstacles
+        near the circle they leave (where most blocked tangents are blocked), then the world's
+        test of the whole segment.
+        """
+        row, j = self._candidate_pairs(batch)
+        row, j = self._directions_ok(batch, row, j)
+        row, j = shadowed(self.world, self.circles, batch, row, j)
+        cand = self._usable(tangents_from(self.circles, batch[row], j))
+        cand = self._free(cand)
+        cand.node = np.full(len(cand.j), -1, dtype=np.intp)
+        order = np.argsort(cand.i, kind="stable")
+        cand = cand.take(order)
+        cuts = np.searchsorted(cand.i, batch, side="left"), np.searchsorted(cand.i, batch, "right")
+        for k, circle in enumerate(batch.tolist()):
+            self._cache[circle] = cand.take(slice(int(cuts[0][k]), int(cuts[1][k])))
+        self._cached[batch] = True
+
+    def _candidate_pairs(self, batch: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The pairs ``(batch[row], j)`` whose tangents a path within the bound may use, by the
+        distances between the circles and their step counts to the goal."""
+        c = self.circles
+        ci = c[batch]
+        # A first sieve over the whole (batch x circles) matrix, with cheap over-estimates of
+        # distances (|dx| + |dy|) and under-estimates (max(|dx|, |dy|)): the bound through the
+        # pair, and the 8-connected step counts to the goal (see FreeGrid.step_ranges).
+        dx = np.abs(c[None, :, 0] - ci[:, None, 0])
+        dy = np.abs(c[None, :, 1] - ci[:, None, 1])
+        spread = ci[:, None, 2] + c[None, :, 2]
+        reach = np.maximum(dx, dy) + self.lb_g[None, :] <= (
+            self.bound - self.lb_s[batch])[:, None] + spread  # fmt: skip
+        n = (dx + dy + 2.0 * spread) * (1.0 / self.grid.H) + 2.0
+        lo_i, hi_i = self.steps[batch, 2, 0][:, None], self.steps[batch, 2, 1][:, None]
+        lo_j, hi_j = self.steps[None, :, 2, 0], self.steps[None, :, 2, 1]
+        with np.errstate(invalid="ignore"):  # inf - inf: a circle no free path reaches: drop
+            reach &= (lo_j - hi_i <= n) & (lo_i - hi_j <= n)
+        reach[:, 0] = False
+        reach[np.arange(len(batch)), batch] = False
+        row, j = np.nonzero(reach)
+        # Then the exact distances and every step count, pair by pair.
+        i = batch[row]
+        d = c[j, :2] - c[i, :2]
+        spread = c[i, 2] + c[j, 2]
+        gap = np.hypot(d[:, 0], d[:, 1]) - spread
+        ok = self.lb_s[i] + np.maximum(gap, 0.0) + self.lb_g[j] <= self.bound
+        ok &= self.grid.visible_pairs(self.steps[i], self.steps[j], np.abs(d[:, 0]) + spread,
+                                      np.abs(d[:, 1]) + spread)  # fmt: skip
+        return row[ok], j[ok]
+
+    def _usable(self, cand: Tangents) -> Tangents:
+        """The tangents within the cones of free directions at both ends, in the bounds, that
+        a path within the bound may use; with their ends, lengths and bounds to the goal."""
+        i = cand.i
+        cand.pos_i = cone_pos(cand.angle_i, self.lo[i])
+        wi, wj = self.width[i], self.width[cand.j]
+        pos_j = cone_pos(cand.angle_j, self.lo[cand.j])
+        cone = ((wi >= TWO_PI) | (cand.pos_i <= wi + ANGLE_TOL)) & (
+            (wj >= TWO_PI) | (pos_j <= wj + ANGLE_TOL))  # fmt: skip
+        cand = cand.take(np.flatnonzero(cone))
+        cand.q = self._ends(cand, cand.j == 1)
+        cand.seg = np.hypot(*(cand.q - cand.p).T)
+        cand.h = self.grid.lower_bound(1, cand.q)
+        lower = self.grid.lower_bound(0, cand.p) + cand.seg + cand.h
+        w = self.world
+        ok = lower <= self.bound
+        ok &= w.points_in_bounds(cand.p) & w.points_in_bounds(cand.q)
+        return cand.take(np.flatnonzero(ok))
+
+    def _free(self, cand: Tangents) -> Tangents:
+        """The free tangents among ``cand``: the raster's sound rejection, then the exact test
+        (straight from the cells in a world of the lattice's cells alone)."""
+        w = self.world
+        if len(cand.j) and self.grid.core_share >= _RASTER_WORTH:
+            cand = cand.take(np.flatnonzero(~self.grid.blocked_segments(cand.p, cand.q)))
+        if len(cand.j) and self._cells_only:
+            # A world of the lattice's cells alone: the exact test straight from the cells.
+            near = self.grid.segments_near_blocked(cand.p, cand.q, w.threshold)
+            return cand.take(np.flatnonzero(~near))
+        if len(cand.j):
+            cand = cand.take(np.flatnonzero(~self.blocked_near(cand)))
+        if len(cand.j):
+            cand = cand.take(np.flatnonzero(w.segments_free(cand.p, cand.q)))
+        return cand
+
+    def _directions_ok(self, batch: np.ndarray, row: np.ndarray, j: np.ndarray):
+        """The pairs ``(batch[row], j)`` that can have a tangent leaving the first circle and
+        reaching the second within their cones of free directions.
+
+        A path wrapping a circle at the outward normal ``n`` travels along ``n +- pi / 2``, so a
+        tangent leaving a vertex whose cone is ``[lo, lo + w]`` heads into one of the two arcs of
+        directions ``[lo + pi / 2, lo + w + pi / 2]`` and ``[lo - pi / 2, lo + w - pi / 2]``,
+        and it arrives at the other circle in the same way. The tangent's direction differs from
+        that of the line of centres by at most ``asin((rho_i + rho_j) / d)``.
+        """
+        i = batch[row]
+        c = self.circles
+        d = c[j, :2] - c[i, :2]
+        dist = np.hypot(d[:, 0], d[:, 1])
+        slack = np.arcsin(np.clip((c[i, 2] + c[j, 2]) / np.maximum(dist, 1e-300), 0.0, 1.0))
+        slack += 1e-7
+        phi = np.arctan2(d[:, 1], d[:, 0])
+        ok = np.ones(len(i), dtype=bool)
+        for k in (i, j):
+            w = self.width[k]
+            cone = w < TWO_PI
+            if not cone.any():
+                continue
+            inside = np.zeros(len(i), dtype=bool)
+            for turn in (0.5 * math.pi, -0.5 * math.pi):
+                off = np.mod(phi - (self.lo[k] + turn) + slack, TWO_PI)
+                inside |= off <= w + 2.0 * slack
+            ok &= ~cone | inside
+        return row[ok], j[ok]
+
+    def blocked_near(self, cand: Tangents) -> np.ndarray:
+        """Tangents that come too close to an obstacle near the circle they leave (booleans; the
+        world's exact distance formulas, against the obstacles the index holds within a few
+        index cells of that circle)."""
+        w = self.world
+        blocked = np.zeros(len(cand.j), dtype=bool)
+        if w.n_obstacles <= _NEAR_ALL:
+            return blocked  # few obstacles: the world's own test is as cheap
+        circles, inverse = np.unique(cand.i, return_inverse=True)
+        c, rho = self.circles[circles, :2], self.circles[circles, 2]
+        reach = (rho + 2.0 * w.index.grid.h)[:, None]
+        query, ids = w.index.grid.pairs_in_boxes(c - reach, c + reach)
+        count = np.bincount(query, minlength=len(circles))
+        first = np.concatenate([[0], np.cumsum(count)])[:-1]
+        n = count[inverse]
+        if not n.sum() or n.sum() > _NEAR_PAIRS:
+            return blocked
+        seg = np.repeat(np.arange(len(cand.j)), n)
+        k = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+        obs = ids[np.repeat(first[inverse], n) + k]
+        d = w.index.pair_distance(seg, obs, cand.p, cand.q)
+        blocked[seg[d < w.threshold]] = True
+        return blocked
+
+    def _ends(self, cand, to_goal: np.ndarray) -> np.ndarray:
+        """Where each tangent ends: its tangent point, or inside a goal tolerance, the point where
+        it enters the goal disc."""
+        end = cand.q.copy()
+        if self.goal_tol > 0 and to_goal.any():
+            d = cand.q[to_goal] - cand.p[to_goal]
+            n = np.hypot(*d.T)
+            frac = np.clip(1.0 - self.goal_tol / np.where(n > 0, n, 1.0), 0.0, 1.0)
+            end[to_goal] = cand.p[to_goal] + frac[:, None] * d
+        return end
+
+
+def _loosen(bound: float, tol: float) -> float:
+    """A bound with room for round-off (lengths add up over many pieces)."""
+    return bound * (1.0 + 1e-9) + 10.0 * tol if math.isfinite(bound) else math.inf

@@ -1,0 +1,240 @@
+"""The exact optimum's entry points: a problem, or a world and a query, in; an
+:class:`~.result.OptimumResult` out.
+
+:func:`shortest_path_in_world` turns a turned map into its grid coordinates (or its boxes into
+polygons), rounds a point robot's corners (radius ``2 tol``), settles the trivial and the
+unsolvable cases with the conservative raster (:mod:`..free_grid`), and runs the tangent search
+(:mod:`.search`) in rounds of growing bounds until one finds a path within its bound: the
+package docstring tells why the answer is exact.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ...model.problem_types import Problem
+from ...model.world import World
+from ..free_grid import FreeGrid, Stopped
+from .circles import NodeCircles
+from .result import OptimumResult, Piece
+from .search import TangentSearch
+
+__all__ = ["shortest_path", "shortest_path_in_world"]
+
+
+def shortest_path(
+    problem: Problem,
+    world: World | None = None,
+    upper_bound: float | None = None,
+    *,
+    terminate: Callable[[], bool] | None = None,
+) -> OptimumResult:
+    """The shortest collision-free path of ``problem`` for its disc robot (moving obstacles
+    ignored).
+
+    Parameters
+    ----------
+    problem : Problem
+        A validated problem.
+    world : World, optional
+        Its static world, when already built.
+    upper_bound : float, optional
+        The length of any valid path, or ``inf``: the search never looks beyond it. By default
+        none is needed: the search runs in rounds of growing bounds (package docstring).
+    terminate : callable, optional
+        Polled between expansions; when it returns True the search stops and the result has
+        ``stopped`` set and no path.
+
+    Returns
+    -------
+    OptimumResult
+        ``length`` None when no path exists (or when stopped).
+
+    Raises
+    ------
+    OptimumTooLarge
+        When the search would create more than :data:`MAX_NODES` tangent nodes.
+    """
+    world = world or World.from_problem(problem)
+    return shortest_path_in_world(
+        world, problem.start[:2], problem.goal[:2], float(problem.goal_tolerance),
+        upper_bound=upper_bound, terminate=terminate, name=problem.name, source=problem.source,
+    )  # fmt: skip
+
+
+def shortest_path_in_world(
+    world: World,
+    start,
+    goal,
+    goal_tolerance: float = 0.0,
+    *,
+    upper_bound: float | None = None,
+    terminate: Callable[[], bool] | None = None,
+    name: str = "",
+    source: str = "<world>",
+) -> OptimumResult:
+    """:func:`shortest_path` for a :class:`~rrtpso_ompl.model.World` and a query (what the
+    ``Exact`` planner has: no problem file).
+
+    Parameters
+    ----------
+    world : World
+        Obstacles, bounds and robot radius.
+    start, goal : (float, float)
+        The query, problem units.
+    goal_tolerance : float
+        Radius of the goal disc (0: the goal point).
+    upper_bound, terminate
+        As for :func:`shortest_path`.
+    name, source : str
+        The problem's name (for the result) and where it came from (for messages).
+    """
+    frame = world.box_frame
+    if frame is not None and frame.confined is not None:
+        local = shortest_path_in_world(
+            _grid_frame_world(world), frame.to_grid(np.asarray(start, dtype=float)[:2]),
+            frame.to_grid(np.asarray(goal, dtype=float)[:2]), goal_tolerance,
+            upper_bound=upper_bound, terminate=terminate, name=name, source=source,
+        )  # fmt: skip
+        return replace(local, pieces=[_turned(p, frame) for p in local.pieces])
+    if frame is not None:
+        world = _boxes_as_polygons(world)
+    t0 = time.perf_counter()
+    radius = max(world.robot_radius, 2.0 * world.tol)  # see the package docstring for R = 0
+    if radius != world.robot_radius:
+        world = world.with_robot_radius(radius)
+    start = np.asarray(start, dtype=float)[:2]
+    goal = np.asarray(goal, dtype=float)[:2]
+    goal_tol = float(goal_tolerance)
+    exact = goal_tol == 0.0 or bool(
+        world.point_clearance(goal[None])[0] >= goal_tol + world.threshold
+    )
+    if math.dist(start, goal) <= goal_tol or np.array_equal(start, goal):
+        still = Piece("line", tuple(map(float, start)), tuple(map(float, start)))
+        return OptimumResult(name, 0.0, [still], True, 1, 0, time.perf_counter() - t0)
+    report = _Report(name, exact, t0)
+    return _search(world, start, goal, goal_tol, upper_bound, terminate, source, report)
+
+
+@dataclass(frozen=True)
+class _Report:
+    """Makes the :class:`OptimumResult` of one query: its name, whether it is exact, and when it
+    started (``time.perf_counter()`` seconds)."""
+
+    name: str
+    exact: bool
+    t0: float
+
+    def __call__(self, found, search=None, stopped=False, rounds=0) -> OptimumResult:
+        """The result of ``found`` (``(length, pieces)`` or None) after ``search``."""
+        nodes, edges = (search.n_nodes, search.n_edges) if search is not None else (0, 0)
+        seconds = time.perf_counter() - self.t0
+        if found is None:
+            return OptimumResult(self.name, None, [], self.exact, nodes, edges, seconds, stopped,
+                                 rounds)  # fmt: skip
+        length, pieces = found
+        pieces = _merge_arcs([p for p in pieces if p.length > 0.0] or pieces[:1])
+        return OptimumResult(self.name, length, pieces, self.exact, nodes, edges, seconds, False,
+                             rounds)  # fmt: skip
+
+
+def _search(world: World, start: np.ndarray, goal: np.ndarray, goal_tol: float,
+            upper_bound: float | None, terminate: Callable[[], bool] | None, source: str,
+            report: _Report) -> OptimumResult:  # fmt: skip
+    """The raster's proof or bounds, then the tangent search in rounds of growing bounds
+    (package docstring); start and goal apart, the robot radius at least twice the tolerance."""
+    stop = terminate if terminate is not None else (lambda: False)
+    if stop():
+        return report(None, stopped=True)
+    try:
+        grid = FreeGrid.for_world(world, start, goal, goal_tol, terminate)
+    except Stopped:
+        return report(None, stopped=True)
+    if not grid.connected:  # a proof: no chain of possibly-free cells joins them
+        return report(None)
+    if stop():
+        return report(None, stopped=True)
+    nodes = NodeCircles.build(world, grid, start, goal, world.robot_radius)
+    cap = math.inf if upper_bound is None else float(upper_bound)
+    lower = float(grid.lower_bound(1, start[None])[0])
+    search = None
+    kind = "lattice" if grid.blocked is not None else "generic"
+    for k, bound in enumerate(_bounds(lower, cap, world.tol, kind)):
+        search = TangentSearch(world, grid, nodes, goal_tol, bound, source, terminate)
+        found = search.run()
+        if search.stopped:
+            return report(None, search, stopped=True, rounds=k + 1)
+        if found is not None or bound >= cap:
+            return report(found, search, rounds=k + 1)
+    return report(None, search)  # pragma: no cover - the last bound is the cap
+
+
+def _grid_frame_world(world: World) -> World:
+    """The world of a turned map in its grid coordinates, where its free configurations are
+    the same (the frame's ``confined`` holds them all, package docstring): the map's rectangle as
+    the bounds, the boxes as they are, the circles and polygons turned into grid coordinates."""
+    f = world.box_frame
+    x0, y0, x1, y1 = f.confined
+    circles = np.column_stack([f.to_grid(world.circles[:, :2]), world.circles[:, 2]])
+    polygons = [f.to_grid(p) for p in world.polygons]
+    return World(((x0, y0), (x1, y1)), circles, polygons, world.robot_radius, world.boxes)
+
+
+def _boxes_as_polygons(world: World) -> World:
+    """The world of a turned map with its boxes as polygons (their turned squares) in the world's
+    coordinates: the search below treats boxes as axis-aligned."""
+    squares = list(world.box_frame.box_corners(world.boxes))
+    return World(world.bounds, world.circles, [*world.polygons, *squares], world.robot_radius)
+
+
+def _turned(piece: Piece, frame) -> Piece:
+    """A piece found in grid coordinates, in the world's."""
+
+    def back(p):
+        return tuple(frame.to_world(np.asarray(p, dtype=float)).tolist())
+
+    if piece.kind != "arc":
+        return replace(piece, start=back(piece.start), end=back(piece.end))
+    return replace(piece, start=back(piece.start), end=back(piece.end),
+                   center=back(piece.center), angle=piece.angle + frame.yaw)  # fmt: skip
+
+
+#: The rounds' bounds, as multiples of the lower bound on the optimum: a round that finds no
+#: path within its bound proves the optimum longer, and the next one looks further. On a map's
+#: lattice the geodesic bound is a few percent short (it counts cells) and a loose bound costs
+#: little (the step counts and the raster bound the candidates); among circles and polygons it
+#: is often within a fraction of a percent, and the width of the ellipse drives the cost.
+_ROUND_FACTORS = {
+    "lattice": (1.08, 1.3, 2.0, 4.0, 8.0),
+    "generic": (1.005, 1.02, 1.08, 1.3, 2.0, 4.0, 8.0),
+}
+
+
+def _bounds(lower: float, cap: float, tol: float, kind: str):
+    """The bound of each round, ending with ``cap``."""
+    for factor in _ROUND_FACTORS[kind]:
+        b = lower * factor + 10.0 * tol
+        if b >= cap:
+            break
+        yield b
+    yield cap
+
+
+def _merge_arcs(pieces: list[Piece]) -> list[Piece]:
+    """Join consecutive arcs on the same circle (the path passed a tangent point it did not use)."""
+    out: list[Piece] = []
+    for p in pieces:
+        last = out[-1] if out else None
+        if (p.kind == "arc" and last is not None and last.kind == "arc"
+                and last.center == p.center and last.radius == p.radius
+                and math.copysign(1.0, last.sweep) == math.copysign(1.0, p.sweep)):  # fmt: skip
+            out[-1] = Piece("arc", last.start, p.end, last.center, last.radius, last.angle,
+                            last.sweep + p.sweep)  # fmt: skip
+        else:
+            out.append(p)
+    return out

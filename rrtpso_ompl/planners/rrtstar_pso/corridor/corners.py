@@ -1,0 +1,216 @@
+"""A disc robot's path round wall corners: the funnel through portals shrunk by the radius, its
+bends replaced by polygons circumscribed about arcs of the radius round the corners, so that no
+segment comes closer than the radius to a corner."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import ndimage
+
+from ....model.raster import Lattice
+from .funnel import FunnelEnds, channel_portals, free_rectangles, funnel, rectangle_channel
+from .routes import channel
+
+#: Most rounds of :func:`wrapped_funnel` adding wall corners its path passed without a bend.
+WRAP_REPAIRS = 8
+
+
+def wrapped_funnel(model, lat: Lattice, free, route, ends: FunnelEnds, terminate=None):
+    """A disc robot's path on a map through the same route, closer to the walls than the wholly
+    free cells allow (they lose up to a cell along every wall).
+
+    The funnel runs through the cells no obstacle enters, with each portal's end moved the
+    robot's radius in where a blocked cell touches it; every wall corner the funnel bends round
+    then becomes a circle of the robot's radius, and the path the taut string round those
+    circles (:func:`_round_corners`). Checked; None when it fails (a gap narrower than the
+    robot, a corner passed without a bend) or the world is not a map."""
+    point = model.point_free_cells(lat) if hasattr(model, "point_free_cells") else None
+    r = float(model.robot_radius) + 16.0 * model.tol
+    if point is None:
+        return None
+    # The cells along the walls next to the wholly free ones (and no others: a band stays a band).
+    point &= ndimage.binary_dilation(free, iterations=math.ceil(r / lat.h) + 1)
+    rects, label = free_rectangles(point)
+    seq = rectangle_channel(channel(route), label)
+    # Lattice points a blocked cell (or the lattice's edge) touches.
+    pad = np.zeros((lat.nx + 2, lat.ny + 2), dtype=bool)
+    pad[1:-1, 1:-1] = point
+    walled = ~(pad[:-1, :-1] & pad[1:, :-1] & pad[:-1, 1:] & pad[1:, 1:])
+    wall_portals = _wall_portals(
+        channel_portals(seq, rects, lat, 0.0), lat, walled, r, 16.0 * model.tol
+    )
+    if wall_portals is None:
+        return None  # narrower than the robot
+    portals, corner_of = wall_portals
+    inner = funnel(ends.a, ends.b, portals)
+    corners = [corner_of.get((float(x), float(y))) for x, y in inner[1:-1]]
+    (ox, oy), h = lat.origin, lat.h
+    walls = np.column_stack([ox + h * np.nonzero(walled)[0], oy + h * np.nonzero(walled)[1]])
+    for _ in range(WRAP_REPAIRS):
+        if terminate is not None and terminate():
+            return None
+        rounded = _round_corners(inner, corners, r)
+        if rounded is None:
+            return None
+        rounded, owner = rounded
+        candidate = ends.path(rounded)
+        if model.path_valid(candidate):
+            return candidate
+        # A wall corner the string passes without wrapping it (a side of the channel that is
+        # free space, not wall, let the funnel pass it without a bend): it becomes a circle too.
+        bad = np.flatnonzero(model.segment_violation(rounded[:-1], rounded[1:]) > 0.0)
+        if not len(bad):
+            return None  # the hops to the end points failed: nothing to repair here
+        k = int(bad[0])
+        corner = _nearest_wall(rounded[k], rounded[k + 1], walls, r)
+        if corner is None:
+            return None
+        at = int(owner[k]) + 1  # after the circle the segment leaves
+        d, e = rounded[k + 1] - rounded[k], corner - rounded[k]
+        side = 1.0 if d[0] * e[1] - d[1] * e[0] > 0.0 else -1.0  # the corner's side of the path
+        inner = np.insert(inner, at, corner, axis=0)
+        corners.insert(at - 1, (corner, side))
+    return None
+
+
+def _wall_portals(portals, lat: Lattice, walled: np.ndarray, r: float, tol: float):
+    """``portals`` with each end moved ``r`` towards the other where a wall touches it
+    (``walled``: the lattice points a blocked cell touches), ``tol`` elsewhere; and, for every
+    end moved ``r``, the wall corner it came from (keyed by the moved end). None when a portal
+    is narrower than that."""
+    (ox, oy), h = lat.origin, lat.h
+    out, corner_of = [], {}
+    for left, right in portals:
+        pair = [np.asarray(left, dtype=float), np.asarray(right, dtype=float)]
+        width = float(np.hypot(*(pair[1] - pair[0])))
+        moved = []
+        for e, other in ((pair[0], pair[1]), (pair[1], pair[0])):
+            wall = walled[round((e[0] - ox) / h), round((e[1] - oy) / h)]
+            step = r if wall else tol
+            if 2.0 * step >= width:
+                return None
+            q = e + step * (other - e) / width
+            if wall:
+                corner_of[(float(q[0]), float(q[1]))] = e
+            moved.append((float(q[0]), float(q[1])))
+        out.append((moved[0], moved[1]))
+    return out, corner_of
+
+
+def _nearest_wall(a: np.ndarray, b: np.ndarray, walls: np.ndarray, r: float):
+    """The point of ``walls`` nearest the segment ``a b`` if closer than ``r``, else None."""
+    lo, hi = np.minimum(a, b) - r, np.maximum(a, b) + r
+    near = walls[np.all((walls >= lo) & (walls <= hi), axis=1)]
+    if not len(near):
+        return None
+    d = b - a
+    f = np.clip(((near - a) @ d) / max(float(d @ d), 1e-300), 0.0, 1.0)
+    dist = np.hypot(*(a + f[:, None] * d - near).T)
+    k = int(np.argmin(dist))
+    return near[k] if dist[k] < r else None
+
+
+def _round_corners(path: np.ndarray, corners, r: float) -> np.ndarray | None:
+    """The taut string from ``path[0]`` to ``path[-1]`` round circles of radius ``r`` at the
+    ``corners`` (one per interior vertex: a point passed on the side the path turns to there,
+    a ``(point, side)`` pair, side +1 for a corner on the left, or None for a vertex kept as a
+    point); every arc replaced by the polygon circumscribed about it (:func:`_arc_polygon`), so
+    no segment comes closer than ``r`` to a corner. Also returns, for every vertex, the index
+    of the path vertex whose circle it lies on. None when two circles on opposite sides overlap
+    or an arc would turn back (the corners do not make a taut string)."""
+    centres, side = [path[0]], [0.0]
+    for k, corner in enumerate(corners, start=1):
+        d_in, d_out = path[k] - path[k - 1], path[k + 1] - path[k]
+        turn = d_in[0] * d_out[1] - d_in[1] * d_out[0]
+        if isinstance(corner, tuple):  # a corner given with its side
+            centres.append(np.asarray(corner[0], dtype=float))
+            side.append(corner[1])
+        elif corner is None or turn == 0.0:
+            centres.append(path[k])
+            side.append(0.0)
+        else:  # turning left: the corner is on the left, the path passes to its right
+            centres.append(np.asarray(corner, dtype=float))
+            side.append(1.0 if turn > 0 else -1.0)
+    centres.append(path[-1])
+    side.append(0.0)
+    c, s = np.asarray(centres), np.asarray(side)
+    d = np.diff(c, axis=0)
+    length = np.hypot(d[:, 0], d[:, 1])
+    if not np.all(length > 0.0):
+        return None
+    u = d / length[:, None]
+    # The common tangent of consecutive circles: travel t at angle phi to the line of centres,
+    # sin(phi) = (s_k - s_k+1) r / L; the tangent points lie s r along t's right normal m.
+    sin_phi = (s[:-1] - s[1:]) * r / length
+    if np.any(np.abs(sin_phi) >= 1.0):
+        return None
+    t = np.sqrt(1.0 - sin_phi**2)[:, None] * u + sin_phi[:, None] * np.column_stack(
+        [-u[:, 1], u[:, 0]]
+    )
+    m = np.column_stack([t[:, 1], -t[:, 0]])
+    leave = c[:-1] + (s[:-1] * r)[:, None] * m
+    arrive = c[1:] + (s[1:] * r)[:, None] * m
+    out, owner = [c[0]], [0]
+    for k in range(1, len(c) - 1):
+        if s[k] == 0.0:
+            out.append(c[k])
+            owner.append(k)
+            continue
+        arc = _arc_polygon(c[k], r, arrive[k - 1], leave[k], s[k])
+        if arc is None:
+            return None
+        out.extend(arc)
+        owner.extend([k] * len(arc))
+    out.append(c[-1])
+    owner.append(len(c) - 1)
+    return np.asarray(out), np.asarray(owner)
+
+
+def _arc_polygon(centre, r: float, enter, leave, side: float) -> np.ndarray | None:
+    """The polygon circumscribed about the arc of radius ``r`` round ``centre`` from ``enter``
+    to ``leave`` (counter-clockwise for ``side`` +1), in pieces of at most 45 degrees, vertices
+    at ``r / cos(delta / 2)``: its edges are tangent to the circle. None for an arc of more
+    than half a turn (the string would turn back)."""
+    a_in = math.atan2(enter[1] - centre[1], enter[0] - centre[0])
+    a_out = math.atan2(leave[1] - centre[1], leave[0] - centre[0])
+    sweep = (a_out - a_in) % (2.0 * math.pi)
+    if side < 0:
+        sweep -= 2.0 * math.pi
+    if abs(sweep) > math.pi:
+        return None
+    pieces = max(1, math.ceil(abs(sweep) / (0.25 * math.pi)))
+    delta = sweep / pieces
+    ang = a_in + (np.arange(pieces) + 0.5) * delta
+    return centre + (r / math.cos(0.5 * delta)) * np.column_stack([np.cos(ang), np.sin(ang)])
+
+
+def circumscribe_corners(path: np.ndarray, lat: Lattice, free: np.ndarray, r: float) -> np.ndarray:
+    """Replace each interior vertex that lies on a lattice corner with the polygon
+    circumscribed about the arc of radius ``r`` round that corner, from the normal of the
+    segment coming in to that of the segment going out (vertices at ``r / cos(delta / 2)``,
+    ``delta`` at most 45 degrees): each of its segments is tangent to the circle, so none comes
+    closer than ``r`` to the corner."""
+    (ox, oy), h = lat.origin, lat.h
+    out = [path[0]]
+    for k in range(1, len(path) - 1):
+        v, u, w = path[k], path[k - 1], path[k + 1]
+        corner = np.array([ox + h * round((v[0] - ox) / h), oy + h * round((v[1] - oy) / h)])
+        d_in, d_out = v - u, w - v
+        n_in, n_out = np.hypot(*d_in), np.hypot(*d_out)
+        if n_in == 0.0 or n_out == 0.0 or np.hypot(*(v - corner)) > 0.25 * h:
+            out.append(v)
+            continue
+        turn = math.atan2(d_in[0] * d_out[1] - d_in[1] * d_out[0], float(d_in @ d_out))
+        side = -math.copysign(1.0, turn)  # the path turns round the corner on this side
+        # Normals pointing away from the corner, on the outside of the turn.
+        a_in = math.atan2(d_in[1], d_in[0]) + side * 0.5 * math.pi
+        pieces = max(1, math.ceil(abs(turn) / (0.25 * math.pi)))
+        delta = turn / pieces
+        rho = r / math.cos(0.5 * delta)
+        for i in range(pieces):
+            ang = a_in + (i + 0.5) * delta
+            out.append(corner + rho * np.array([math.cos(ang), math.sin(ang)]))
+    out.append(path[-1])
+    return np.asarray(out)

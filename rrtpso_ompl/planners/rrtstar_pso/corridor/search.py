@@ -1,0 +1,346 @@
+"""The corridor stage's orchestration within its time: the lattice sized by the time, a map
+searched whole or coarse-to-fine, shapes through bands of marked cells, the centre route as the
+last resort."""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import math
+import time
+from typing import Any
+
+import numpy as np
+from scipy import ndimage
+
+from ....model.raster import Lattice
+from ....model.world import MarkingStopped
+from .paths import CorridorResult, centre_route, route_and_funnel
+from .routes import ALTERNATIVE_APART, ALTERNATIVE_SLACK, alternative_routes
+
+#: Lattice cells the corridor stage builds, searches and funnels per second, on the safe side
+#: (measured on the reference machine: 2-3 million on maps, fewer among many shapes).
+CELLS_PER_SECOND = 1_000_000
+
+
+#: The refinement searches the cells within this many coarse cells of the coarse path.
+BAND_CELLS = 3.0
+
+
+#: Lattice cells per second a map's cells are marked free or not (array work over the whole
+#: lattice; the search itself stays in the band), on the safe side.
+MARK_CELLS_PER_SECOND = 8_000_000
+
+
+#: Lattice cells of a map routed (with alternatives) and funnelled whole per second, on the safe
+#: side (measured 1.0-1.3 million on 256 x 256 mazes and random maps). A map whose lattice fits
+#: in the time left at this rate is searched whole: pooling its cells into a coarse lattice opens
+#: gaps through walls one cell thick, and the coarse routes then miss a maze's only corridor.
+DIRECT_CELLS_PER_SECOND = 1_200_000
+
+
+#: Lattice cells per second :func:`centre_route` builds and routes over among shapes, on the
+#: safe side (measured 0.6-1 million among 10,000 circles).
+CENTRE_CELLS_PER_SECOND = 600_000
+
+
+#: Cells of the small lattice on which the cost of marking cells among shapes is measured.
+MARKING_PROBE_CELLS = 1_600
+
+
+#: The share of the stage's time the probe may take: obstacles so detailed that marking the
+#: probe's cells takes longer leave no time for a lattice worth routing on (the stage gives up).
+MARKING_PROBE_SHARE = 0.1
+
+
+#: Among shapes, the share of the stage's time for the bands of wholly free cells; the rest is
+#: kept for :func:`centre_route` in case they hold no route.
+SHAPE_BAND_SHARE = 0.5
+
+
+#: Among shapes, fine cells per coarse cell side in the bands.
+SHAPE_SPLIT = 4
+
+
+def find_corridor_path(
+    model: Any,
+    start,
+    goal,
+    seconds: float | None,
+    max_cells: int = 4_194_304,
+    terminate=None,
+    alternatives: int = 3,
+    no_route_seconds: float | None = None,
+) -> CorridorResult:
+    """The corridor stage within ``seconds`` (None: no limit but ``max_cells``).
+
+    A map whose fine lattice fits the time (:data:`DIRECT_CELLS_PER_SECOND`) is searched whole
+    (:func:`route_and_funnel`). Otherwise:
+
+    1. **Coarse routes** on a lattice small enough to route on in a third of the time
+       (:data:`CELLS_PER_SECOND`), its cells open generously (a map's when any fine cell they
+       pool is wholly free; among shapes when their centre is free): no passage the fine cells
+       keep is closed. The shortest route and ``alternatives`` through other corridors.
+    2. **A fine route in each corridor**, best first: the fine cells within :data:`BAND_CELLS`
+       coarse cells of it (marked in a box round the band: the work follows the band), the route
+       over them and its funnel path. The shortest valid path wins.
+
+    With no route yet, the search may go on until ``no_route_seconds`` (nothing is left for the
+    later stages to refine meanwhile): a map's whole fine lattice if it fits, then, for free
+    space too thin for any wholly free fine cell, :func:`centre_route`.
+
+    Marking a lattice's cells stops at the deadline too (:meth:`World.marking_stops
+    <rrtpso_ompl.model.World.marking_stops>`): a marking cut short gives no cells, and the
+    stage ends with the best path it had.
+    """
+    t0 = time.perf_counter()
+    end = None if seconds is None else t0 + seconds
+    start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
+    stages: dict[str, float] = {}
+    out_of_time = _Deadline(end, terminate)
+    if end is not None and no_route_seconds is not None:
+        out_of_time.grace_end = max(end, t0 + no_route_seconds)
+    with _marking_stops(model, out_of_time):
+        try:
+            result = _search(model, start, goal, seconds, max_cells, alternatives,
+                             no_route_seconds, out_of_time, t0, stages)  # fmt: skip
+        except MarkingStopped:
+            result = CorridorResult(None, reason="out of time marking the lattice's cells")
+    return dataclasses.replace(result, time=time.perf_counter() - t0, stages=stages)
+
+
+def _marking_stops(model, stop):
+    """``model.marking_stops(stop)`` where the model has it (the World, the space information's
+    adapter), else nothing."""
+    marking_stops = getattr(model, "marking_stops", None)
+    return contextlib.nullcontext() if marking_stops is None else marking_stops(stop)
+
+
+def _search(model, start, goal, seconds, max_cells, alternatives, no_route_seconds, out_of_time,
+            t0, stages) -> CorridorResult:  # fmt: skip
+    """:func:`search`'s steps (a marking cut short raises :class:`MarkingStopped`)."""
+    end = out_of_time.end
+    terminate = out_of_time.terminate
+    left = out_of_time.left
+    on_map = getattr(model, "raster", None) is not None
+    # Among shapes the wholly free cells may miss gaps narrower than a cell (a dense field of
+    # circles): time is kept for the route through free cell centres.
+    first = (out_of_time if on_map or end is None
+             else _Deadline(t0 + SHAPE_BAND_SHARE * seconds, terminate))  # fmt: skip
+    # Among shapes the cost of marking a cell grows with the obstacles' detail (a polygon of
+    # 10,000 vertices marks 100,000 cells a second, a few circles millions): measured first.
+    rate = CELLS_PER_SECOND
+    if not on_map and end is not None:
+        rate = _marking_rate(model, seconds)
+        if rate is None:
+            return CorridorResult(None, reason="marking cells is too slow for the time (the "
+                                  "obstacles are too detailed)")  # fmt: skip
+    result, fine_cells, route_cells = _coarse_tries(
+        model, start, goal, max_cells, alternatives, out_of_time, first, t0, stages, rate
+    )
+    if result.path is None and end is not None and no_route_seconds is not None:
+        out_of_time.end = max(end, t0 + no_route_seconds)
+        if on_map and not out_of_time():  # the whole fine lattice, if it now fits
+            result = _map_corridors(model, fine_cells, route_cells, start, goal, 0, out_of_time,
+                                    t0, stages, left)  # fmt: skip
+    if result.path is None and not out_of_time():
+        per_second = min(CENTRE_CELLS_PER_SECOND, 0.5 * rate)
+        cells = min(max_cells, int(per_second * left())) if end else 1 << 18
+        thin = centre_route(model, start, goal, max(cells, 4096), out_of_time)
+        if thin.path is not None:
+            result = thin
+    return result
+
+
+def _marking_rate(model, seconds: float) -> float | None:
+    """Lattice cells per second ``model`` marks (its free cell centres), measured on a small
+    lattice; at most :data:`CELLS_PER_SECOND`. None when the probe takes more than
+    :data:`MARKING_PROBE_SHARE` of ``seconds`` (it is stopped there)."""
+    probe = model.lattice(MARKING_PROBE_CELLS)
+    t = time.perf_counter()
+    end = t + MARKING_PROBE_SHARE * seconds
+    outer = getattr(model, "mark_stop", None)
+
+    def stop() -> bool:
+        return time.perf_counter() >= end or bool(outer is not None and outer())
+
+    try:
+        with _marking_stops(model, stop):
+            model.centres_free(probe)
+    except MarkingStopped:
+        return None
+    return min(CELLS_PER_SECOND, probe.n_cells / max(time.perf_counter() - t, 1e-6))
+
+
+def _coarse_tries(model, start, goal, max_cells, alternatives, out_of_time, first, t0, stages,
+                  rate=CELLS_PER_SECOND):  # fmt: skip
+    """:func:`search`'s tries until a path, ``first()`` or too little time: when no corridor
+    held a route at the fine level (the coarse lattice joined cells that do not join), twice the
+    coarse cells, while a try as long again fits twice over. The last result, the fine and the
+    coarse lattice's cells."""
+    left = out_of_time.left
+    on_map = getattr(model, "raster", None) is not None
+    route_cells = int(min(max_cells, max(min(CELLS_PER_SECOND, rate) * left() / 3.0, 1024)))
+    fine_cells = 0
+    while True:  # at most log2(max_cells) rounds: the coarse cells double each time
+        t1 = time.perf_counter()
+        if on_map:
+            fine_cells = int(min(max_cells, max(0.4 * MARK_CELLS_PER_SECOND * left(), 4096)))
+            result = _map_corridors(model, fine_cells, route_cells, start, goal, alternatives,
+                                    out_of_time, t0, stages, left)  # fmt: skip
+        else:
+            result = _shape_corridors(model, route_cells, max_cells, start, goal, alternatives,
+                                      first, t0, stages, rate)  # fmt: skip
+        took = time.perf_counter() - t1
+        if result.path is not None or route_cells >= max_cells or first() or left() < 4.0 * took:
+            return result, fine_cells, route_cells
+        route_cells = min(2 * route_cells, max_cells)
+
+
+def _map_corridors(model, fine_cells, route_cells, start, goal, alternatives, terminate, t0,
+                   stages, left) -> CorridorResult:  # fmt: skip
+    """:func:`search` on a map: the fine cells marked once, searched whole when the time
+    ``left()`` affords it (:data:`DIRECT_CELLS_PER_SECOND`), else pooled into a coarse lattice;
+    when no coarse corridor holds a fine route, the whole fine lattice without alternatives if
+    it still fits."""
+    fine = model.lattice(fine_cells)
+    if fine.nx < 2 or fine.ny < 2:
+        return CorridorResult(None, reason="the lattice is too small")
+    free = model.free_cells(fine)
+    stages["cells"] = time.perf_counter() - t0
+    k = max(1, math.ceil(math.sqrt(fine.n_cells / route_cells)))
+    nx, ny = fine.nx // k, fine.ny // k
+    if k == 1 or nx < 2 or ny < 2 or fine.n_cells <= DIRECT_CELLS_PER_SECOND * left():
+        return route_and_funnel(model, fine, free, start, goal, alternatives, terminate, t0,
+                                 stages)  # fmt: skip
+    result = _pooled_corridors(model, fine, free, k, start, goal, alternatives, terminate, t0,
+                               stages)  # fmt: skip
+    if result.path is None and fine.n_cells <= DIRECT_CELLS_PER_SECOND * left():
+        return route_and_funnel(model, fine, free, start, goal, 0, terminate, t0, stages)
+    return result
+
+
+def _pooled_corridors(model, fine, free, k, start, goal, alternatives, terminate, t0,
+                      stages) -> CorridorResult:  # fmt: skip
+    """Corridors on the coarse lattice pooling ``k`` x ``k`` fine cells (open when any is wholly
+    free: no passage of the fine lattice is closed), each searched again on the fine cells."""
+    nx, ny = fine.nx // k, fine.ny // k
+    pooled = free[: nx * k, : ny * k].reshape(nx, k, ny, k).any(axis=(1, 3))
+    coarse = Lattice(fine.origin, fine.h * k, nx, ny)
+
+    def fine_band(r0, r1, c0, c1, mask):
+        i0, i1, j0, j1 = r0 * k, r1 * k, c0 * k, c1 * k
+        box = Lattice((fine.origin[0] + i0 * fine.h, fine.origin[1] + j0 * fine.h), fine.h,
+                      i1 - i0, j1 - j0)  # fmt: skip
+        return box, free[i0:i1, j0:j1], k
+
+    return _corridors(model, coarse, pooled, fine_band, start, goal, alternatives, terminate,
+                      t0, stages)  # fmt: skip
+
+
+def _shape_corridors(model, route_cells, max_cells, start, goal, alternatives, terminate, t0,
+                     stages, rate=CELLS_PER_SECOND) -> CorridorResult:  # fmt: skip
+    """:func:`search` among shapes: coarse cells open when their centre is free, fine cells
+    (:data:`SHAPE_SPLIT` per coarse side) marked in each band's box only."""
+    coarse = model.lattice(route_cells)
+    if coarse.nx < 2 or coarse.ny < 2:
+        return CorridorResult(None, reason="the lattice is too small")
+    opened = model.centres_free(coarse)
+    stages["cells"] = time.perf_counter() - t0
+
+    def fine_band(r0, r1, c0, c1, mask):
+        cells = int(mask.sum())
+        # As fine as the time left affords: the band's cells are routed and funnelled too.
+        afford = max_cells
+        if terminate.end is not None:
+            afford = min(afford, rate * max(terminate.end - time.perf_counter(), 0.0))
+        k = SHAPE_SPLIT
+        while k > 1 and cells * k * k > afford:
+            k -= 1
+        box = Lattice((coarse.origin[0] + r0 * coarse.h, coarse.origin[1] + c0 * coarse.h),
+                      coarse.h / k, (r1 - r0) * k, (c1 - c0) * k)  # fmt: skip
+        near = np.repeat(np.repeat(mask, k, axis=0), k, axis=1)
+        return box, model.free_cells(box, near), k
+
+    return _corridors(model, coarse, opened, fine_band, start, goal, alternatives, terminate,
+                      t0, stages)  # fmt: skip
+
+
+def _corridors(model, coarse: Lattice, opened, fine_band, start, goal, alternatives, terminate,
+               t0, stages) -> CorridorResult:  # fmt: skip
+    """Coarse routes over ``opened``, then the funnel path of the fine route in each one's band
+    (``fine_band(r0, r1, c0, c1)`` gives, for a box of coarse cells, its fine lattice, which of
+    its cells are wholly free and the fine cells per coarse side); the shortest valid one."""
+    nx, ny = coarse.nx, coarse.ny
+    ends = []
+    for point in (start, goal):
+        cell = _nearest_open(opened, coarse.cell_of(point))
+        if cell is None:
+            return CorridorResult(None, lattice=coarse, reason="start or goal is not next to "
+                                  "a free lattice cell")  # fmt: skip
+        ends.append(cell)
+    t1 = time.perf_counter()
+    apart = max(3.0, ALTERNATIVE_APART * math.hypot(nx, ny))
+    routes = alternative_routes(opened, ends[0], ends[1], alternatives, ALTERNATIVE_SLACK, apart)
+    stages["coarse_route"] = time.perf_counter() - t1
+    best = None
+    grow = math.ceil(BAND_CELLS)
+    for route in routes:
+        if terminate():
+            break
+        mask = np.zeros((nx, ny), dtype=bool)
+        mask[tuple(np.array(route).T)] = True
+        mask = ndimage.binary_dilation(mask, iterations=grow)
+        rows, cols = np.nonzero(mask)
+        r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+        try:
+            box, free, k = fine_band(r0, r1, c0, c1, mask[r0:r1, c0:c1])
+            near = np.repeat(np.repeat(mask[r0:r1, c0:c1], k, axis=0), k, axis=1)
+            result = route_and_funnel(model, box, free & near, start, goal, 0, terminate, t0,
+                                       stages)  # fmt: skip
+            if result.path is None and not terminate():
+                # The corridor's gaps are narrower than wholly free fine cells: through the
+                # centres of the fine cells that are free, every segment checked.
+                result = centre_route(model, start, goal, 0, terminate, box, near)
+        except MarkingStopped:
+            break  # out of time in this corridor: the best of those before it
+        if result.path is not None and (best is None or result.length < best.length):
+            best = result
+    if best is None:
+        return CorridorResult(None, lattice=coarse, reason="no route through the lattice")
+    return dataclasses.replace(best, routes=len(routes))
+
+
+class _Deadline:
+    """A termination test: ``terminate()``, or the clock past ``end``; :meth:`grace` the same
+    with ``grace_end`` (later) for a step that improves a path already found."""
+
+    def __init__(self, end: float | None, terminate=None) -> None:
+        self.end, self.terminate = end, terminate
+        self.grace_end = end
+
+    def left(self) -> float:
+        """Seconds until ``end`` (infinite without one)."""
+        return math.inf if self.end is None else max(self.end - time.perf_counter(), 0.0)
+
+    def grace(self) -> bool:
+        return bool(self.terminate is not None and self.terminate()) or (
+            self.grace_end is not None and time.perf_counter() >= self.grace_end
+        )
+
+    def __call__(self) -> bool:
+        return bool(self.terminate is not None and self.terminate()) or (
+            self.end is not None and time.perf_counter() >= self.end
+        )
+
+
+def _nearest_open(opened: np.ndarray, cell, reach: int = 2):
+    """``cell`` when open, else the nearest open cell within ``reach`` (Manhattan), or None."""
+    if opened[cell]:
+        return cell
+    i0, j0 = max(cell[0] - reach, 0), max(cell[1] - reach, 0)
+    near = np.argwhere(opened[i0 : cell[0] + reach + 1, j0 : cell[1] + reach + 1])
+    if not len(near):
+        return None
+    near += (i0, j0)
+    return tuple(int(c) for c in near[np.argmin(np.abs(near - cell).sum(axis=1))])

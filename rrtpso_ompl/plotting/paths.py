@@ -1,0 +1,132 @@
+"""Figures of a world and a path through it: a planner's solution with its stages and the
+swarm's best cost per iteration (the paper's Fig. 15), the exact optimum, and the grid reference
+of the inflation objective over its costmap.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from matplotlib import ticker
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from ..model.problem_types import Problem
+from ..planners.result import SolveResult
+from .canvas import fit_layout, plt
+from .styles import PATH_COLOUR, RRT_COLOUR
+from .world import draw_costmap, draw_world, world_legend, world_width
+
+__all__ = ["plot_cost_reference", "plot_optimum", "plot_solution"]
+
+
+def plot_cost_reference(problem: Problem, result: Any) -> Figure:
+    """The world, its costmap (:func:`draw_costmap`) and the grid reference of the inflation
+    objective (a :class:`~rrtpso_ompl.groundtruth.costgrid.CostGridResult`)."""
+    fig, ax = plt.subplots(figsize=(world_width(problem, 6.0), 6))
+    key = draw_world(ax, problem)
+    key += draw_costmap(ax, problem)
+    path = np.asarray(result.path, dtype=float).reshape(-1, 2)
+    if result.found:
+        key += ax.plot(path[:, 0], path[:, 1], "-", color=PATH_COLOUR, lw=1.8, zorder=4,
+                       label=f"grid reference (J {result.cost:.2f})")  # fmt: skip
+    world_legend(ax, key)
+    found = (f"J {result.cost:.4f}, length {result.length:.4f}" if result.found
+             else "no path on the grid")  # fmt: skip
+    ax.set_title(f"{problem.name}: grid reference (h = {result.resolution:.3g}), {found}",
+                 fontsize=10)  # fmt: skip
+    fig.tight_layout()
+    return fig
+
+
+def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> Figure:
+    """The paper's Fig. 15: the world with the raw RRT* path and the final path (a), and the PSO's
+    best cost per iteration (b) when the planner ran a swarm. ``curve`` (a
+    :class:`~rrtpso_ompl.kinematics.ReferenceCurve`) adds the smooth reference the robot drives."""
+    stages: dict[str, Any] = result.stages or {}
+    history = stages.get("pso_history") or []
+    width = world_width(problem, 6.0)
+    widths = [width, 5.5] if history else [width]
+    fig, axes = plt.subplots(1, len(widths), figsize=(sum(widths), 6), squeeze=False,
+                             gridspec_kw={"width_ratios": widths})  # fmt: skip
+    ax = axes[0, 0]
+    key = draw_world(ax, problem)
+    key += draw_costmap(ax, problem)
+    raw = np.asarray(stages.get("rrt_path") or [], dtype=float).reshape(-1, 2)
+    if len(raw):
+        key += ax.plot(
+            raw[:, 0],
+            raw[:, 1],
+            "o--",
+            color=RRT_COLOUR,
+            ms=3,
+            lw=1.2,
+            zorder=3,
+            label=f"RRT* path ({stages.get('rrt_length', float('nan')):.1f})",
+        )
+    path = np.asarray(result.path, dtype=float).reshape(-1, 2)
+    if len(path):
+        key += ax.plot(
+            path[:, 0],
+            path[:, 1],
+            "o-",
+            color=PATH_COLOUR,
+            ms=3,
+            lw=1.8,
+            zorder=4,
+            label=f"{result.planner} path ({result.length:.1f})",
+        )
+    if curve is not None:
+        key += ax.plot(
+            curve.x,
+            curve.y,
+            "-",
+            color="tab:blue",
+            lw=1.0,
+            zorder=5,
+            label=f"reference curve ({curve.kind})",
+        )
+    title = f"{problem.name}: {result.planner}, {result.status}"
+    if result.length is not None:
+        title += f", length {result.length:.2f}"
+    ax.set_title(title)
+    world_legend(ax, key)
+    if history:
+        _draw_pso_history(axes[0, 1], history, problem.units, problem.objective.active)
+    fit_layout(fig)
+    return fig
+
+
+def _draw_pso_history(bx: Axes, history: Any, units: str, inflated: bool = False) -> None:
+    """Panel (b) of :func:`plot_solution`: the swarm's best cost per iteration, over all its
+    rounds (with an inflation cost, the objective J's)."""
+    h = np.asarray(history, dtype=float)
+    bx.plot(np.arange(len(h)), h, color=PATH_COLOUR)
+    bx.xaxis.set_major_locator(ticker.MaxNLocator(integer=True))
+    bx.set_xlabel("PSO iteration (all rounds)")
+    # The swarm's best is always collision-free, so its cost is the path length plus the
+    # turning penalty (smoothness_weight, 0 by default): a length.
+    what = "J = length + w x inflation cost" if inflated else "length + turning penalty"
+    bx.set_ylabel(f"best cost: {what} [{units or 'length units'}]")
+    bx.set_title("PSO best cost per iteration")
+    bx.grid(alpha=0.3)
+
+
+def plot_optimum(problem: Problem, result: Any) -> Figure:
+    """The world with the exact shortest path (an :class:`~rrtpso_ompl.groundtruth.OptimumResult`):
+    its tangent segments and its arcs around the inflated obstacles."""
+    fig, ax = plt.subplots(figsize=(world_width(problem, 6.0), 6))
+    key = draw_world(ax, problem)
+    path = result.polyline(np.radians(0.5))
+    if len(path):
+        key += ax.plot(path[:, 0], path[:, 1], "-", color=PATH_COLOUR, lw=1.8, zorder=4,
+                       label=f"shortest path ({result.length:.2f})")  # fmt: skip
+        bends = np.array([p.end for p in result.pieces[:-1]]).reshape(-1, 2)
+        key += ax.plot(bends[:, 0], bends[:, 1], "o", color=PATH_COLOUR, ms=3, zorder=5,
+                       label="bends (tangent points)")  # fmt: skip
+    world_legend(ax, key)
+    found = f"length {result.length:.4f}" if result.found else "no path"
+    ax.set_title(f"{problem.name}: exact optimum, {found}")
+    fit_layout(fig)
+    return fig
