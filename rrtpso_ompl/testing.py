@@ -682,8 +682,7 @@ def _other_space_failure(case: _Case, kind: str) -> str | None:
     objective.setCostThreshold(ob.Cost(math.inf))  # any path will do: stop at the first
     ss.setOptimizationObjective(objective)
     try:
-        planner = request.entry.make(si, request.values)
-        ss.setPlanner(planner)
+        ss.setPlanner(planner := request.entry.make(si, request.values))
         ss.setup()
     except Exception:  # refused before any solve: no answer, so no wrong one
         return None
@@ -704,8 +703,7 @@ def _other_space_failure(case: _Case, kind: str) -> str | None:
     seed_length = getattr(getattr(planner, "last_stats", None), "seed_length", None)
     longer = seed_length is not None and path.length() > seed_length * (1 + _RTOL) + 1e-12
     if wrong is None and exact and longer:  # by the space's own distance
-        wrong = (f"its length {path.length():.6g} is more than that of the seed path its stats "
-                 f"name ({seed_length:.6g})")  # fmt: skip
+        wrong = f"its length {path.length():.6g} exceeds its stats' seed_length {seed_length:.6g}"
     if wrong is None:
         return None
     what = "exact" if exact else "approximate"
