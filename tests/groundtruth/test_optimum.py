@@ -550,7 +550,8 @@ def _random_grid(rng, size=12, density=0.3, pinches=2):
     return g
 
 
-@pytest.mark.parametrize(("seed", "radius"), [(0, 0.0), (1, 0.0), (2, 0.0), (3, 0.25), (4, 0.4),
+@pytest.mark.parametrize(("seed", "radius"), [(0, 0.0), (1, 0.0), (2, 0.0), (3, 0.25),
+                                              pytest.param(4, 0.4, marks=pytest.mark.slow),
                                               (5, 0.7)])  # fmt: skip
 def test_grid_maps_agree_with_brute_force(tmp_path, seed, radius):
     rng = np.random.default_rng(seed)

@@ -121,7 +121,7 @@ def test_rrtstarpso_solves_validly_and_no_longer_than_its_seed(kind):
     assert json.loads(json.dumps(stats.to_dict()))["stages"] == stats.stages
 
 
-@pytest.mark.parametrize("kind", ["R^3", "Dubins"])
+@pytest.mark.parametrize("kind", ["R^3", pytest.param("Dubins", marks=pytest.mark.slow)])
 def test_the_same_seeds_give_the_same_path(kind):
     paths = []
     for _ in range(2):
