@@ -248,3 +248,39 @@ def test_the_kit_checks_the_planners_in_these_spaces_and_catches_a_longer_path()
     assert len(lines) == len(OTHER_SPACES)
     assert all("exceeds its stats' seed_length" in line for line in lines)
     assert lines[0].startswith("Inflating in a user's R^3 SimpleSetup: reported 'Exact solution'")
+
+
+def test_a_returned_path_is_checked_ten_times_finer_than_the_swarm_s_candidates():
+    """A slab across a straight R^3 motion, between two samples of the check at 10 times the
+    resolution and six samples wide at 100 times: the candidates' check lets it through, the
+    check of a returned path does not, so the swarm returns its input rather than that motion."""
+    from rrtpso_ompl.planners.pso.space_path import FINAL_FINER, FINER, MotionChecker
+
+    space = ob.RealVectorStateSpace(3)
+    bounds = ob.RealVectorBounds(3)
+    bounds.setLow(0.0)
+    bounds.setHigh(10.0)
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+    slab = {"centre": 0.0, "half": 0.0}  # placed once the resolution is known
+    ss.setStateValidityChecker(lambda s: abs(s[0] - slab["centre"]) > slab["half"])
+    si = ss.getSpaceInformation()
+    si.setup()  # not ss.setup(): with no start and goal it crashes the wheel
+    adapter = space_adapter(si)
+    a, b = np.array([1.0, 1.0, 1.0]), np.array([9.0, 1.0, 1.0])
+    sa, sb = si.allocState(), si.allocState()
+    adapter.assign(sa, a)
+    adapter.assign(sb, b)
+    gap = 8.0 / (FINER * space.validSegmentCount(sa, sb))  # between the 10x samples
+    slab["centre"] = 1.0 + gap * (round(4.0 / gap) + 0.5)  # midway between two, near x = 5
+    slab["half"] = 0.3 * gap
+    checker = MotionChecker(si, adapter)
+    assert checker.motion_free(a, b, factor=FINER)  # the slab lies between its samples
+    assert not checker.motion_free(a, b, factor=FINAL_FINER)
+    # A path round the slab cannot be (it spans the space): whatever the swarm made of a path
+    # through it, it returns the input.
+    path = np.array([a, [5.0, 2.0, 1.0], b])
+    result = optimize_space_path(path, adapter, si, PathOptimizerOptions(),
+                                 np.random.default_rng(1))  # fmt: skip
+    assert not result.improved
+    assert np.array_equal(result.path, path)

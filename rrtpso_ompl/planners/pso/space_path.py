@@ -49,6 +49,7 @@ from .swarm import PSOOptions
 
 __all__ = [
     "CHECKED_PER_EVALUATION",
+    "FINAL_FINER",
     "FINER",
     "MotionChecker",
     "SpacePathResult",
@@ -58,6 +59,10 @@ __all__ = [
 
 #: Motions are checked at this many times the space's validity-checking resolution.
 FINER = 10
+#: ... and a path that is returned, at this many times (once per path: a swarm's shortened path
+#: hugs the obstacles, and a check ten times finer still let 2 of 10 Dubins paths cut into an
+#: obstacle between its samples, found by 4,000 states along the path; docs/spaces.md).
+FINAL_FINER = 100
 #: Candidates checked with ``checkMotion`` per evaluation of the swarm, at most (the shortest of
 #: those that would improve their particle's best).
 CHECKED_PER_EVALUATION = 8
@@ -146,9 +151,10 @@ class MotionChecker:
         self._b = si.allocState()
         self._s = si.allocState()
 
-    def motion_free(self, a: np.ndarray, b: np.ndarray, fine: bool = True) -> bool:
+    def motion_free(self, a: np.ndarray, b: np.ndarray, fine: bool = True,
+                    factor: int = FINER) -> bool:  # fmt: skip
         """Whether the motion from row ``a`` to row ``b`` is valid (``fine``: also at
-        :data:`FINER` times the resolution)."""
+        ``factor`` times the resolution; the time of checks at :data:`FINER` is measured)."""
         sa, sb, s = self._a, self._b, self._s
         self.adapter.assign(sa, a)
         self.adapter.assign(sb, b)
@@ -159,16 +165,17 @@ class MotionChecker:
             return True
         t0 = time.perf_counter()
         try:
-            return self._between(sa, sb, s)
+            return self._between(sa, sb, s, factor)
         finally:
-            self.fine_seconds += time.perf_counter() - t0
-            self.fine_motions += 1
+            if factor == FINER:
+                self.fine_seconds += time.perf_counter() - t0
+                self.fine_motions += 1
 
-    def _between(self, sa, sb, s) -> bool:
-        n = FINER * max(int(self.space.validSegmentCount(sa, sb)), 1)
+    def _between(self, sa, sb, s, factor: int) -> bool:
+        n = factor * max(int(self.space.validSegmentCount(sa, sb)), 1)
         interpolate, valid = self.space.interpolate, self.si.isValid
         for k in range(1, n):
-            if k % FINER == 0:
+            if k % factor == 0:
                 continue  # a state checkMotion looked at
             interpolate(sa, sb, k / n, s)
             if not valid(s):
@@ -179,13 +186,18 @@ class MotionChecker:
         """Measured seconds of the finer check per motion (0 before any)."""
         return self.fine_seconds / self.fine_motions if self.fine_motions else 0.0
 
+    def final_check_seconds(self, motions: int) -> float:
+        """The measured time a check of ``motions`` motions at :data:`FINAL_FINER` takes (the
+        finer checks' cost per motion, scaled: the states checked grow with the factor)."""
+        return self.fine_mean() * motions * FINAL_FINER / FINER
+
     def path_free(self, rows: np.ndarray, stop: Callable[[], bool] | None = None,
-                  fine: bool = True) -> bool | None:  # fmt: skip
+                  fine: bool = True, factor: int = FINER) -> bool | None:  # fmt: skip
         """Whether every motion of the path is valid; None when ``stop`` fired first."""
         for k in range(len(rows) - 1):
             if stop is not None and stop():
                 return None
-            if not self.motion_free(rows[k], rows[k + 1], fine):
+            if not self.motion_free(rows[k], rows[k + 1], fine, factor):
                 return False
         return True
 
@@ -262,8 +274,8 @@ FINAL_CHECK_MARGIN = 1.5
 
 class _Stop:
     """When the work stops: the caller's condition, or ``deadline`` less the time the last check
-    of a path of ``motions`` motions needs (:data:`FINAL_CHECK_MARGIN` times the finer check's
-    measured cost per motion: a user's checker may take a millisecond a state)."""
+    of a path of ``motions`` motions needs (:data:`FINAL_CHECK_MARGIN` times its measured cost,
+    :meth:`MotionChecker.final_check_seconds`: a user's checker may take a millisecond a state)."""
 
     def __init__(self, terminate, deadline: float | None, checker: MotionChecker,
                  motions: int) -> None:  # fmt: skip
@@ -275,7 +287,7 @@ class _Stop:
             return True
         if self.deadline is None:
             return False
-        reserve = FINAL_CHECK_MARGIN * self.checker.fine_mean() * self.motions
+        reserve = FINAL_CHECK_MARGIN * self.checker.final_check_seconds(self.motions)
         return time.perf_counter() >= self.deadline - reserve
 
     def room_for_a_check(self, rows: np.ndarray) -> bool:
@@ -284,7 +296,7 @@ class _Stop:
         if self.deadline is None or len(rows) <= 2:
             return True
         self.checker.motion_free(rows[0], rows[1])
-        need = 2.0 * self.checker.fine_mean() * (len(rows) - 1)
+        need = 2.0 * self.checker.final_check_seconds(len(rows) - 1)
         return time.perf_counter() + need <= self.deadline
 
 
@@ -301,10 +313,11 @@ def _round(kind, rows, adapter, checker, options, rng, stop, deadline, history, 
 
 def _final(seed: np.ndarray, best: np.ndarray, adapter: SpaceAdapter, checker: MotionChecker,
            input_length: float) -> np.ndarray:  # fmt: skip
-    """``best`` once checked again along every motion and strictly shorter; else ``seed``."""
+    """``best`` once checked again along every motion (at :data:`FINAL_FINER` times the
+    resolution) and strictly shorter; else ``seed``."""
     if best is seed or not adapter.length(best) < input_length * (1.0 - _RELATIVE_GAIN):
         return seed
-    return best if checker.path_free(best) else seed
+    return best if checker.path_free(best, factor=FINAL_FINER) else seed
 
 
 def _prune(rows: np.ndarray, adapter: SpaceAdapter, checker: MotionChecker, stop) -> np.ndarray:
