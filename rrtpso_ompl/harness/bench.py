@@ -514,7 +514,13 @@ def overview_markdown(summary: Sequence[SummaryRow]) -> str:
     planners = list(dict.fromkeys(s.planner for s in summary))
     budgets = sorted({s.budget for s in summary})
     first = planners[0] if planners else ""
-    lost, total = _cells_lost(summary, first, budgets)
+    lost, ties, total = _cells_lost(summary, first, budgets)
+    alone = total - len(lost) - ties
+    tied = f" and ties for it in {ties}" if ties else ""
+    standing = f"{first} has the shortest median path alone in {alone} of {total} problem x budget"
+    standing += f" cells{tied}."
+    behind = (["In the others, the shortest median path was:", "", *lost] if lost
+              else [f"{first} is behind in none."])  # fmt: skip
     return "\n".join(
         [
             "## Overview",
@@ -530,10 +536,9 @@ def overview_markdown(summary: Sequence[SummaryRow]) -> str:
             "",
             _overview_table(summary, planners, budgets, _raw_cell),
             "",
-            f"{first} has the shortest median path in {total - len(lost)} of {total} problem x "
-            "budget cells. In the others, the shortest median path was:",
+            standing,
             "",
-            *(lost or ["- none"]),
+            *behind,
             "",
         ]
     )
@@ -571,10 +576,11 @@ def _raw_cell(cells: list[SummaryRow]) -> str:
 
 def _cells_lost(
     summary: Sequence[SummaryRow], first: str, budgets: Sequence[float]
-) -> tuple[list[str], int]:
+) -> tuple[list[str], int, int]:
     """The problem x budget cells in which ``first`` has not the shortest median path (one line
-    each: who has it, and by how much), and how many cells have any solved run."""
-    lost, total = [], 0
+    each: who has it, and by how much), how many it shares with another planner (a tie is no
+    win), and how many cells have any solved run."""
+    lost, ties, total = [], 0, 0
     for budget in budgets:
         for problem in dict.fromkeys(s.problem for s in summary if s.budget == budget):
             cell = {s.planner: s.median_ratio for s in summary
@@ -585,12 +591,14 @@ def _cells_lost(
             best = min(cell, key=cell.__getitem__)
             if first not in cell:
                 lost.append(f"- {budget:g} s, {problem}: {best}; {first} solved no run")
-            elif best != first:
+            elif cell[best] < cell[first]:
                 margin = 100 * (cell[first] - cell[best])
                 lost.append(
                     f"- {budget:g} s, {problem}: {best}, shorter by {margin:.3f} % of the optimum"
                 )
-    return lost, total
+            elif sum(r == cell[first] for r in cell.values()) > 1:
+                ties += 1
+    return lost, ties, total
 
 
 def report_markdown(

@@ -110,7 +110,24 @@ def test_overview_counts_the_cells_the_first_planner_loses():
         row("b", "Ours", 1.003), row("b", "Theirs", 1.002),  # they win by 0.1 %
         row("c", "Ours", None, solved=0), row("c", "Theirs", 1.5),  # we solve nothing
     ])  # fmt: skip
-    assert "Ours has the shortest median path in 1 of 3 problem x budget cells" in text
+    assert "Ours has the shortest median path alone in 1 of 3 problem x budget cells." in text
     assert "- 1 s, b: Theirs, shorter by 0.100 % of the optimum" in text
     assert "- 1 s, c: Theirs; Ours solved no run" in text
     assert "| Ours | +0.20 %, 67%, 1.00 s |" in text  # median of 1.001 and 1.003; 20 of 30 runs
+
+
+def test_overview_counts_a_tie_as_no_win_and_lists_no_loss_when_there_is_none():
+    from rrtpso_ompl.harness.bench import SummaryRow, overview_markdown
+
+    def row(problem, planner, ratio):
+        return SummaryRow(problem, 1.0, planner, 10, 10, 1.0, 100.0, None, ratio, None, None,
+                          ratio, ratio, 1.0)  # fmt: skip
+
+    text = overview_markdown([
+        row("a", "Ours", 1.001), row("a", "Theirs", 1.002),  # we win
+        row("b", "Ours", 1.000), row("b", "Theirs", 1.000),  # both found the optimum: a tie
+    ])  # fmt: skip
+    assert "Ours has the shortest median path alone in 1 of 2 problem x budget cells and ties " \
+           "for it in 1." in text  # fmt: skip
+    assert "Ours is behind in none." in text
+    assert "- none" not in text and "In the others" not in text
