@@ -154,5 +154,7 @@ def run(args: argparse.Namespace) -> int:
         where = f"generate {args.kind}:"
         text = str(exc)
         raise UsageError(text if text.startswith(where) else f"{where} {text}") from None
-    note(f"wrote {path}")
+    # A map kind's map files are written too, beside the problem: say so (and where).
+    maps = [str(p) for p in paths[1:]]
+    note(f"wrote {path}" + (f" and its map, {' and '.join(maps)}" if maps else ""))
     return EXIT_OK

@@ -158,6 +158,10 @@ def test_the_header_command_regenerates_the_three_files(tmp_path):
     assert command == "rrtpso generate maze_map --seed 3 --cells 24 --exact --corridor 1 --out FILE"
     proc = run(*shlex.split(command)[1:-1], str(tmp_path / "b" / "p.yaml"))
     assert proc.returncode == 0, proc.stderr
+    # The command says it wrote the map's two files too, naming them.
+    b = tmp_path / "b"
+    assert f"wrote {b / 'p.yaml'} and its map, {b / 'p_map.yaml'} and {b / 'p_map.pgm'}" in (
+        proc.stderr)  # fmt: skip
     for x, y in zip(three(first), three(tmp_path / "b" / "p.yaml"), strict=True):
         assert x.read_bytes() == y.read_bytes()
 
