@@ -20,7 +20,7 @@ user's own) is respected: the swarm's path is kept only when it does not raise t
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -33,8 +33,7 @@ from ..base import PlannerStats
 from ..post import simplify_until
 from ..pso.path_optimizer import PathOptimizerOptions
 from ..pso.space_path import FINAL_FINER, MotionChecker, optimize_space_path
-from ..result import BenchmarkRun
-from .rrtstar_stage import grow_rrtstar, has_exact_solution
+from .rrtstar_stage import RRTstarStatsMixin, grow_rrtstar, has_exact_solution
 
 __all__ = ["SpaceStats", "solve_in_space", "space_of_planner"]
 
@@ -46,7 +45,7 @@ _BITSTAR_SPACES = ("R^n", "SE(2)")
 
 
 @dataclass
-class SpaceStats(PlannerStats):
+class SpaceStats(RRTstarStatsMixin, PlannerStats):
     """The figures of one RRTstarPSO solve outside the plane (the ``stages`` of a solve result).
 
     Lengths are by the space's distance (units; SE(2) adds weighted radians), times in seconds.
@@ -80,34 +79,10 @@ class SpaceStats(PlannerStats):
     pso_improved: bool = False
     pso_history: list[float] = field(default_factory=list)
 
-    def to_dict(self) -> dict[str, Any]:
-        d = asdict(self)
-        d["rrt_progress"] = [list(p) for p in self.rrt_progress]
-        return d
-
-    def progress(self) -> list[tuple[float, float]]:
-        """RRT*'s best cost over time, then the length after OMPL's simplifier."""
-        rows = list(self.rrt_progress)
-        if self.simplified_length is not None:
-            rows.append((self.rrt_time + self.simplify_time, self.simplified_length))
-        return rows
-
-    def benchmark_run(self, elapsed: float, length: float | None) -> BenchmarkRun:
-        swarm_ran = self.pso_length is not None
-        return BenchmarkRun(
-            time=elapsed - self.pso_time,
-            solution_length=self.seed_length if self.seed_length is not None else self.rrt_length,
-            simplification_time=self.pso_time if swarm_ran else None,
-            simplified_length=length if swarm_ran else None,
-            properties={
-                "rrt iterations": ("INTEGER", self.rrt_iterations),
-                "pso iterations": ("INTEGER", self.pso_iterations),
-                "pso evaluations": ("INTEGER", self.pso_evaluations),
-                "pso rounds": ("INTEGER", self.pso_rounds),
-                "pso motion checks": ("INTEGER", self.pso_motion_checks),
-            },
-            progress=self.progress(),
-        )
+    def log_properties(self) -> dict[str, tuple[str, Any]]:
+        """RRT*'s and the swarm's figures, and the swarm's motion checks."""
+        return {**super().log_properties(),
+                "pso motion checks": ("INTEGER", self.pso_motion_checks)}  # fmt: skip
 
 
 def space_of_planner(si: ob.SpaceInformation, name: str) -> tuple[SpaceAdapter | None, str | None]:

@@ -29,7 +29,7 @@ split it; the termination condition itself does not tell how much time is left.
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -53,11 +53,10 @@ from ..baselines.ompl_planners import RRTSTAR_PARAMS
 from ..post import PSOPathOptimizer, inflation_of, simplify_until
 from ..pso.path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
 from ..pso.swarm import SWARM_PARAMS
-from ..result import BenchmarkRun
 from .corridor import find_corridor_path
 from .costroute import cost_route
 from .general import solve_in_space, space_of_planner
-from .rrtstar_stage import INFLATION_RRT_MIN, INFLATION_RRT_SHARE, grow_rrtstar
+from .rrtstar_stage import INFLATION_RRT_MIN, INFLATION_RRT_SHARE, RRTstarStatsMixin, grow_rrtstar
 
 #: The RRT* parameters RRTstarPSO passes on to its inner og.RRTstar.
 _INNER = ("range", "goal_bias", "rewire_factor", "informed_sampling", "tree_pruning")
@@ -115,7 +114,7 @@ RRTSTAR_PSO_PARAMS = (
 
 
 @dataclass
-class RRTstarPSOStats(PlannerStats):
+class RRTstarPSOStats(RRTstarStatsMixin, PlannerStats):
     """Per-stage figures of one RRTstarPSO solve (the ``stages`` of a solve result).
 
     Lengths are in problem units, times in seconds; ``*_cost`` are the problem's objective (the
@@ -164,37 +163,14 @@ class RRTstarPSOStats(PlannerStats):
     pso_improved: bool = False
     pso_history: list[float] = field(default_factory=list)
 
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dictionary."""
-        d = asdict(self)
-        d["rrt_progress"] = [list(p) for p in self.rrt_progress]
-        return d
-
-    def progress(self) -> list[tuple[float, float]]:
-        """RRT*'s best cost over time, then the length after OMPL's simplifier."""
-        rows = list(self.rrt_progress)
-        if self.simplified_length is not None:
-            rows.append((self.rrt_time + self.simplify_time, self.simplified_length))
-        return rows
-
-    def benchmark_run(self, elapsed: float, length: float | None) -> BenchmarkRun:
-        swarm_ran = self.pso_length is not None
-        return BenchmarkRun(
-            time=elapsed - self.pso_time,
-            solution_length=self.seed_length if self.seed_length is not None else self.rrt_length,
-            simplification_time=self.pso_time if swarm_ran else None,
-            simplified_length=length if swarm_ran else None,
-            properties={
-                "corridor time": ("REAL", self.corridor_time),
-                "corridor length": ("REAL", self.corridor_length),
-                "costroute time": ("REAL", self.costroute_time),
-                "rrt iterations": ("INTEGER", self.rrt_iterations),
-                "pso iterations": ("INTEGER", self.pso_iterations),
-                "pso evaluations": ("INTEGER", self.pso_evaluations),
-                "pso rounds": ("INTEGER", self.pso_rounds),
-            },
-            progress=self.progress(),
-        )
+    def log_properties(self) -> dict[str, tuple[str, Any]]:
+        """The corridor stage's and the cost route's figures first, then RRT*'s and the swarm's."""
+        return {
+            "corridor time": ("REAL", self.corridor_time),
+            "corridor length": ("REAL", self.corridor_length),
+            "costroute time": ("REAL", self.costroute_time),
+            **super().log_properties(),
+        }
 
 
 #: How many times over OMPL's simplifier checks the path's length in one pass (vertex reduction,

@@ -10,15 +10,19 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping
+from dataclasses import asdict
 from typing import Any
 
 import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
+from ..result import BenchmarkRun
+
 __all__ = [
     "INFLATION_RRT_MIN",
     "INFLATION_RRT_SHARE",
+    "RRTstarStatsMixin",
     "connect_with_bitstar",
     "grow_rrtstar",
     "has_exact_solution",
@@ -29,6 +33,47 @@ __all__ = [
 INFLATION_RRT_SHARE = 0.1
 #: ... and none when that share is under this many seconds (``RRTstarPSO._rrt_futile``).
 INFLATION_RRT_MIN = 0.05
+
+
+class RRTstarStatsMixin:
+    """What the statistics of RRTstarPSO, in the plane and outside it, report the same way:
+    JSON, RRT*'s progress, and the run of OMPL's benchmark log (the swarm as its
+    simplification). A class using it is a dataclass with the fields read here and names its
+    own extra log properties in :meth:`log_properties`."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dictionary."""
+        d = asdict(self)
+        d["rrt_progress"] = [list(p) for p in self.rrt_progress]
+        return d
+
+    def progress(self) -> list[tuple[float, float]]:
+        """RRT*'s best cost over time, then the length after OMPL's simplifier."""
+        rows = list(self.rrt_progress)
+        if self.simplified_length is not None:
+            rows.append((self.rrt_time + self.simplify_time, self.simplified_length))
+        return rows
+
+    def log_properties(self) -> dict[str, tuple[str, Any]]:
+        """The run's properties in OMPL's log: ``name -> (SQL type, value)``."""
+        return {
+            "rrt iterations": ("INTEGER", self.rrt_iterations),
+            "pso iterations": ("INTEGER", self.pso_iterations),
+            "pso evaluations": ("INTEGER", self.pso_evaluations),
+            "pso rounds": ("INTEGER", self.pso_rounds),
+        }
+
+    def benchmark_run(self, elapsed: float, length: float | None) -> BenchmarkRun:
+        """The run as OMPL's benchmark logs it: the swarm is the simplification."""
+        swarm_ran = self.pso_length is not None
+        return BenchmarkRun(
+            time=elapsed - self.pso_time,
+            solution_length=self.seed_length if self.seed_length is not None else self.rrt_length,
+            simplification_time=self.pso_time if swarm_ran else None,
+            simplified_length=length if swarm_ran else None,
+            properties=self.log_properties(),
+            progress=self.progress(),
+        )
 
 
 def grow_rrtstar(
