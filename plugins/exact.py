@@ -11,6 +11,6 @@ PLANNERS = [
         description="The exact shortest path (tangent graph, A*); needs this package's world, "
         "not a user's own validity checker",
         aliases=("geometric::Exact",),
-        capabilities=Capabilities(optimizing=False),
+        capabilities=Capabilities(optimizing=False, car_spaces=False),
     )
 ]

@@ -10,6 +10,6 @@ PLANNERS = [
         params=PSOPlanner.PARAMS,
         description="Particle swarm over random waypoints (the paper's PSO baseline, Table 3)",
         aliases=("geometric::PSO",),
-        capabilities=Capabilities(optimizing=True),
+        capabilities=Capabilities(optimizing=True, car_spaces=False),
     )
 ]

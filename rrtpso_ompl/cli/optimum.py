@@ -100,7 +100,9 @@ def _shortest(args: argparse.Namespace, problem: Any, frame: Any) -> int:
     _write_bag(args, problem, frame, path)
     if result.found:
         what = "no inflation: J is the length; " if args.cost else ""
-        note(f"{problem.name}: {what}optimum length={result.length:.6f}")
+        bound = (" (the disc's shortest path, turning radius ignored: a lower bound for this "
+                 "car-like robot)") if problem.car else ""  # fmt: skip
+        note(f"{problem.name}: {what}optimum length={result.length:.6f}{bound}")
         return EXIT_OK
     note(f"{problem.name}: no path exists")
     return EXIT_UNSOLVED

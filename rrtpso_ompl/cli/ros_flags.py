@@ -96,10 +96,12 @@ def ros_poses(args: argparse.Namespace, frame: Any, path: Any) -> Any:
         return None
     try:
         if args.bag:  # a bag's /plan holds fewer poses than a path document
+            import numpy as np
+
             from ..model.geometry import path_length
             from ..ros.bag import check_pose_count
 
-            check_pose_count(frame, path_length(path) * frame.scale)
+            check_pose_count(frame, path_length(np.asarray(path)[:, :2]) * frame.scale)
         return frame.poses(path)
     except ValueError as exc:
         raise UsageError(f"{args.problem}: --path-resolution: {exc}") from None

@@ -157,6 +157,10 @@ def run(args: argparse.Namespace) -> int:
 def _check_flags(args: argparse.Namespace, problem: Any) -> None:
     """The robot keys a simulation needs and the flags' values (UsageError naming them)."""
     src = args.problem
+    if problem.car:  # the replanning manager drives a differential-drive robot's polylines
+        raise UsageError(f"{src}: robot.turning_radius: simulate drives a differential-drive "
+                         "robot; a car-like robot's curves are planned by solve (--trajectory "
+                         "for its wheel commands)")  # fmt: skip
     for key in ("speed", "sample_time", "sensor_range"):
         if getattr(problem.robot, key) is None:
             raise UsageError(f"{src}: robot.{key}: required for simulate")

@@ -208,6 +208,8 @@ def _drive(problem: Any, result: Any, profile: str, slow: bool = False) -> Any:
     from ..kinematics import TrajectoryError, drive
     from ..model import World
 
+    if problem.car:
+        return _drive_car(problem, result, profile)
     yaw = None if problem.goal_yaw is None else math.radians(problem.goal_yaw)
     try:
         return drive(
@@ -222,10 +224,37 @@ def _drive(problem: Any, result: Any, profile: str, slow: bool = False) -> Any:
         raise ProblemError(problem.source, "", str(exc)) from None
 
 
+def _drive_car(problem: Any, result: Any, profile: str) -> Any:
+    """A car's trajectory: its curves' dense poses driven as they are (no turn in place)."""
+    import numpy as np
+
+    from ..errors import ProblemError
+    from ..kinematics import TrajectoryError, drive_car
+    from ..ompl_setup.car import CarModel
+
+    car = CarModel.of(problem)
+    poses = car.polyline(np.asarray(result.stages["poses"], dtype=float))
+    try:
+        return drive_car(poses, problem.robot, profile, result.stages["car"]["space"])
+    except TrajectoryError as exc:
+        raise ProblemError(problem.source, "", str(exc)) from None
+
+
+def _ros_path(result: Any) -> Any:
+    """The path the ROS outputs take: its points, with a car's headings as a third column."""
+    import numpy as np
+
+    yaw = (result.stages or {}).get("path_yaw")
+    if yaw is None or len(yaw) != len(result.path):
+        return result.path
+    return np.column_stack([result.path, yaw])
+
+
 def _write_outputs(
     args: argparse.Namespace, problem: Any, result: Any, motion: Any, frame: Any
 ) -> None:
-    poses = ros_poses(args, frame, result.path if result.solved else None)  # may refuse: first
+    plan = _ros_path(result) if result.solved else None
+    poses = ros_poses(args, frame, plan)  # may refuse: first
     if args.plot:
         from ..plotting import plot_solution, save_figure
 
@@ -245,7 +274,7 @@ def _write_outputs(
     if args.bag:
         from ..ros.bag import write_plan_bag
 
-        write_plan_bag(problem, frame, result.path if result.solved else None, args.bag)
+        write_plan_bag(problem, frame, plan, args.bag)
     if args.json:
         from ..outputs import write_json_atomic
         from ..ros import units_fields

@@ -11,11 +11,13 @@ Stages, each a pure function:
 3. :func:`wheel_speeds`: eqs. 9-12, and :func:`integrate_wheels`: the corrected eqs. 1-3
    (:mod:`.diffdrive`);
 4. :func:`track`: Kanayama's kinematic controller on that model (:mod:`.tracking`);
-5. :func:`drive`: all of it for one path (:mod:`.drive`).
+5. :func:`drive`: all of it for one path (:mod:`.drive`); :func:`drive_car`: a car-like
+   robot's curves, forwards and backwards, with no turn in place (:mod:`.car_drive`).
 
 Printed typos and their corrections are listed in ``docs/kinematics.md``.
 """
 
+from .car_drive import drive_car
 from .diffdrive import integrate_wheels, wheel_speeds
 from .drive import REQUIRED_ROBOT_KEYS, DriveResult, drive
 from .profile import (
@@ -43,6 +45,7 @@ __all__ = [
     "check_samples",
     "clearance_speed_share",
     "drive",
+    "drive_car",
     "integrate_wheels",
     "reference_curve",
     "reference_polynomial",

@@ -55,6 +55,7 @@ KINDS: dict[str, dict[str, Any]] = {
     # The short form (the map YAML's path) or the long form (a mapping).
     "map": {"anyOf": [{"type": "string", "minLength": 1}, {"$ref": "#/$defs/map"}]},
     "unknown": {"enum": ["obstacle", "free"]},
+    "bool": {"type": "boolean"},
 }
 
 
@@ -118,6 +119,12 @@ ROBOT = Section("robot", (
         unit="1/length"),
     Key("cost_travel_multiplier", "positive", "w, Smac 2D's name: driving at the radius from a "
         "wall costs 1 + w times the length (default: 2.0)"),
+    Key("turning_radius", "positive", "a car-like robot: its smallest turning radius; its path "
+        "is arcs of this radius and straight lines, Dubins curves (forwards only) or "
+        "Reeds-Shepp curves (with reverse); default: none, a differential-drive robot that turns "
+        "in place", unit="length"),
+    Key("reverse", "bool", "a car-like robot that may also drive backwards (Reeds-Shepp "
+        "curves); default false (Dubins curves)"),
 ), "the robot: a disc plus its drive parameters")  # fmt: skip
 
 PLANNER = Section("planner", (
@@ -166,7 +173,12 @@ TOP = Section("problem", (
     Key("goal", "point", "goal position", True, "length"),
     Key("goal_tolerance", "length", "how close to the goal a path must end", unit="length"),
     Key("goal_yaw", "number", "heading wanted at the goal, counter-clockwise from +x (any "
-        "number, read modulo 360): the robot turns in place there", unit="deg"),
+        "number, read modulo 360): a disc robot turns in place there, a car-like robot's path "
+        "arrives with it (default for a car: the direction from the start to the goal)",
+        unit="deg"),
+    Key("start_yaw", "number", "a car-like robot's heading at the start, counter-clockwise "
+        "from +x (default: the direction from the start to the goal); only with "
+        "robot.turning_radius", unit="deg"),
     Key("robot", "robot", "the robot", True),
     Key("obstacles", "list:obstacle", "static obstacles (circles, rectangles, polygons)"),
     Key("moving_obstacles", "list:moving_obstacle", "moving obstacles"),

@@ -180,6 +180,7 @@ def problem_from_dict(
         goal=v.point(doc["goal"], "goal"),
         goal_tolerance=v.number(_get(doc, "goal_tolerance", 0.0), "goal_tolerance", low=0.0),
         goal_yaw=v.degrees(doc.get("goal_yaw"), "goal_yaw"),
+        start_yaw=v.degrees(doc.get("start_yaw"), "start_yaw"),
         robot=_with_default_scaling(robot, units),
         obstacles=obstacles,
         moving_obstacles=moving,
@@ -187,6 +188,7 @@ def problem_from_dict(
         source=source,
         map=occupancy,
     )
+    v.car(problem)
     for key in ("start", "goal"):
         v.free_position(problem, key)
     return problem
@@ -216,6 +218,7 @@ def _with_default_scaling(robot: Robot, units: str) -> Robot:
 # also make the JSON Schema: one list of keys for both.
 _TOP_KEYS = TOP.names()
 _ROBOT_KEYS = ROBOT.names()
+_ROBOT_FLAGS = frozenset(k.name for k in ROBOT.keys if k.kind == "bool")
 _PLANNER_KEYS = PLANNER.names()
 _OBSTACLE_KEYS = {kind: section.names() for kind, section in OBSTACLES.items()}
 _MOVING_KEYS = MOVING.names()
@@ -364,11 +367,37 @@ class _Validator:
         # Radius 0 is a point robot, which is a legitimate (classic) planning problem.
         radius = self.length(doc["radius"], f"{key}.radius")
         optional = {
-            k: self.length(doc[k], f"{key}.{k}", strict=True)
+            k: self.flag(doc[k], f"{key}.{k}") if k in _ROBOT_FLAGS
+            else self.length(doc[k], f"{key}.{k}", strict=True)
             for k in _ROBOT_KEYS[1:]
             if doc.get(k) is not None
-        }
+        }  # fmt: skip
         return Robot(radius=radius, **optional)
+
+    def flag(self, value: Any, key: str) -> bool:
+        """A yes/no key: YAML's true or false, nothing else (not 0, 1 or "yes" in quotes)."""
+        if not isinstance(value, bool):
+            raise self.error(key, f"must be true or false, got {describe(value)}")
+        return value
+
+    def car(self, problem: Problem) -> None:
+        """Reject the keys a car-like robot needs or refuses in the wrong company: ``reverse``
+        and ``start_yaw`` without ``robot.turning_radius``, and the inflation cost with it (a
+        car is planned by the length of its curves alone)."""
+        robot = problem.robot
+        if robot.turning_radius is None:
+            for name, given in (("robot.reverse", robot.reverse),
+                                ("start_yaw", problem.start_yaw is not None)):  # fmt: skip
+                if given:
+                    raise self.error(name, "applies to a car-like robot only: give "
+                                           "robot.turning_radius too (a disc robot turns in "
+                                           "place)")  # fmt: skip
+        elif robot.inflation_radius is not None:
+            raise self.error(
+                "robot.inflation_radius",
+                "is not supported for a car-like robot "
+                "(robot.turning_radius): its path is planned by length alone",
+            )
 
     def planner(self, value: Any, key: str) -> PlannerConfig:
         doc = self.mapping(value, key, _PLANNER_KEYS)

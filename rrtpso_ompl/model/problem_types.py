@@ -114,6 +114,8 @@ def _robot_class() -> type:
     for key in ROBOT.keys:
         if key.required:
             fields.append((key.name, float))
+        elif key.kind == "bool":
+            fields.append((key.name, bool, field(default=False)))
         else:
             fields.append((key.name, float | None, field(default=None)))
     cls = dataclasses.make_dataclass("Robot", fields, frozen=True)
@@ -147,7 +149,8 @@ class Problem:
     """One validated planning problem. Build it with :func:`load_problem`.
 
     Lengths are in the problem's ``units``; ``goal_yaw`` is the heading wanted at the goal in
-    degrees, counter-clockwise from +x, normalised to (-180, 180] (None: any heading).
+    degrees, counter-clockwise from +x, normalised to (-180, 180] (None: any heading), and
+    ``start_yaw`` a car-like robot's heading at the start (None: towards the goal).
     """
 
     name: str
@@ -159,6 +162,7 @@ class Problem:
     moving_obstacles: tuple[MovingObstacle, ...] = ()
     goal_tolerance: float = 0.0
     goal_yaw: float | None = None
+    start_yaw: float | None = None
     planner: PlannerConfig = field(default_factory=PlannerConfig)
     description: str = ""
     units: str = ""
@@ -172,6 +176,21 @@ class Problem:
         near obstacles (:class:`~rrtpso_ompl.model.objective.InflationCost`; its ``active`` says
         whether it has one). Built once, here, from the robot's declared keys."""
         return InflationCost.of(self.robot)
+
+    @property
+    def car(self) -> bool:
+        """Whether the robot is car-like (``robot.turning_radius``): its path is Dubins or
+        Reeds-Shepp curves, planned in OMPL's space of them (:mod:`rrtpso_ompl.ompl_setup.car`)."""
+        return self.robot.turning_radius is not None
+
+    def end_yaws(self) -> tuple[float, float]:
+        """A car-like robot's headings at the start and the goal, radians in ``[-pi, pi)`` (as
+        OMPL's ``SO2StateSpace`` bounds them: a yaw of ``pi`` is out of its bounds): the
+        file's, else the direction from the start to the goal."""
+        toward = math.atan2(self.goal[1] - self.start[1], self.goal[0] - self.start[0])
+        yaws = (toward if deg is None else math.radians(deg)
+                for deg in (self.start_yaw, self.goal_yaw))  # fmt: skip
+        return tuple((y + math.pi) % (2.0 * math.pi) - math.pi for y in yaws)
 
     @property
     def map_boxes(self) -> np.ndarray | None:

@@ -5,7 +5,9 @@
   :class:`~rrtpso_ompl.model.World` (no discretisation: a segment is valid only when every point of
   it keeps the robot radius from every obstacle);
 * the problem's objective (path length, plus the inflation cost when the robot has one:
-  :mod:`.objective`), the start and the goal (with its tolerance).
+  :mod:`.objective`), the start and the goal (with its tolerance);
+* for a car-like robot (``robot.turning_radius``) instead OMPL's Dubins or Reeds-Shepp space,
+  its curves checked soundly against the same world (:mod:`.car`).
 
 See ``docs/design.md`` for why some OMPL calls are avoided from Python (the bindings notes).
 """
@@ -20,7 +22,10 @@ from ompl import geometric as og
 
 from ..model.problem_types import Problem
 from ..model.world import World
+from .car import CarModel, CarValidityChecker, CurveMotionValidator
+from .convert import path_to_array
 from .objective import objective_for
+from .space import centre_bounds
 
 __all__ = ["ExactMotionValidator", "PlanningContext", "WorldValidityChecker", "make_context"]
 
@@ -79,6 +84,23 @@ class PlanningContext:
     #: Held here too: OMPL holds it in C++, and a Python subclass whose Python object is
     #: collected silently loses its overrides (its motion costs fall back to the length).
     objective: ob.OptimizationObjective | None = None
+    #: A car-like robot's curves (None: the plane, a path is its waypoints' polyline).
+    car: CarModel | None = None
+
+    def polyline(self, path: og.PathGeometric) -> np.ndarray:
+        """A path of the problem's space as the polyline it is checked and reported as,
+        ``(n, 2)``: its waypoints in the plane; a car's curves cut into chords
+        (:meth:`.car.CarModel.polyline`)."""
+        if self.car is None:
+            return path_to_array(path)
+        return self.car.polyline(self.car.path_poses(path))[:, :2]
+
+    def polyline_valid(self, xy: np.ndarray) -> bool:
+        """Whether a polyline from :meth:`polyline` is a valid path: exact in the plane; for a
+        car, its chords with the sagitta's margin (so the curves they cut are free too)."""
+        if self.car is None:
+            return bool(self.world.path_valid(xy))
+        return self.motion_validator.polyline_valid(xy)
 
 
 def make_context(problem: Problem, world: World | None = None) -> PlanningContext:
@@ -92,14 +114,10 @@ def make_context(problem: Problem, world: World | None = None) -> PlanningContex
         Its static world; built from the problem when omitted.
     """
     world = world or World.from_problem(problem)
+    if problem.car:
+        return _car_context(problem, world)
     space = ob.RealVectorStateSpace(2)
-    (xmin, ymin), (xmax, ymax) = problem.bounds
-    bounds = ob.RealVectorBounds(2)
-    bounds.setLow(0, xmin)
-    bounds.setLow(1, ymin)
-    bounds.setHigh(0, xmax)
-    bounds.setHigh(1, ymax)
-    space.setBounds(bounds)
+    space.setBounds(centre_bounds(problem.bounds))
 
     ss = og.SimpleSetup(space)
     si = ss.getSpaceInformation()
@@ -120,3 +138,26 @@ def make_context(problem: Problem, world: World | None = None) -> PlanningContex
     objective = objective_for(si, problem.objective, world)
     ss.setOptimizationObjective(objective)
     return PlanningContext(problem, world, ss, si, space, checker, validator, objective)
+
+
+def _car_context(problem: Problem, world: World) -> PlanningContext:
+    """A car-like robot's setup: Dubins or Reeds-Shepp poses, the exact world's point check,
+    each curve checked soundly (:mod:`.car`), the start and goal poses, the path length."""
+    car = CarModel.of(problem)
+    ss = og.SimpleSetup(car.space)
+    si = ss.getSpaceInformation()
+    checker = CarValidityChecker(si, world)
+    ss.setStateValidityChecker(checker)
+    validator = CurveMotionValidator(si, world, car)
+    si.setMotionValidator(validator)
+    start, goal = car.space.allocState(), car.space.allocState()
+    ends = zip((start, goal), (problem.start, problem.goal), problem.end_yaws(), strict=True)
+    for state, (x, y), yaw in ends:
+        state.setXY(float(x), float(y))
+        state.setYaw(float(yaw))
+    # The goal's threshold is in the space's distance (a curve's length): the tolerance, or
+    # the world's round-off allowance for an exact goal (as in the plane).
+    ss.setStartAndGoalStates(start, goal, max(problem.goal_tolerance, world.tol))
+    objective = ob.PathLengthOptimizationObjective(si)
+    ss.setOptimizationObjective(objective)
+    return PlanningContext(problem, world, ss, si, car.space, checker, validator, objective, car)

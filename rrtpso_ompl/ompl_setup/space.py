@@ -17,10 +17,28 @@ from ompl import base as ob
 
 from ..errors import UnsupportedSpaceError
 
-__all__ = ["PLANE_SPACE", "describe_space", "plane_space_problem", "require_plane_space"]
+__all__ = [
+    "PLANE_SPACE",
+    "centre_bounds",
+    "describe_space",
+    "plane_space_problem",
+    "require_plane_space",
+]
 
 #: The one state space this package's planners plan in, as a user writes it.
 PLANE_SPACE = "ob.RealVectorStateSpace(2)"
+
+
+def centre_bounds(bounds: Any) -> ob.RealVectorBounds:
+    """A problem's ``bounds`` ``((xmin, ymin), (xmax, ymax))`` (where the robot's centre may
+    be) as OMPL's bounds of the plane's two coordinates (also those of an SE(2)-like space)."""
+    (xmin, ymin), (xmax, ymax) = bounds
+    out = ob.RealVectorBounds(2)
+    out.setLow(0, xmin)
+    out.setLow(1, ymin)
+    out.setHigh(0, xmax)
+    out.setHigh(1, ymax)
+    return out
 
 
 def _space_of(si_or_space: Any) -> Any:

@@ -66,11 +66,16 @@ class Capabilities:
     simplify_in_benchmark : bool
         Benchmarks follow it with OMPL's path simplifier, as OMPL's ``Benchmark`` does for its
         planners; the planners of this package optimise their own paths.
+    car_spaces : bool
+        It plans in OMPL's Dubins and Reeds-Shepp spaces, a car-like robot's problem
+        (``robot.turning_radius``); False for planners of the plane only, which such a problem
+        refuses before planning.
     """
 
     optimizing: bool = False
     progress_polling: bool = False
     simplify_in_benchmark: bool = False
+    car_spaces: bool = True
 
 
 @dataclass(frozen=True)

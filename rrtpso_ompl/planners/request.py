@@ -45,6 +45,7 @@ from ..errors import (
     ParameterError,
     ProblemError,
     UnknownPlannerError,
+    UnsupportedSpaceError,
     did_you_mean,
     shown,
 )
@@ -295,6 +296,7 @@ def resolve(
     src = problem.source if problem is not None else ""
     origins: dict[str, str] = {}
     entry, spec_post = _planner(spec, cfg, src, registry or default_registry(), sources, origins)
+    _check_space(problem, entry, origins)
     steps = tuple(dict.fromkeys((*spec_post, *parse_steps(post, sources.label("post")))))
     if post:
         origins["post"] = sources.label("post")
@@ -306,6 +308,16 @@ def resolve(
     )
     _check_rules(request, origins)
     return request
+
+
+def _check_space(problem: Problem | None, entry: PlannerEntry, origins: Mapping[str, str]) -> None:
+    """Refuse a planner of the plane only for a car-like robot's problem, before planning."""
+    if problem is not None and problem.car and not entry.capabilities.car_spaces:
+        raise UnsupportedSpaceError(
+            f"{origins.get('planner', entry.name)}: {entry.name} plans in the plane only; a "
+            f"car-like robot (robot.turning_radius of {problem.source}) is planned in OMPL's "
+            f"Dubins or Reeds-Shepp space: use RRTstarPSO or one of OMPL's planners"
+        )
 
 
 def check_arguments(

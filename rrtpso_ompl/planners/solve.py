@@ -97,6 +97,8 @@ def solve(
     run = _run_planner(ctx, instance, request, progress)
     _post_passes(ctx, request, run, simplify)
     path, status = _validated_path(ctx, run.code)
+    if ctx.car is not None and len(path):
+        run.stages.update(_car_path(ctx))
     return _result(request, ctx, instance, run, path, status)
 
 
@@ -160,8 +162,6 @@ def _run_planner(
     """Step 3: the planner for its share of the time, sampled when asked; its own figures."""
     from ompl import base as ob
 
-    from ..ompl_setup import path_to_array
-
     limit = request.planner_time
     sampler = _ProgressSampler(instance, limit, request) if progress else None
     t0 = time.perf_counter()
@@ -172,16 +172,44 @@ def _run_planner(
         status = ctx.ss.solve(ob.timedPlannerTerminationCondition(limit))
     elapsed = time.perf_counter() - t0
     pdef = ctx.ss.getProblemDefinition()
-    raw = path_to_array(pdef.getSolutionPath()) if pdef.hasSolution() else None
+    raw = ctx.polyline(pdef.getSolutionPath()) if pdef.hasSolution() else None
     stats = request.entry.collect_stats(instance)
     run = _Run(status, t0, elapsed, raw, stats.benchmark_run(elapsed, _length(raw)),
-               stats.to_dict(), elapsed)  # fmt: skip
+               _car_stages(ctx, stats.to_dict()), elapsed)  # fmt: skip
     if sampler is not None:
         # The last row is the planner's own path at the end of its budget (before any
         # simplification by the harness).
         final = _length(raw) if run.code == ob.PlannerStatus.EXACT_SOLUTION else None
         run.benchmark = _with_progress(run.benchmark, sampler.rows(), elapsed, final)
     return run
+
+
+def _car_stages(ctx: PlanningContext, stages: dict[str, Any]) -> dict[str, Any]:
+    """A car's stage paths as the plane's are read: ``rrt_path`` and ``seed_path`` (poses
+    ``x, y, yaw`` outside the plane) become their curves' chord polylines, the poses kept as
+    ``rrt_poses`` and ``seed_poses``."""
+    if ctx.car is None:
+        return stages
+    for key in ("rrt_path", "seed_path"):
+        poses = np.asarray(stages.get(key) or [], dtype=float).reshape(-1, 3)
+        if len(poses):
+            stages[key.replace("_path", "_poses")] = poses.tolist()
+            stages[key] = ctx.car.polyline(poses)[:, :2].tolist()
+    return stages
+
+
+def _car_path(ctx: PlanningContext) -> dict[str, Any]:
+    """A car's returned path as what drives it: its waypoint poses ``(x, y, yaw)`` (units,
+    rad), the heading at each point of the reported polyline (``path_yaw``, rad) and its
+    curves' figures (the curve's length by the space's distance, its turning
+    radius, whether it backs, the chords' sagitta)."""
+    path = ctx.ss.getProblemDefinition().getSolutionPath()
+    car = ctx.car
+    poses = car.path_poses(path)
+    return {"poses": poses.tolist(), "path_yaw": car.polyline(poses)[:, 2].tolist(),
+            "car": {"space": "Reeds-Shepp" if car.reverse else "Dubins",
+                    "turning_radius": car.rho, "curve_length": float(path.length()),
+                    "sagitta": car.sagitta}}  # fmt: skip
 
 
 def _post_passes(ctx: PlanningContext, request: PlannerRequest, run: _Run, simplify: bool) -> None:
@@ -216,13 +244,11 @@ def _validated_path(ctx: PlanningContext, code: Any) -> tuple[np.ndarray, str]:
     ``"none"`` otherwise (a path that fails the check is never returned)."""
     from ompl import base as ob
 
-    from ..ompl_setup import path_to_array
-
     verdicts = {ob.PlannerStatus.EXACT_SOLUTION: "exact",
                 ob.PlannerStatus.APPROXIMATE_SOLUTION: "approximate"}  # fmt: skip
     pdef = ctx.ss.getProblemDefinition()
-    path = path_to_array(pdef.getSolutionPath()) if pdef.hasSolution() else np.empty((0, 2))
-    if code not in verdicts or not (len(path) and ctx.world.path_valid(path)):
+    path = ctx.polyline(pdef.getSolutionPath()) if pdef.hasSolution() else np.empty((0, 2))
+    if code not in verdicts or not (len(path) and ctx.polyline_valid(path)):
         return np.empty((0, 2)), "none"
     return path, verdicts[code]
 
@@ -274,12 +300,13 @@ def _simplify(
     t1 = time.perf_counter()
     path = ctx.ss.getProblemDefinition().getSolutionPath()
     objective = _inflation_objective(ctx)
-    before = path_to_array(path), path_cost(objective, path) if objective else None
+    if objective is not None:
+        before = path_to_array(path), path_cost(objective, path)
     ctx.ss.simplifySolution()
     if objective is not None and path_cost(objective, path) > before[1]:
         assign_path(ctx.si, path, before[0])  # the simplifier raised the objective: undone
     seconds = time.perf_counter() - t1
-    length = path_length(path_to_array(path))
+    length = path_length(ctx.polyline(path))
     own = run.simplification_time or 0.0  # a planner's own simplification stage comes first
     run = BenchmarkRun(
         time=run.time,
@@ -292,7 +319,7 @@ def _simplify(
     stages = {
         "simplification_time": seconds,
         "unsimplified_length": path_length(raw),
-        "unsimplified_valid": bool(ctx.world.path_valid(raw)),
+        "unsimplified_valid": bool(ctx.polyline_valid(raw)),
     }
     return run, stages
 

@@ -53,30 +53,21 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
     ax = axes[0, 0]
     key = draw_world(ax, problem)
     key += draw_costmap(ax, problem)
+    # A car's paths are curves drawn by their chords: marked at their waypoint poses only.
+    car = stages.get("car")
     raw = np.asarray(stages.get("rrt_path") or [], dtype=float).reshape(-1, 2)
     if len(raw):
-        key += ax.plot(
-            raw[:, 0],
-            raw[:, 1],
-            "o--",
-            color=RRT_COLOUR,
-            ms=3,
-            lw=1.2,
-            zorder=3,
-            label=f"RRT* path ({stages.get('rrt_length', float('nan')):.1f})",
-        )
+        label = f"RRT* path ({stages.get('rrt_length', float('nan')):.1f})"
+        key += ax.plot(raw[:, 0], raw[:, 1], "--" if car else "o--", color=RRT_COLOUR, ms=3,
+                       lw=1.2, zorder=3, label=label)  # fmt: skip
     path = np.asarray(result.path, dtype=float).reshape(-1, 2)
     if len(path):
-        key += ax.plot(
-            path[:, 0],
-            path[:, 1],
-            "o-",
-            color=PATH_COLOUR,
-            ms=3,
-            lw=1.8,
-            zorder=4,
-            label=f"{result.planner} path ({result.length:.1f})",
-        )
+        what = f"{car['space']} curves" if car else "path"
+        key += ax.plot(path[:, 0], path[:, 1], "-" if car else "o-", color=PATH_COLOUR, ms=3,
+                       lw=1.8, zorder=4,
+                       label=f"{result.planner} {what} ({result.length:.1f})")  # fmt: skip
+    if car and len(path):
+        key += _draw_poses(ax, np.asarray(stages.get("poses") or [], dtype=float), problem)
     if curve is not None:
         key += ax.plot(
             curve.x,
@@ -93,14 +84,16 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
     ax.set_title(title)
     world_legend(ax, key)
     if history:
-        _draw_pso_history(axes[0, 1], history, problem.units, problem.objective.active)
+        _draw_pso_history(axes[0, 1], history, problem.units, problem.objective.active,
+                          bool(car))  # fmt: skip
     fit_layout(fig)
     return fig
 
 
-def _draw_pso_history(bx: Axes, history: Any, units: str, inflated: bool = False) -> None:
+def _draw_pso_history(bx: Axes, history: Any, units: str, inflated: bool = False,
+                      car: bool = False) -> None:  # fmt: skip
     """Panel (b) of :func:`plot_solution`: the swarm's best cost per iteration, over all its
-    rounds (with an inflation cost, the objective J's)."""
+    rounds (with an inflation cost, the objective J's; for a car, its curves' length)."""
     h = np.asarray(history, dtype=float)
     bx.plot(np.arange(len(h)), h, color=PATH_COLOUR)
     bx.xaxis.set_major_locator(ticker.MaxNLocator(integer=True))
@@ -108,9 +101,23 @@ def _draw_pso_history(bx: Axes, history: Any, units: str, inflated: bool = False
     # The swarm's best is always collision-free, so its cost is the path length plus the
     # turning penalty (smoothness_weight, 0 by default): a length.
     what = "J = length + w x inflation cost" if inflated else "length + turning penalty"
+    if car:  # outside the plane the swarm lowers the curves' length alone
+        what = "length of the curves"
     bx.set_ylabel(f"best cost: {what} [{units or 'length units'}]")
     bx.set_title("PSO best cost per iteration")
     bx.grid(alpha=0.3)
+
+
+def _draw_poses(ax: Axes, poses: np.ndarray, problem: Problem) -> list:
+    """A car's waypoint poses as arrows along its heading, 3 % of the world's larger side long."""
+    if not len(poses):
+        return []
+    (x0, y0), (x1, y1) = problem.bounds
+    size = 0.03 * max(x1 - x0, y1 - y0)
+    q = ax.quiver(poses[:, 0], poses[:, 1], np.cos(poses[:, 2]), np.sin(poses[:, 2]),
+                  color=PATH_COLOUR, angles="xy", scale_units="xy", scale=1.0 / size,
+                  width=0.004, zorder=6, label="waypoint poses (heading)")  # fmt: skip
+    return [q]
 
 
 def plot_optimum(problem: Problem, result: Any) -> Figure:

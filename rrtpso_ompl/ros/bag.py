@@ -236,7 +236,9 @@ def _moving_samples(tracks: list, times: np.ndarray):
 def plan_poses(frame: RosFrame, path: Any) -> Any:
     """``frame.poses(path)``, at most about :data:`MAX_PLAN_POSES` of them
     (:func:`check_pose_count`)."""
-    p = frame.metres(np.asarray(path, dtype=float).reshape(-1, 2))
+    given = np.asarray(path, dtype=float)
+    p = frame.metres(given[:, :2] if given.ndim == 2 and given.shape[1] == 3 else
+                     given.reshape(-1, 2))  # fmt: skip
     check_pose_count(frame, float(np.hypot(*np.diff(p, axis=0).T).sum()) if len(p) > 1 else 0.0)
     return frame.poses(path)
 

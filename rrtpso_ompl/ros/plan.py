@@ -70,5 +70,11 @@ class RosFrame:
         return np.asarray(xy, dtype=float) * self.scale
 
     def poses(self, path: Any) -> Poses:
-        """The path's dense poses in metres, the goal heading on the last one."""
-        return dense_poses(self.metres(path), self.resolution, self.goal_yaw)
+        """The path's dense poses in metres, the goal heading on the last one; a car's path
+        ``(m, 3)`` keeps its own headings (:func:`~.poses.dense_poses`)."""
+        p = np.array(path, dtype=float)
+        if p.ndim == 2 and p.shape[1] == 3:
+            p[:, :2] *= self.scale
+        else:
+            p = self.metres(p)
+        return dense_poses(p, self.resolution, self.goal_yaw)

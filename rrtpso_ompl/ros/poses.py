@@ -44,8 +44,11 @@ def dense_poses(path: np.ndarray, resolution: float, goal_yaw: float | None = No
 
     Parameters
     ----------
-    path : (m, 2) array_like
-        Waypoints, in any length unit (the result is in the same unit).
+    path : (m, 2) or (m, 3) array_like
+        Waypoints, in any length unit (the result is in the same unit); with a third column,
+        a car's headings there (radians): the poses between take them, turned the shorter
+        way, and the last pose the last one (``goal_yaw`` is not used); else each pose faces
+        along its segment.
     resolution : float
         Largest spacing between consecutive poses, same unit, > 0. Each segment of length ``L``
         gets ``ceil(L / resolution)`` equal steps.
@@ -63,7 +66,9 @@ def dense_poses(path: np.ndarray, resolution: float, goal_yaw: float | None = No
         ``resolution`` is not positive and finite, or the path would need more than
         :data:`MAX_POSES` poses.
     """
-    p = np.asarray(path, dtype=float).reshape(-1, 2)
+    given = np.asarray(path, dtype=float)
+    headed = given.ndim == 2 and given.shape[1] == 3  # a car's poses: their own headings
+    p = given[:, :2] if headed else given.reshape(-1, 2)
     if not (math.isfinite(resolution) and resolution > 0):
         raise ValueError(f"path resolution must be positive and finite, got {resolution!r}")
     if len(p) == 0:
@@ -88,6 +93,17 @@ def dense_poses(path: np.ndarray, resolution: float, goal_yaw: float | None = No
     xy = np.empty((total, 2))
     xy[:-1] = starts[seg] + frac[:, None] * d[seg]
     xy[-1] = p[-1]
+    if headed:
+        return Poses(xy, _between(given[:, 2], keep, seg, frac))
     heading = np.arctan2(d[:, 1], d[:, 0])
     yaw = np.append(heading[seg], heading[-1] if goal_yaw is None else goal_yaw)
     return Poses(xy, yaw)
+
+
+def _between(yaw: np.ndarray, keep: np.ndarray, seg: np.ndarray, frac: np.ndarray) -> np.ndarray:
+    """Headings of the poses of :func:`dense_poses` from a car's headings at the waypoints: each
+    step's between its segment's end poses' (turned the shorter way), the last the last."""
+    yaw0, yaw1 = yaw[:-1][keep], yaw[1:][keep]
+    turn = np.angle(np.exp(1j * (yaw1 - yaw0)))
+    out = np.append(yaw0[seg] + frac * turn[seg], yaw[-1])
+    return np.angle(np.exp(1j * out))

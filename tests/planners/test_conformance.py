@@ -328,7 +328,7 @@ def test_an_exception_out_of_solve_is_caught_and_one_out_of_setup_is_a_refusal()
 
 
 def test_the_kit_lists_each_check_once_and_ids_read_as_planner_and_check():
-    assert len({c.__name__ for c in CHECKS}) == len(CHECKS) == 8
+    assert len({c.__name__ for c in CHECKS}) == len(CHECKS) == 9
     mark = parametrize_with_checks(["RRTConnect"], budget=FAST)
     ids = mark.kwargs["ids"]
     assert ids[0] == "RRTConnect-check_solves" and len(ids) == len(CHECKS)

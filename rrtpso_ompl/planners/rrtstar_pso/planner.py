@@ -53,7 +53,7 @@ from ..baselines.ompl_planners import RRTSTAR_PARAMS
 from ..post import PSOPathOptimizer, inflation_of, simplify_until
 from ..pso.path_optimizer import OPTIMIZER_PARAMS, PathOptimizerOptions
 from ..pso.swarm import SWARM_PARAMS
-from .corridor import find_corridor_path
+from .corridor import REPRODUCIBLE_CORRIDOR_CELLS, find_corridor_path
 from .costroute import cost_route
 from .general import solve_in_space, space_of_planner
 from .rrtstar_stage import INFLATION_RRT_MIN, INFLATION_RRT_SHARE, RRTstarStatsMixin, grow_rrtstar
@@ -177,9 +177,6 @@ class RRTstarPSOStats(RRTstarStatsMixin, PlannerStats):
 #: shortcuts, collapsing), for sizing it to a user's slow checker: an estimate on the safe side.
 SIMPLIFIER_PASS_LENGTHS = 20
 
-#: The corridor stage's lattice in an iteration-bounded run (no time limit: the same lattice on
-#: any machine).
-REPRODUCIBLE_CORRIDOR_CELLS = 65_536
 #: With no route through the lattice yet, a finer lattice may be tried until this share of the
 #: budget (there is nothing for the other stages to refine meanwhile).
 _CORRIDOR_NO_ROUTE_SHARE = 0.5

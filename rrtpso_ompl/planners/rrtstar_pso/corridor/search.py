@@ -21,6 +21,9 @@ from .routes import ALTERNATIVE_APART, ALTERNATIVE_SLACK, alternative_routes
 #: Lattice cells the corridor stage builds, searches and funnels per second, on the safe side
 #: (measured on the reference machine: 2-3 million on maps, fewer among many shapes).
 CELLS_PER_SECOND = 1_000_000
+#: The lattice's cells in an iteration-bounded run (no time limit: the same lattice on any
+#: machine).
+REPRODUCIBLE_CORRIDOR_CELLS = 65_536
 
 
 #: The refinement searches the cells within this many coarse cells of the coarse path.
