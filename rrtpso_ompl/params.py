@@ -229,11 +229,15 @@ class ParamTable:
         Constraints over several parameters.
     """
 
-    def __init__(self, *params: ParamSpec, rules: Iterable[Rule] = ()) -> None:
+    def __init__(self, *params: ParamSpec, rules: Iterable[Rule] = (),
+                 groups: Mapping[str, tuple[str, bool]] | None = None) -> None:  # fmt: skip
         self._params = {p.name: p for p in params}
         if len(self._params) != len(params):
             raise ValueError("a parameter table declares a parameter twice")
         self.rules = tuple(r for r in rules if set(r.names) <= set(self._params))
+        # Each parameter's stage and whether it is worth tuning first, for listings; kept beside
+        # the specs so that a planner shares another's declarations (the same objects).
+        self._groups = {n: g for n, g in (groups or {}).items() if n in self._params}
         for spec in params:
             spec.convert(spec.default)  # a default outside its own range is a declaration bug
 
@@ -269,7 +273,13 @@ class ParamTable:
     # -- composition -----------------------------------------------------------------------------
     def __add__(self, other: ParamTable) -> ParamTable:
         """Both tables' parameters (and rules); a name in both is a declaration bug."""
-        return ParamTable(*self, *other, rules=(*self.rules, *other.rules))
+        return ParamTable(*self, *other, rules=(*self.rules, *other.rules),
+                          groups={**self._groups, **other._groups})  # fmt: skip
+
+    def group_of(self, name: str) -> tuple[str, bool]:
+        """``(stage, worth tuning first)`` of a parameter, as :meth:`grouped` set it (``("",
+        False)`` when it has none)."""
+        return self._groups.get(name, ("", False))
 
     def with_defaults(self, **defaults: Any) -> ParamTable:
         """The same parameters with other defaults (a planner that sets its own)."""
@@ -281,15 +291,25 @@ class ParamTable:
             self[name]  # raises ParameterError for an unknown name
         specs = [dataclasses.replace(p, **changes[p.name]) if p.name in changes else p
                  for p in self]  # fmt: skip
-        return ParamTable(*specs, rules=self.rules)
+        return ParamTable(*specs, rules=self.rules, groups=self._groups)
+
+    def grouped(self, group: str, key: Iterable[str] = ()) -> ParamTable:
+        """The same table with every parameter in ``group`` and those of ``key`` marked as worth
+        tuning first (for listings: ``rrtpso planners NAME``)."""
+        key = set(key)
+        for name in key:
+            self[name]  # raises ParameterError for an unknown name
+        return ParamTable(*self, rules=self.rules,
+                          groups={p.name: (group, p.name in key) for p in self})  # fmt: skip
 
     def subset(self, *names: str) -> ParamTable:
         """A table of some of the parameters (and the rules among them), in the order given."""
-        return ParamTable(*(self[n] for n in names), rules=self.rules)
+        return ParamTable(*(self[n] for n in names), rules=self.rules, groups=self._groups)
 
     def without(self, *names: str) -> ParamTable:
         """The table without some parameters (and the rules that involve them)."""
-        return ParamTable(*(p for p in self if p.name not in names), rules=self.rules)
+        return ParamTable(*(p for p in self if p.name not in names), rules=self.rules,
+                          groups=self._groups)  # fmt: skip
 
     # -- validation ------------------------------------------------------------------------------
     def validate(self, values: Mapping[str, Any] | None, owner: str = "") -> dict[str, Any]:

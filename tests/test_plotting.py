@@ -414,7 +414,11 @@ def test_every_gif_frame_has_a_legend_that_hides_nothing(simulated, tmp_path):
     finally:
         _close(fig)
     out = tmp_path / "run.gif"
-    animate_simulation(problem, sim, out, max_frames=12)
+    calls = []
+    animate_simulation(problem, sim, out, max_frames=12,
+                       progress=lambda done, total: calls.append((done, total)))  # fmt: skip
+    # The progress covers every frame and then the file (issue 36: no bar stuck at 90 %).
+    assert calls == [(k, 13) for k in range(1, 14)]
     with Image.open(out) as gif:
         assert gif.n_frames == 12
         assert gif.size[0] > gif.size[1] * 1.2  # the world and its legend beside it
@@ -490,3 +494,57 @@ def test_bench_figures_are_written(tmp_path):
     for what in ("ratio", "success"):
         save_figure(plot_bench(summary, what), tmp_path / f"{what}.png")
         assert (tmp_path / f"{what}.png").stat().st_size > 1000
+
+
+# ----------------------------------------------------------------------------------------------
+# Each stage credited with what it gave (issue 36, item 2)
+# ----------------------------------------------------------------------------------------------
+def _result_with(stages: dict, path=None):
+    import dataclasses
+
+    problem = problem_from_dict(SINGLE_CIRCLE)
+    base = solve(problem, "RRTstarPSO", time_limit=60.0, seed=1,
+                 params={"rrt_max_iterations": 200, "iterations": 10})  # fmt: skip
+    return problem, dataclasses.replace(base, stages={**base.stages, **stages})
+
+
+@pytest.mark.parametrize(
+    ("stages", "label", "absent"),
+    [
+        ({"rrt_path": [[20, 20], [100, 100]], "rrt_length": 113.1},
+         "RRT*'s best, short of the goal", "RRT* path ("),
+        ({"rrt_path": [], "rrt_length": None}, "no RRT* path", "RRT* path ("),
+    ],
+)  # fmt: skip
+def test_rrt_star_is_credited_only_with_a_path_that_reached_the_goal(stages, label, absent):
+    problem, result = _result_with(stages)
+    fig = plot_solution(problem, result)
+    try:
+        labels = legend_labels(fig.axes[0])
+        assert label in labels and not any(absent in t for t in labels)
+    finally:
+        _close(fig)
+
+
+def test_the_swarm_s_seed_from_the_corridor_is_drawn_and_its_gain_is_the_swarm_s_own():
+    problem, result = _result_with({"seed_source": "corridor", "seed_length": 700.0,
+                                    "seed_cost": 700.0,
+                                    "seed_path": [[20, 20], [300, 100], [450, 450]]})  # fmt: skip
+    fig = plot_solution(problem, result)
+    try:
+        labels = " | ".join(legend_labels(fig.axes[0]))
+        assert "corridor route (" in labels and "the swarm's seed" in labels
+        panel = fig.axes[1]
+        assert panel.get_title().startswith("PSO best cost per iteration\n700 -> ")
+        assert panel.yaxis.get_major_formatter().get_useOffset() is False  # no "+9.47e1"
+    finally:
+        _close(fig)
+
+
+def test_no_swarm_panel_without_a_swarm_to_show():
+    problem, result = _result_with({"pso_history": [647.5]})
+    fig = plot_solution(problem, result)
+    try:
+        assert len(fig.axes) == 1
+    finally:
+        _close(fig)

@@ -69,6 +69,12 @@ def set_quiet(quiet: bool) -> None:
     _quiet = bool(quiet)
 
 
+def with_unit(value: float, units: str, digits: int = 3) -> str:
+    """A length in a summary line with its unit: ``"34.807 m"`` (``"units"`` for a problem with
+    no ``units`` key: its lengths are in whatever unit its numbers are)."""
+    return f"{value:.{digits}f} {units or 'units'}"
+
+
 def note(message: str) -> None:
     """A line for the user on stderr (the summary of a command), unless ``-q``."""
     if not _quiet:
@@ -112,10 +118,10 @@ def choose_planner(args: argparse.Namespace) -> PlannerRequest:
         For an unknown planner or a bad flag, the message naming the file and where the value
         came from (``--planner``, ``planner.type``, ``--param NAME``, ...).
     """
-    from ..model import load_problem
     from ..planners.request import command_line, resolve
+    from .query import load_query
 
-    problem = load_problem(args.problem)
+    problem = load_query(args)
     try:
         return resolve(
             problem,

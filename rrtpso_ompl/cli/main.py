@@ -19,7 +19,7 @@ import logging
 import signal
 import sys
 from collections.abc import Iterator, Sequence
-from typing import NoReturn
+from typing import Any, NoReturn
 
 from .._version import __version__
 from ..errors import OutputError, RrtpsoError, shown
@@ -42,9 +42,25 @@ __all__ = ["Terminated", "main"]
 COMMANDS = ("solve", "simulate", "batch", "generate", "optimum", "bench", "planners")
 
 
+class _WholeWords(argparse.HelpFormatter):
+    """argparse's help, its lines broken between words only (argparse's own breaks a long
+    name such as ``omega_left`` or a path in two)."""
+
+    def _split_lines(self, text: str, width: int) -> list[str]:
+        import textwrap
+
+        return textwrap.wrap(" ".join(text.split()), width, break_long_words=False,
+                             break_on_hyphens=False)  # fmt: skip
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse's parser, its usage errors bounded: argparse quotes a bad value whole
-    (``--runs 1000...``), and a command-line argument may hold 128 KiB."""
+    (``--runs 1000...``), and a command-line argument may hold 128 KiB; its help breaks lines
+    between words only."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("formatter_class", _WholeWords)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> NoReturn:
         super().error(shown(message, MAX_USAGE_MESSAGE))

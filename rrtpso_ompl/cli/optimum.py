@@ -8,7 +8,8 @@ import math
 from typing import Any
 
 from ..errors import UsageError
-from .common import EXIT_OK, EXIT_UNSOLVED, Output, check_outputs, note
+from .common import EXIT_OK, EXIT_UNSOLVED, Output, check_outputs, note, with_unit
+from .query import add_query_flags, load_query
 from .ros_flags import add_ros_flags, ros_frame, ros_outputs, ros_poses, write_path_out
 
 __all__ = ["HELP", "add_parser", "run"]
@@ -30,7 +31,7 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         "Moving obstacles are ignored. Exit status 0 when a path exists, 1 when none does (or "
         "the grid has none).",
     )
-    o.add_argument("problem", help="problem file (YAML)")
+    add_query_flags(o)
     o.add_argument("--json", metavar="OUT", help='write {"length": ..., "path": [...], ...} in '
                    "the problem's units (its units key)")  # fmt: skip
     o.add_argument("--plot", metavar="OUT.png", help="draw the world and the path")
@@ -57,14 +58,12 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..model import load_problem
-
     if args.resolution is not None:
         if not args.cost:
             raise UsageError("--resolution: only with --cost")
         if not (math.isfinite(args.resolution) and args.resolution > 0):
             raise UsageError(f"--resolution: must be a positive number, got {args.resolution:g}")
-    problem = load_problem(args.problem)
+    problem = load_query(args)
     outputs = [Output("--json", args.json), Output("--plot", args.plot, "image"),
                *ros_outputs(args)]  # fmt: skip
     check_outputs(outputs, inputs=problem.inputs)
@@ -102,7 +101,8 @@ def _shortest(args: argparse.Namespace, problem: Any, frame: Any) -> int:
         what = "no inflation: J is the length; " if args.cost else ""
         bound = (" (the disc's shortest path, turning radius ignored: a lower bound for this "
                  "car-like robot)") if problem.car else ""  # fmt: skip
-        note(f"{problem.name}: {what}optimum length={result.length:.6f}{bound}")
+        note(f"{problem.name}: {what}optimum length={with_unit(result.length, problem.units, 6)}"
+             f"{bound}")  # fmt: skip
         return EXIT_OK
     note(f"{problem.name}: no path exists")
     return EXIT_UNSOLVED
@@ -141,8 +141,8 @@ def _cost_reference(args: argparse.Namespace, problem: Any, frame: Any) -> int:
         f"{result.nodes:,} nodes, {result.edges:,} edges, {result.time:.1f}s"
     )
     if result.found:
-        note(f"{problem.name}: grid reference J={result.cost:.6f} "
-             f"length={result.length:.6f} ({grid})")  # fmt: skip
+        note(f"{problem.name}: grid reference J={with_unit(result.cost, problem.units, 6)} "
+             f"length={with_unit(result.length, problem.units, 6)} ({grid})")  # fmt: skip
         return EXIT_OK
     note(f"{problem.name}: no path on the grid ({grid}); a finer --resolution may find one")
     return EXIT_UNSOLVED

@@ -39,16 +39,35 @@ def run(args: argparse.Namespace) -> int:
     for e in entries:
         aliases = f"  (also: {', '.join(e.aliases)})" if e.aliases else ""
         lines.append(f"{e.name}{aliases}\n    {e.description}  [{e.source}]")
-        for p in e.params:
-            unit = f" {p.unit}" if p.unit else ""
-            lines.append(
-                f"    {p.name:<28} {p.type.__name__:<5} default {p.default!s:<8}{unit} "
-                f"in {p.range_text()}"
-            )
-            if args.name:
-                lines.append(f"        {p.doc}")
+        lines += _param_lines(e.params, bool(args.name))
     write_stdout("".join(f"{line}\n" for line in lines))  # one message if it cannot be written
     return EXIT_OK
+
+
+def _param_lines(table: Any, docs: bool) -> list[str]:
+    """A planner's parameters, by stage when they have one, the columns as wide as the longest
+    name and default; those worth tuning first marked with ``*`` (and said so)."""
+    params = list(table)
+    if not params:
+        return []
+    name_w = max(len(p.name) for p in params) + 2
+    default_w = max(len(str(p.default)) for p in params)
+    out, group, any_key = [], None, False
+    for p in params:
+        stage, key = table.group_of(p.name)
+        any_key = any_key or key
+        if stage and stage != group:
+            group = stage
+            out.append(f"  {group}:")
+        unit = f" {p.unit}" if p.unit else ""
+        mark = "*" if key else " "
+        out.append(f"  {mark} {p.name:<{name_w}}{p.type.__name__:<6}default "
+                   f"{p.default!s:<{default_w}}{unit} in {p.range_text()}")  # fmt: skip
+        if docs:
+            out.append(f"        {p.doc}")
+    if any_key:
+        out.append("  (* worth tuning first)")
+    return out
 
 
 def _entry_dict(e: Any) -> dict[str, Any]:
@@ -70,6 +89,8 @@ def _entry_dict(e: Any) -> dict[str, Any]:
                 "unit": p.unit,
                 "range": p.range_text(),
                 "doc": p.doc,
+                "group": e.params.group_of(p.name)[0],
+                "key": e.params.group_of(p.name)[1],
             }
             for p in e.params
         ],

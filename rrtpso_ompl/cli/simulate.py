@@ -22,7 +22,9 @@ from .common import (
     note,
     progress_bar,
     report_errors,
+    with_unit,
 )
+from .query import add_query_flags
 from .ros_flags import add_ros_flags, ros_frame, ros_outputs, ros_poses, write_path_out
 
 __all__ = ["HELP", "OPTION_FLAGS", "add_parser", "run"]
@@ -67,7 +69,7 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         "senses them within robot.sensor_range, predicts collisions and replans contour detours "
         "(docs/dynamic.md). Exit status 0 when the goal is reached without a collision, else 1.",
     )
-    m.add_argument("problem", help="problem file with moving_obstacles")
+    add_query_flags(m)
     m.add_argument(
         "--json", metavar="OUT", help="write the simulation as JSON, in the problem's units"
     )
@@ -149,7 +151,8 @@ def run(args: argparse.Namespace) -> int:
     verdict = "reached the goal" if sim.reached_goal else f"did not reach the goal ({sim.status})"
     note(
         f"{problem.name}: {verdict}, {sim.collisions} collisions, {len(sim.replans)} replans, "
-        f"time {sim.total_time:.1f}s, length {sim.path_length:.1f}",
+        f"driving time {sim.total_time:.1f} s (simulated), "
+        f"driven {with_unit(sim.path_length, problem.units, 1)}",
     )
     return EXIT_OK if sim.success else EXIT_UNSOLVED
 
@@ -201,7 +204,13 @@ def _write_outputs(args: argparse.Namespace, problem: Any, sim: Any, frame: Any)
     if args.gif and sim.motion is not None:
         from ..plotting import animate_simulation
 
-        animate_simulation(problem, sim, args.gif)
+        with progress_bar("drawing the GIF", unit="frame") as bar:
+
+            def progress(done: int, total: int) -> None:
+                bar.total, bar.n = total, done
+                bar.refresh()
+
+            animate_simulation(problem, sim, args.gif, progress=progress)
     write_path_out(args, frame, poses)  # nothing when no static plan was found
     if args.bag:
         from ..ros.bag import write_simulation_bag

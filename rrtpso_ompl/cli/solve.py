@@ -15,7 +15,9 @@ from .common import (
     choose_planner,
     note,
     report_errors,
+    with_unit,
 )
+from .query import add_query_flags
 from .ros_flags import add_ros_flags, ros_frame, ros_outputs, ros_poses, write_path_out
 
 __all__ = ["HELP", "add_parser", "run"]
@@ -31,7 +33,7 @@ def add_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
         help=HELP,
         description="Solve one problem file and report the path.",
     )
-    p.add_argument("problem", help="problem file (YAML, see docs/problem-format.md)")
+    add_query_flags(p)
     add_planner_flags(
         p,
         planner="planner name (default: the file's planner.type, else RRTstarPSO); "
@@ -79,8 +81,9 @@ def _add_drive_flags(p: argparse.ArgumentParser) -> None:
         "--trajectory",
         metavar="OUT.csv",
         help="write the wheel commands every robot.sample_time, in the problem's units (lengths) "
-        "and seconds, radians: t,x,y,theta,v,omega,v_right,v_left,omega_right,omega_left; with "
-        "goal_yaw it ends with the turn in place to that heading",
+        "and seconds, radians: the columns t, x, y, theta, v, omega, v_right, v_left, "
+        "omega_right, omega_left (the header has no spaces); with goal_yaw it ends with the "
+        "turn in place to that heading (a car-like robot: no turn in place, v < 0 backing)",
     )
     p.add_argument(
         "--plot-velocities",
@@ -148,9 +151,10 @@ def run(args: argparse.Namespace) -> int:
     if wants_motion and result.solved:
         motion = _drive(problem, result, args.profile, args.slow_near_obstacles)
     _write_outputs(args, problem, result, motion, frame)
-    length = f"{result.length:.3f}" if result.length is not None else "-"
+    length = with_unit(result.length, problem.units) if result.length is not None else "-"
     note(
-        f"{problem.name}: {result.planner} {result.status} length={length} time={result.time:.3f}s",
+        f"{problem.name}: {result.planner} {result.status} length={length} "
+        f"planning time={result.time:.3f} s",
     )
     return EXIT_OK if result.solved else EXIT_UNSOLVED
 

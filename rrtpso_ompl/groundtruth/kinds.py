@@ -189,6 +189,9 @@ class GeneratorOptions:
         return {
             "name": name,
             "description": "",  # filled in once the problem is certified
+            # Metres, so that axes, summaries and the ROS outputs name a unit (a generated world
+            # models a floor a robot drives, as the map kinds do).
+            "units": "m",
             "bounds": [[0.0, 0.0], [float(self.size), float(self.size)]],
             "start": [float(v) for v in start],
             "goal": [float(v) for v in goal],

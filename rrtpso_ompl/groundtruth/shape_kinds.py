@@ -51,12 +51,6 @@ class _ShapeOptions(GeneratorOptions):
         """The narrowest free width the robot's centre gets, for the certificate's grid."""
         raise NotImplementedError
 
-    def document(self, name: str, obstacles: list[dict[str, Any]]) -> dict[str, Any]:
-        data = super().document(name, obstacles)
-        # Metres, as the map kinds: these families model rooms and corridors a robot drives.
-        return {"name": data.pop("name"), "description": data.pop("description"), "units": "m",
-                **data}  # fmt: skip
-
     def _resolve_shapes(self, **values: Any):
         robot = 0.005 * self.size if self.robot_radius is None else self.robot_radius
         free = self.passage(robot)

@@ -126,7 +126,8 @@ class _MovingScene:
                 self.title, *self.obstacles, *self.detours]  # fmt: skip
 
 
-def frame_images(fig: Figure, draw: Callable[[int], list[Any]], frames: np.ndarray) -> list[Any]:
+def frame_images(fig: Figure, draw: Callable[[int], list[Any]], frames: np.ndarray,
+                 progress: Callable[[int, int], None] | None = None) -> list[Any]:  # fmt: skip
     """The frames of a one-panel figure as PIL images, each as ``fig.canvas.draw()`` would render
     it after ``draw(i)``, pixel for pixel, at a fraction of the cost.
 
@@ -136,6 +137,7 @@ def frame_images(fig: Figure, draw: Callable[[int], list[Any]], frames: np.ndarr
     above it within the panel: the start and goal) is drawn over it in the order ``Axes.draw``
     uses (by ``zorder``, ties in the order added). Artists clipped to the panel stay inside it; a
     frame whose unclipped moving artist (the title) would reach what was kept is drawn whole.
+    ``progress(done, total)`` is called after each frame.
     """
     from operator import attrgetter
 
@@ -177,11 +179,19 @@ def frame_images(fig: Figure, draw: Callable[[int], list[Any]], frames: np.ndarr
                 if a.get_visible():
                     ax.draw_artist(a)
         images.append(Image.fromarray(np.asarray(canvas.buffer_rgba())[..., :3]))
+        if progress is not None:
+            progress(len(images), len(frames))
     return images
 
 
 def animate_simulation(
-    problem: Problem, sim: Any, path: str | Path, *, max_frames: int = 150, fps: int = 10
+    problem: Problem,
+    sim: Any,
+    path: str | Path,
+    *,
+    max_frames: int = 150,
+    fps: int = 10,
+    progress: Callable[[int, int], None] | None = None,
 ) -> None:
     """Write a GIF of the simulation (:func:`simulation_frames`): static and moving obstacles,
     the robot and its sensor range, the plan it is driving, the predicted cross points and the
@@ -190,13 +200,22 @@ def animate_simulation(
     Each frame is drawn once and grabbed from the canvas (matplotlib's animation writers draw a
     frame three times), and only from the lowest layer that moves up (:func:`frame_images`):
     what lies below it (a map, the static obstacles) is drawn once for all frames.
+    ``progress(done, total)`` is called after each frame is drawn and once the file is written
+    (``total + 1`` steps: encoding the GIF takes about as long as a tenth of the frames).
     """
     fig, draw, frames = simulation_frames(problem, sim, max_frames)
     try:
         fig.set_dpi(80)
-        images = frame_images(fig, draw, frames)
+        steps = len(frames) + 1
+
+        def drawn(done: int, _total: int) -> None:
+            if progress is not None:
+                progress(done, steps)
+
+        images = frame_images(fig, draw, frames, drawn)
         with atomic_path(path, suffix=".gif") as tmp:
             images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
                            duration=int(1000 / fps), loop=0)  # fmt: skip
+        drawn(steps, steps)
     finally:
         plt.close(fig)

@@ -41,13 +41,20 @@ def plot_cost_reference(problem: Problem, result: Any) -> Figure:
 
 
 def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> Figure:
-    """The paper's Fig. 15: the world with the raw RRT* path and the final path (a), and the PSO's
-    best cost per iteration (b) when the planner ran a swarm. ``curve`` (a
-    :class:`~rrtpso_ompl.kinematics.ReferenceCurve`) adds the smooth reference the robot drives."""
+    """The paper's Fig. 15: the world with what each stage gave (a), and the swarm's best cost
+    per iteration (b) when the swarm ran more than one iteration. ``curve`` (a
+    :class:`~rrtpso_ompl.kinematics.ReferenceCurve`) adds the smooth reference the robot drives.
+
+    Each line is credited to the stage that made it: RRT*'s path only when it reached the goal
+    ("RRT*'s best, short of the goal" else, "no RRT* path" without one), the swarm's seed when
+    it came from another stage (the corridor route, BIT*, the cost route), and the final path;
+    the swarm's panel says what the swarm itself gained (from its seed to its result).
+    """
     stages: dict[str, Any] = result.stages or {}
-    history = stages.get("pso_history") or []
+    history = np.asarray(stages.get("pso_history") or [], dtype=float)
+    panel = len(history) >= 2
     width = world_width(problem, 6.0)
-    widths = [width, 5.5] if history else [width]
+    widths = [width, 5.5] if panel else [width]
     fig, axes = plt.subplots(1, len(widths), figsize=(sum(widths), 6), squeeze=False,
                              gridspec_kw={"width_ratios": widths})  # fmt: skip
     ax = axes[0, 0]
@@ -55,11 +62,7 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
     key += draw_costmap(ax, problem)
     # A car's paths are curves drawn by their chords: marked at their waypoint poses only.
     car = stages.get("car")
-    raw = np.asarray(stages.get("rrt_path") or [], dtype=float).reshape(-1, 2)
-    if len(raw):
-        label = f"RRT* path ({stages.get('rrt_length', float('nan')):.1f})"
-        key += ax.plot(raw[:, 0], raw[:, 1], "--" if car else "o--", color=RRT_COLOUR, ms=3,
-                       lw=1.2, zorder=3, label=label)  # fmt: skip
+    key += _draw_stage_paths(ax, problem, stages, bool(car))
     path = np.asarray(result.path, dtype=float).reshape(-1, 2)
     if len(path):
         what = f"{car['space']} curves" if car else "path"
@@ -69,42 +72,82 @@ def plot_solution(problem: Problem, result: SolveResult, curve: Any = None) -> F
     if car and len(path):
         key += _draw_poses(ax, np.asarray(stages.get("poses") or [], dtype=float), problem)
     if curve is not None:
-        key += ax.plot(
-            curve.x,
-            curve.y,
-            "-",
-            color="tab:blue",
-            lw=1.0,
-            zorder=5,
-            label=f"reference curve ({curve.kind})",
-        )
+        key += ax.plot(curve.x, curve.y, "-", color="tab:blue", lw=1.0, zorder=5,
+                       label=f"reference curve ({curve.kind})")  # fmt: skip
     title = f"{problem.name}: {result.planner}, {result.status}"
     if result.length is not None:
         title += f", length {result.length:.2f}"
     ax.set_title(title)
     world_legend(ax, key)
-    if history:
+    if panel:
         _draw_pso_history(axes[0, 1], history, problem.units, problem.objective.active,
-                          bool(car))  # fmt: skip
+                          bool(car), stages)  # fmt: skip
     fit_layout(fig)
     return fig
 
 
-def _draw_pso_history(bx: Axes, history: Any, units: str, inflated: bool = False,
-                      car: bool = False) -> None:  # fmt: skip
+#: The stages a swarm's seed may come from other than RRT*, as the legend names them.
+_SEED_NAMES = {"corridor": "corridor route", "costroute": "cost route", "BITstar": "BIT* path"}
+
+
+def _draw_stage_paths(ax: Axes, problem: Problem, stages: dict[str, Any], car: bool) -> list:
+    """RRT*'s path (or why there is none to draw) and the swarm's seed when another stage made
+    it; their legend handles."""
+    key: list = []
+    raw = np.asarray(stages.get("rrt_path") or [], dtype=float).reshape(-1, 2)
+    if "rrt_path" in stages or "rrt_length" in stages:
+        goal = np.asarray(problem.goal, dtype=float)
+        scale = max(1.0, float(np.abs(raw).max())) if len(raw) else 1.0
+        reached = len(raw) > 1 and bool(
+            np.hypot(*(raw[-1] - goal)) <= problem.goal_tolerance + 1e-9 * scale
+        )
+        if reached:
+            label = f"RRT* path ({stages.get('rrt_length') or float('nan'):.1f})"
+        elif len(raw):
+            label = "RRT*'s best, short of the goal"
+        else:
+            label = "no RRT* path"
+        xs, ys = (raw[:, 0], raw[:, 1]) if len(raw) else ([], [])
+        key += ax.plot(xs, ys, "--" if car else "o--", color=RRT_COLOUR, ms=3, lw=1.2,
+                       zorder=3, label=label)  # fmt: skip
+    source = str(stages.get("seed_source") or "").split("+")[0]
+    seed = np.asarray(stages.get("seed_path") or [], dtype=float).reshape(-1, 2)
+    if source in _SEED_NAMES and len(seed) > 1:
+        length = float(np.hypot(*np.diff(seed, axis=0).T).sum())
+        key += ax.plot(seed[:, 0], seed[:, 1], ":", color="tab:green", lw=1.6, zorder=3,
+                       label=f"{_SEED_NAMES[source]} ({length:.1f}), the swarm's seed")  # fmt: skip
+    return key
+
+
+def _draw_pso_history(bx: Axes, history: np.ndarray, units: str, inflated: bool = False,
+                      car: bool = False, stages: dict[str, Any] | None = None) -> None:  # fmt: skip
     """Panel (b) of :func:`plot_solution`: the swarm's best cost per iteration, over all its
-    rounds (with an inflation cost, the objective J's; for a car, its curves' length)."""
-    h = np.asarray(history, dtype=float)
-    bx.plot(np.arange(len(h)), h, color=PATH_COLOUR)
+    rounds (with an inflation cost, the objective J's; for a car, its curves' length), titled
+    with what the swarm itself gained, from its seed's cost to its result's."""
+    bx.plot(np.arange(len(history)), history, color=PATH_COLOUR)
     bx.xaxis.set_major_locator(ticker.MaxNLocator(integer=True))
+    # Whole values on the axis: no "+9.47e1" offset that hides what the ticks mean.
+    bx.yaxis.set_major_formatter(ticker.ScalarFormatter(useOffset=False))
     bx.set_xlabel("PSO iteration (all rounds)")
     # The swarm's best is always collision-free, so its cost is the path length plus the
     # turning penalty (smoothness_weight, 0 by default): a length.
     what = "J = length + w x inflation cost" if inflated else "length + turning penalty"
     if car:  # outside the plane the swarm lowers the curves' length alone
         what = "length of the curves"
-    bx.set_ylabel(f"best cost: {what} [{units or 'length units'}]")
-    bx.set_title("PSO best cost per iteration")
+    unit = units or "length units"
+    bx.set_ylabel(f"best cost: {what} [{unit}]")
+    stages = stages or {}
+    seed = stages.get("seed_cost", stages.get("seed_length"))
+    before = float(history[0]) if seed is None else float(seed)
+    after = stages.get("pso_cost", stages.get("pso_length"))
+    after = float(history[-1]) if after is None else float(after)
+    gain = before - after
+    if gain > 1e-9 * max(abs(before), 1.0):
+        told = (f"{before:.6g} -> {after:.6g} {unit}, -{gain:.2g} {unit} "
+                f"(-{100.0 * gain / before:.2g} %)")  # fmt: skip
+    else:
+        told = f"no gain on its seed ({before:.4g} {unit})"
+    bx.set_title(f"PSO best cost per iteration\n{told}", fontsize=10)
     bx.grid(alpha=0.3)
 
 

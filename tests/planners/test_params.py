@@ -170,3 +170,25 @@ def test_declared_fields_may_be_optional_or_fixed_tuples():
         @declared
         class Either:
             x: int | str = param(3, "Either.")
+
+
+def test_rrtstar_pso_s_parameters_are_listed_by_stage_with_the_few_to_tune_first():
+    """``rrtpso planners RRTstarPSO`` (issue 36): a header per stage, the few worth tuning first
+    marked, every column aligned however long a name is."""
+    from rrtpso_ompl.cli.planners import _param_lines
+
+    table = default_registry().get("RRTstarPSO").params
+    keys = {n for n in table.names() if table.group_of(n)[1]}
+    assert keys == {"budget", "corridor_fraction", "rrt_time_fraction", "rrt_max_iterations",
+                    "swarm_size", "iterations", "smoothness_weight"}  # fmt: skip
+    assert all(table.group_of(n)[0] for n in table.names())  # every one has a stage
+    lines = _param_lines(table, docs=False)
+    headers = [line.strip() for line in lines if line.endswith(":")]
+    assert headers == ["the run:", "the corridor stage:", "RRT* and OMPL's simplifier:",
+                       "the swarm (eqs. 4-5):",
+                       "the swarm over the path: rounds, polish, costs:"]  # fmt: skip
+    rows = [line for line in lines if " default " in line]
+    assert len(rows) == len(table) and len({row.index(" default ") for row in rows}) == 1
+    assert sum(row.startswith("  * ") for row in rows) == len(keys)
+    # The grouping is the listing's: the specs stay the declarations they were.
+    assert table["range"] is default_registry().get("RRTstar").params["range"]

@@ -125,3 +125,17 @@ def test_terminate_stops_the_swarm_but_keeps_the_guarantees():
     res = optimize_path(ZIGZAG, CIRCLE_WORLD, rng=np.random.default_rng(0), terminate=lambda: True)
     assert res.n_iterations == 0
     assert CIRCLE_WORLD.path_valid(res.path) and res.length <= res.input_length
+
+
+@pytest.mark.parametrize("window", [0, 2])
+def test_the_best_cost_curve_is_the_path_s_own_never_below_what_was_kept(window):
+    """The curve the picture draws (issue 36): every value a cost of a path the swarm had, so
+    never below the returned path's, and ending at it; with windows too (whose swarms see their
+    window's cost only)."""
+    for seed in range(4):
+        res = optimize_path(ZIGZAG, CIRCLE_WORLD, PathOptimizerOptions(window=window,
+                            iterations=30), rng=np.random.default_rng(seed))  # fmt: skip
+        assert len(res.history) and res.history.min() >= res.cost - 1e-9
+        assert res.history.max() <= res.input_cost + 1e-9
+        if res.improved:
+            assert res.history[-1] == pytest.approx(res.cost, abs=1e-9)

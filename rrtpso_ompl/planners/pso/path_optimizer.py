@@ -179,7 +179,10 @@ class PathOptimizationResult:
     improved : bool
         Whether ``path`` differs from (and is shorter than) the input.
     history : ndarray
-        Best cost after each PSO iteration, over all rounds (the paper's best-cost curve).
+        The path's best cost after each PSO iteration, over all rounds (the paper's best-cost
+        curve): a round whose best was not kept (refused by the exact check, or costlier) is
+        flat at the cost it started from, and a round of windows (whose swarms see their
+        window's cost only) steps from the cost before it to the cost after it.
     n_iterations, n_evaluations : int
         PSO iterations and particle evaluations over all rounds.
     rounds : int
@@ -650,6 +653,11 @@ class _Rounds:
             self.current = self._no_costlier(
                 shortcut(self.current, world.segments_free, self.terminate), self.current
             )
+            if self.history and len(self.history[-1]):
+                # The last point of the curve is the path this pass leaves (it costs no more).
+                last = np.array(self.history[-1], dtype=float)
+                last[-1] = min(last[-1], _cost_of(self.cost_model, self.current))
+                self.history[-1] = last
 
     def _no_costlier(self, candidate: np.ndarray, fallback: np.ndarray) -> np.ndarray:
         """``candidate`` unless it costs more than ``fallback`` (a shortcut never lengthens a
@@ -663,13 +671,13 @@ class _Rounds:
         """One swarm round from ``seed``; keeps its path when valid and no worse. Returns the
         cost after the round."""
         opts = self.options
-        if opts.window and len(seed) - 2 > opts.window:
+        windowed = bool(opts.window and len(seed) - 2 > opts.window)
+        if windowed:
             candidate, res = _window_round(seed, self.cost_model, opts, self.rng, self.terminate,
                                            r * (opts.window // 2 + 1), self.deadline)  # fmt: skip
         else:
             candidate, res = _pso_round(seed, self.cost_model, opts, self.rng, self.terminate,
                                         self.deadline)  # fmt: skip
-        self.history.append(res.history)
         self.iterations += res.n_iterations
         self.evaluations += res.n_evaluations
         self.rounds += 1
@@ -677,8 +685,17 @@ class _Rounds:
         if self.world.path_valid(candidate):
             cost = _cost_of(self.cost_model, candidate)
             if cost <= before:
+                # The path's cost as the round went: a window's swarm reports its window's own
+                # cost, so that round shows the path's cost before it and after it only.
+                steps = np.full(len(res.history), before) if windowed else res.history
+                self.history.append(np.clip(steps, cost, before))
+                if len(steps):
+                    self.history[-1][-1] = cost
                 self.current = candidate
                 return cost
+        # The round's best was not kept (the exact check refused it, or it cost more): its
+        # history would show a gain the path never had, so the round counts as flat.
+        self.history.append(np.full(len(res.history), before))
         self.current = seed
         return before
 
@@ -687,8 +704,10 @@ class _Rounds:
         p = self.current
         input_cost = self.cost(self.original)
         ok = p is not self.original and self.world.path_valid(p)
+        history = np.concatenate(self.history) if self.history else np.empty(0)
         if not (ok and self.cost(p) < input_cost):
             p = self.original
+            history = np.full(len(history), input_cost)  # nothing the swarm found was kept
         return PathOptimizationResult(
             path=p,
             length=path_length(p),
@@ -696,7 +715,7 @@ class _Rounds:
             improved=p is not self.original,
             cost=self.cost(p),
             input_cost=input_cost,
-            history=np.concatenate(self.history) if self.history else np.empty(0),
+            history=history,
             n_iterations=self.iterations,
             n_evaluations=self.evaluations,
             rounds=self.rounds,

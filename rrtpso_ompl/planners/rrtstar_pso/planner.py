@@ -70,11 +70,8 @@ __all__ = [
     "clutter_range",
 ]
 
-#: RRTstarPSO's parameters: those of its inner RRT* (OMPL's own declarations, passed on through
-#: their setters), its own, then the swarm's and the path optimiser's.
-RRTSTAR_PSO_PARAMS = (
-    ParamTable(*(RRTSTAR_PARAMS[n] for n in _INNER))
-    + ParamTable(
+#: RRTstarPSO's own parameters (besides its inner RRT*'s, the swarm's and the path optimiser's).
+_OWN = ParamTable(
         BUDGET,
         ParamSpec("corridor_cells", int, 4_194_304,
                   "Most cells of the corridor stage's fine lattice (0 = no corridor stage); "
@@ -107,9 +104,23 @@ RRTSTAR_PSO_PARAMS = (
                   "through the exact motion validator, about a millisecond) on RRT*'s path before "
                   "the swarm."),
         SEED,
-    )
-    + SWARM_PARAMS
-    + OPTIMIZER_PARAMS
+)  # fmt: skip
+
+#: RRTstarPSO's parameters by stage, as listings show them (``rrtpso planners RRTstarPSO``): its
+#: run, the corridor stage, its inner RRT* (OMPL's own declarations, passed on through their
+#: setters) and OMPL's simplifier, the swarm, and the swarm's rounds over the path; the few worth
+#: tuning first marked.
+RRTSTAR_PSO_PARAMS = (
+    _OWN.subset("budget", "seed").grouped("the run", key=("budget",))
+    + _OWN.subset("corridor_cells", "corridor_fraction", "corridor_alternatives").grouped(
+        "the corridor stage", key=("corridor_fraction",))
+    + (ParamTable(*(RRTSTAR_PARAMS[n] for n in _INNER))
+       + _OWN.subset("rrt_time_fraction", "stall_fraction", "connect_after",
+                     "rrt_max_iterations", "simplify")).grouped(
+        "RRT* and OMPL's simplifier", key=("rrt_time_fraction", "rrt_max_iterations"))
+    + SWARM_PARAMS.grouped("the swarm (eqs. 4-5)", key=("swarm_size", "iterations"))
+    + OPTIMIZER_PARAMS.grouped("the swarm over the path: rounds, polish, costs",
+                               key=("smoothness_weight",))
 )  # fmt: skip
 
 
