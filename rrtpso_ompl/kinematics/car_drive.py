@@ -120,4 +120,5 @@ def _joined(parts: list[Trajectory]) -> Trajectory:
         cols["t"].append(part.t[keep] + offset)
         offset += float(part.t[-1])
     joined = {n: np.concatenate(c) for n, c in cols.items()}
+    joined["theta"] = np.unwrap(joined["theta"])  # each stretch unwrapped its own headings
     return dataclasses.replace(parts[0], **joined, goal_turn_times=None)

@@ -10,23 +10,25 @@ straight lines, checked by :class:`CurveMotionValidator` soundly against the exa
   ``step = sqrt(8 * sagitta * rho)``; a piece whose curvature is at most ``1 / rho`` lies within
   ``step^2 / (8 rho) = sagitta`` of its chord (the chord's sagitta bound, which holds for any
   curve of bounded curvature, not only for one arc);
-* so the curve's disc of radius ``r`` is free when each chord's disc of radius ``r + sagitta`` is
-  free, which the world checks exactly (circles as circles, polygons' edges, the map's cells);
 * a Reeds-Shepp cusp (the car stops and backs) inside a piece is found by its chord being
   shorter than any chord of that arc length and curvature could be; that piece is halved
   around the cusp until its chord is within ``sagitta`` of the curve too (a point of a piece of
   arc length ``s`` is within ``s / 2`` of its chord's nearer end).
 
-A coarse pass comes first (poses every ``16 step`` of arc, their exact clearance and their
-distance inside the bounds): a point inside an obstacle's reach refuses the curve at once, and a
-piece whose ends both clear the radius by half its arc length is free as it is (each of its
-points is that close to an end); the other pieces are halved, and checked so, down to two
-steps, and only those still in doubt are cut into chords. A curve accepted is free exactly (never a
-collision), and its points between its ends keep the
-same margin inside the bounds; a curve within ``sagitta`` of contact may be refused. ``sagitta``
-is :data:`SAGITTA` of the turning radius. The chords themselves, the polyline the solve reports
-as ``path``, are free with the robot's radius as the file format defines it (they were checked
-with a larger one).
+A curve passes when each of its points keeps the robot's radius ``r`` plus a margin ``m`` (the
+sagitta, and a cusp's ``step^3 / (24 rho^2)``, below 1e-7 rho) from every obstacle and ``m``
+inside the bounds. Then any chords of it no longer than ``step`` lie within ``m`` of it and keep
+``r``: the polyline a solve reports as ``path`` is valid as the file format defines a path, and
+the solve's final check is the format's own (:meth:`CurveMotionValidator.polyline_valid`).
+
+The check: a coarse pass first (poses every ``16 step`` of arc, their exact clearance and their
+distance inside the bounds): a point that hits refuses the curve at once, and a piece whose ends
+both have half its arc length of room beyond ``r + m`` is free as it is (each of its points is
+that close to an end); the other pieces are halved, and tested so, down to two steps; only those
+still in doubt are cut into chords of at most ``step``, each checked exactly with the radius
+``r + 2 m`` (circles as circles, polygons' edges, the map's cells), so that the curve within
+``m`` of it keeps ``r + m``. A curve accepted is never a collision; one within ``2 m`` of contact
+may be refused. ``sagitta`` is :data:`SAGITTA` of the turning radius.
 """
 
 from __future__ import annotations
@@ -213,8 +215,11 @@ class CarValidityChecker(ob.StateValidityChecker):
 
 
 class CurveMotionValidator(ob.MotionValidator):
-    """The space's curve from one pose to another, checked soundly (the module docstring): its
-    chords, with the robot's radius plus the sagitta, against the exact world.
+    """The space's curve from one pose to another, checked soundly (the module docstring): a
+    curve passes when every point of it keeps the robot's radius plus :attr:`margin` from every
+    obstacle and :attr:`margin` inside the bounds. Then chords of it no longer than ``step``
+    (which lie within ``margin`` of it), the polyline a solve reports, keep the robot's radius:
+    valid as the file format defines a path.
 
     ``exact = True`` tells :class:`~rrtpso_ompl.planners.pso.space_path.MotionChecker` that no
     finer samples are needed: nothing lies between this check's chords.
@@ -226,11 +231,12 @@ class CurveMotionValidator(ob.MotionValidator):
         super().__init__(si)
         self.car = car
         self.world = world
-        #: The world for the chords: the robot's radius plus the sagitta (and what a cusp within
-        #: a step's ``step^3 / (48 rho^2)`` of a chord's end, unseen by the cusp test, adds;
-        #: doubled).
+        #: How far a curve may lie from its chords: the sagitta, and what a cusp within a step's
+        #: ``step^3 / (48 rho^2)`` of a chord's end (unseen by the cusp test) adds, doubled.
         self.margin = car.sagitta + car.step**3 / (24.0 * car.rho**2)
-        self.chord_world = world.with_robot_radius(world.robot_radius + self.margin)
+        #: The world for the check's chords: a chord that keeps the radius plus twice the margin
+        #: leaves its curve the radius plus the margin.
+        self.chord_world = world.with_robot_radius(world.robot_radius + 2.0 * self.margin)
         self._s = car.space.allocState()
 
     def checkMotion(self, s1, s2, *last_valid) -> bool:
@@ -240,7 +246,7 @@ class CurveMotionValidator(ob.MotionValidator):
         length = car.space.distance(s1, s2)
         ts = np.linspace(0.0, 1.0, max(1, math.ceil(length / car.coarse_step)) + 1)
         room = self._room(car.at(s1, s2, ts, s))
-        if (room < 0.0).any():  # a point of the curve itself is in an obstacle's reach or out
+        if (room < -self.margin).any():  # a point of the curve itself hits, or is out
             return False
         piece = length / (len(ts) - 1)  # arc length of each piece
         lo = ts[:-1]
@@ -252,7 +258,7 @@ class CurveMotionValidator(ob.MotionValidator):
             piece *= 0.5
             dt = piece / length
             mid = self._room(car.at(s1, s2, lo + dt, s))
-            if (mid < 0.0).any():
+            if (mid < -self.margin).any():
                 return False
             lo = np.concatenate([lo, lo + dt])
             left, right = np.minimum(room_lo, mid), np.minimum(mid, room_hi)
@@ -260,15 +266,16 @@ class CurveMotionValidator(ob.MotionValidator):
             room_hi = np.concatenate([mid, room_hi])[keep]
             room_lo = np.concatenate([room_lo, mid])[keep]
             lo = lo[keep]
-        for t0 in lo.tolist():  # the rest: their chords, with the sagitta's margin
+        for t0 in lo.tolist():  # the rest: their chords, with twice the margin
             xy = car.samples(s1, s2, s, t0, min(1.0, t0 + piece / length))[:, :2]
-            if not (self._inside(xy) and self.chord_world.segments_free(xy[:-1], xy[1:]).all()):
+            if not (self._inside(xy, 2.0 * self.margin)
+                    and self.chord_world.segments_free(xy[:-1], xy[1:]).all()):  # fmt: skip
                 return False
         return True
 
     def _room(self, poses: np.ndarray) -> np.ndarray:
-        """How far each pose's position may move and stay valid: its clearance less the robot's
-        radius, and its distance inside the bounds (negative: not valid there)."""
+        """How far each pose's position may move and keep the robot's radius plus the margin
+        from obstacles and the margin inside the bounds (below ``-margin``: not valid there)."""
         xy = poses[:, :2]
         (xmin, ymin), (xmax, ymax) = self.world.bounds
         edge = np.minimum.reduce([xy[:, 0] - xmin, xmax - xy[:, 0], xy[:, 1] - ymin,
@@ -276,19 +283,18 @@ class CurveMotionValidator(ob.MotionValidator):
         r = self.world.robot_radius
         clear = self.world.point_clearance(xy, cap=r + self.car.coarse_step) - r
         tol = self.world.tol  # the world's touching allowance: an end state may touch
-        return np.where((clear < 0) & (clear > -tol), 0.0, np.minimum(clear, edge))
+        raw = np.where((clear < 0) & (clear > -tol), 0.0, np.minimum(clear, edge))
+        return raw - self.margin
 
-    def _inside(self, xy: np.ndarray) -> bool:
-        """Whether points between a curve's ends keep the sagitta's margin inside the bounds
-        (so the curve between them stays inside too; its ends are valid states)."""
+    def _inside(self, xy: np.ndarray, m: float) -> bool:
+        """Whether the points keep ``m`` inside the bounds."""
         (xmin, ymin), (xmax, ymax) = self.world.bounds
-        m = self.margin
         return bool(((xy[:, 0] >= xmin + m) & (xy[:, 0] <= xmax - m) & (xy[:, 1] >= ymin + m)
                      & (xy[:, 1] <= ymax - m)).all())  # fmt: skip
 
     def polyline_valid(self, xy: np.ndarray) -> bool:
-        """Whether a chord polyline (``(n, 2)``, from :meth:`CarModel.polyline`) is free with the
-        sagitta's margin and within the bounds (its inner points by the margin)."""
+        """Whether a chord polyline (``(n, 2)``, from :meth:`CarModel.polyline`) is a valid path
+        as the file format defines one (the robot's radius, the bounds): every motion this
+        validator passed gives one."""
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-        return (len(xy) > 1 and bool(self.chord_world.path_valid(xy))
-                and self._inside(xy[1:-1]))  # fmt: skip
+        return len(xy) > 1 and bool(self.world.path_valid(xy))
