@@ -218,10 +218,7 @@ def _car_corridor(planner, adapter: SpaceAdapter, values, ptc, deadline, rng,
     def stop() -> bool:
         return until is not None and (bool(ptc()) or time.perf_counter() >= until)
 
-    def check_stop() -> bool:  # the route's check and repair: up to half of the budget
-        return deadline is not None and (
-            bool(ptc()) or time.perf_counter() >= t1 + 0.5 * (deadline - t1)
-        )
+    check_stop = _stop(ptc, deadline, 0.5)  # the route's check and repair: half of what is left
 
     rows, reason = car_corridor_seed(si, adapter, validator, start, goal, seconds, cells, rng,
                                      stop, check_stop)  # fmt: skip
