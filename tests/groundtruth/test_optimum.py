@@ -706,3 +706,21 @@ def test_six_library_maps_keep_their_written_optima():
         written = float(re.search(r"Shortest collision-free path: ([0-9.]+)", text).group(1))
         result = shortest_path(load_problem(path))
         assert result.length == pytest.approx(written, abs=6e-5), path.stem
+
+
+def test_a_search_that_adds_nodes_faster_than_it_expands_them(tmp_path):
+    """A warehouse of 1-cell aisles: the first expansions add over 2,048 tangent nodes, and the
+    record of expanded nodes once grew by only its own size (an IndexError, issue 37)."""
+    from rrtpso_ompl.groundtruth.generate import generate_to_file
+
+    path = generate_to_file("warehouse_map", 1, tmp_path / "w.yaml", cells=128, rack=2,
+                            aisle=(1, 1), run=(10, 10), cross=(1, 1), robot_radius=0.0,
+                            query=1)  # fmt: skip
+    problem = load_problem(path)
+    world = World.from_problem(problem)
+    result = shortest_path(problem, world)
+    assert result.found
+    grid = grid_path(problem)
+    assert result.length <= path_length(grid) + 1e-9
+    assert world.path_valid(np.asarray(result.to_dict(world)["path"]))
+    assert result.length == pytest.approx(81.29363437135086, rel=1e-9)

@@ -86,8 +86,8 @@ class TangentSearch:
                 return float(g_u), self._pieces(u)
             if self._dominated(u):
                 continue
-            if u >= len(done):
-                done = np.concatenate([done, np.full(len(done), math.inf)])
+            if u >= len(done):  # nodes are added faster than expanded: grow past u at once
+                done = np.concatenate([done, np.full(max(len(done), u + 1), math.inf)])
             done[u] = g_u
             for v in self._expand(u):
                 heapq.heappush(heap, (self.g[v] + self.h[v], v))
