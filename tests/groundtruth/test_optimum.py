@@ -713,9 +713,9 @@ def test_a_search_that_adds_nodes_faster_than_it_expands_them(tmp_path):
     record of expanded nodes once grew by only its own size (an IndexError, issue 37)."""
     from rrtpso_ompl.groundtruth.generate import generate_to_file
 
-    path = generate_to_file("warehouse_map", 1, tmp_path / "w.yaml", cells=128, rack=2,
+    path = generate_to_file("warehouse_map", 2, tmp_path / "w.yaml", cells=128, rack=2,
                             aisle=(1, 1), run=(10, 10), cross=(1, 1), robot_radius=0.0,
-                            query=1)  # fmt: skip
+                            query=0)  # fmt: skip
     problem = load_problem(path)
     world = World.from_problem(problem)
     result = shortest_path(problem, world)
@@ -723,4 +723,4 @@ def test_a_search_that_adds_nodes_faster_than_it_expands_them(tmp_path):
     grid = grid_path(problem)
     assert result.length <= path_length(grid) + 1e-9
     assert world.path_valid(np.asarray(result.to_dict(world)["path"]))
-    assert result.length == pytest.approx(81.29363437135086, rel=1e-9)
+    assert result.length == pytest.approx(84.51244267708103, rel=1e-9)
