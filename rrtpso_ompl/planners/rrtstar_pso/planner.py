@@ -190,7 +190,7 @@ SIMPLIFIER_PASS_LENGTHS = 20
 
 #: With no route through the lattice yet, a finer lattice may be tried until this share of the
 #: budget (there is nothing for the other stages to refine meanwhile).
-_CORRIDOR_NO_ROUTE_SHARE = 0.5
+_CORRIDOR_NO_ROUTE_SHARE = 0.7
 
 #: Share of the budget kept back for handing the path over (the last checks, OMPL's path): the
 #: stages aim to be done by the rest.

@@ -19,6 +19,20 @@ corridor at once, at the resolution of a lattice:
    It bends only at portal end points, the corners of the channel, exactly where a taut string
    would: on a map with 1-cell corridors it is the exact shortest path within 1e-4.
 
+4. **Taut lengths decide.** The cell lattice rates a corridor by its staircase of cell moves: along
+   one-cell corridors a diagonal costs as two axis moves, so of many corridors of nearly equal
+   lattice length (aisles between racks, crossed diagonally) it cannot tell which the taut
+   string makes shortest. Where the time affords, the routes of a second lattice are added, over
+   the cells' *corners* with moves up to four cells in any of 48 directions
+   (:mod:`.corner_routes`: within 0.8 % of any straight line however narrow the corridor),
+   searched over the cells of the routes within 15 % of the shortest; every route is funnelled
+   and the shortest checked path wins.
+5. **A disc narrower than a map cell.** The cells wholly free for the disc close every gap one
+   map cell wide once the disc is wider than a quarter cell. With the radius under half a cell,
+   two blocked cells close the way between them exactly when they touch, so the corridors are
+   the point robot's: routes over the map's free cells, each searched again on cells fine enough
+   for the gap (:func:`.search._thin_disc_corridors`) and wrapped round the wall corners.
+
 The path stays inside cells that are wholly free, so it is valid without further checks; it is
 checked once anyway (exactly, or through the user's checker, whose lattice answers are not
 conservative). Its cost is a few array operations and one sparse-graph search: milliseconds on a
@@ -26,10 +40,12 @@ map of 65,000 cells.
 
 The stage's rooms: :mod:`.search` (the orchestration within the time), :mod:`.paths` (one
 search on one lattice), :mod:`.routes` (routes on the lattice of free cells), :mod:`.funnel`
-(the taut path in a channel), :mod:`.corners` (a disc robot round wall corners); the graph over
-the cells is :mod:`rrtpso_ompl.model.grid_graph`'s.
+(the taut path in a channel), :mod:`.corners` (a disc robot round wall corners),
+:mod:`.corner_routes` (routes between cell corners, near their taut length); the graph over the
+cells is :mod:`rrtpso_ompl.model.grid_graph`'s.
 """
 
+from .corner_routes import CORNER_BAND_SLACK, CORNER_CELLS_PER_SECOND, CORNER_REACH, corner_routes
 from .funnel import free_rectangles, funnel
 from .paths import CENTRE_ROUTE_ROUNDS, CorridorResult, centre_route, corridor_path
 from .routes import (
@@ -46,9 +62,11 @@ from .search import (
     CELLS_PER_SECOND,
     CENTRE_CELLS_PER_SECOND,
     DIRECT_CELLS_PER_SECOND,
+    LEAN_CELLS_PER_SECOND,
     REPRODUCIBLE_CORRIDOR_CELLS,
     SHAPE_BAND_SHARE,
     SHAPE_SPLIT,
+    THIN_SPLIT,
     find_corridor_path,
 )
 
@@ -59,15 +77,21 @@ __all__ = [
     "CELLS_PER_SECOND",
     "CENTRE_CELLS_PER_SECOND",
     "CENTRE_ROUTE_ROUNDS",
+    "CORNER_BAND_SLACK",
+    "CORNER_CELLS_PER_SECOND",
+    "CORNER_REACH",
     "DIRECT_CELLS_PER_SECOND",
+    "LEAN_CELLS_PER_SECOND",
     "REPRODUCIBLE_CORRIDOR_CELLS",
     "SHAPE_BAND_SHARE",
     "SHAPE_SPLIT",
+    "THIN_SPLIT",
     "CorridorResult",
     "alternative_routes",
     "band",
     "centre_route",
     "channel",
+    "corner_routes",
     "corridor_path",
     "find_corridor_path",
     "free_rectangles",

@@ -13,8 +13,9 @@ from ....model.raster import Lattice
 from .funnel import FunnelEnds, channel_portals, free_rectangles, funnel, rectangle_channel
 from .routes import channel
 
-#: Most rounds of :func:`wrapped_funnel` adding wall corners its path passed without a bend.
-WRAP_REPAIRS = 8
+#: Most rounds of :func:`wrapped_funnel` adding a wall corner its path passed without a bend, or
+#: releasing one the string no longer wraps.
+WRAP_REPAIRS = 32
 
 
 def wrapped_funnel(model, lat: Lattice, free, route, ends: FunnelEnds, terminate=None):
@@ -45,7 +46,7 @@ def wrapped_funnel(model, lat: Lattice, free, route, ends: FunnelEnds, terminate
         return None  # narrower than the robot
     portals, corner_of = wall_portals
     inner = funnel(ends.a, ends.b, portals)
-    corners = [corner_of.get((float(x), float(y))) for x, y in inner[1:-1]]
+    corners = _sided([corner_of.get((float(x), float(y))) for x, y in inner[1:-1]], inner)
     (ox, oy), h = lat.origin, lat.h
     walls = np.column_stack([ox + h * np.nonzero(walled)[0], oy + h * np.nonzero(walled)[1]])
     for _ in range(WRAP_REPAIRS):
@@ -54,25 +55,76 @@ def wrapped_funnel(model, lat: Lattice, free, route, ends: FunnelEnds, terminate
         rounded = _round_corners(inner, corners, r)
         if rounded is None:
             return None
+        if isinstance(rounded, int):  # a corner the string no longer wraps: released
+            inner = np.delete(inner, rounded, axis=0)
+            del corners[rounded - 1]
+            continue
         rounded, owner = rounded
         candidate = ends.path(rounded)
         if model.path_valid(candidate):
             return candidate
         # A wall corner the string passes without wrapping it (a side of the channel that is
         # free space, not wall, let the funnel pass it without a bend): it becomes a circle too.
-        bad = np.flatnonzero(model.segment_violation(rounded[:-1], rounded[1:]) > 0.0)
-        if not len(bad):
-            return None  # the hops to the end points failed: nothing to repair here
-        k = int(bad[0])
-        corner = _nearest_wall(rounded[k], rounded[k + 1], walls, r)
-        if corner is None:
+        blamed = _blamed_corner(model, rounded, owner, inner, corners, walls, r)
+        if blamed is None:
             return None
-        at = int(owner[k]) + 1  # after the circle the segment leaves
-        d, e = rounded[k + 1] - rounded[k], corner - rounded[k]
-        side = 1.0 if d[0] * e[1] - d[1] * e[0] > 0.0 else -1.0  # the corner's side of the path
+        k, at, corner = blamed
+        side = _wall_side(corner, rounded[k + 1] - rounded[k], rounded[k], lat, point)
         inner = np.insert(inner, at, corner, axis=0)
         corners.insert(at - 1, (corner, side))
     return None
+
+
+def _blamed_corner(model, rounded, owner, inner, corners, walls, r: float):
+    """``(segment, insert at, wall corner)`` for the first segment of ``rounded`` that fails the
+    check with a wall corner within ``r`` of it that is not one of the circles it runs between
+    (such a circle was passed on the wrong side: not to be added again); None when there is
+    none (the hops to the end points failed, or no corner is to blame)."""
+    bad = np.flatnonzero(model.segment_violation(rounded[:-1], rounded[1:]) > 0.0)
+    for k in bad.tolist():
+        corner = _nearest_wall(rounded[k], rounded[k + 1], walls, r)
+        at = int(owner[k]) + 1  # after the circle the segment leaves
+        if corner is not None and not any(
+            corners[i - 1] is not None and np.array_equal(corner, corners[i - 1][0])
+            for i in (at - 1, at)
+            if 0 < i < len(inner) - 1
+        ):
+            return k, at, corner
+    return None
+
+
+def _wall_side(corner: np.ndarray, d: np.ndarray, a: np.ndarray, lat: Lattice, point) -> float:
+    """The side (+1 left, -1 right) of a path through ``a`` in direction ``d`` that the wall
+    corner ``corner`` is to be passed on: the side it lies on, or, for a corner on the path's
+    line (a path along a wall, touching it), the side of the blocked cells at it (their mean
+    centre), not one by chance."""
+    (ox, oy), h = lat.origin, lat.h
+    ci, cj = round((corner[0] - ox) / h), round((corner[1] - oy) / h)
+    mass = np.zeros(2)
+    for di in (-1, 0):
+        for dj in (-1, 0):
+            i, j = ci + di, cj + dj
+            if not (0 <= i < lat.nx and 0 <= j < lat.ny) or not point[i, j]:
+                mass += (di + 0.5, dj + 0.5)
+    e = corner - a
+    cross = d[0] * e[1] - d[1] * e[0]
+    if abs(cross) <= 1e-9 * float(np.hypot(*d)) * h:  # on the line: the wall's side decides
+        cross = d[0] * mass[1] - d[1] * mass[0]
+    return 1.0 if cross > 0.0 else -1.0
+
+
+def _sided(corners, path: np.ndarray):
+    """``corners`` (one per interior vertex of ``path``: a wall corner or None) with the side
+    each is passed on, ``(corner, +1)`` where the path turns left there, ``(corner, -1)`` right,
+    None where it does not turn: fixed from the funnel's own path, so that a corner inserted by
+    a repair cannot flip the sides of those around it."""
+    out = []
+    for k, corner in enumerate(corners, start=1):
+        d_in, d_out = path[k] - path[k - 1], path[k + 1] - path[k]
+        turn = d_in[0] * d_out[1] - d_in[1] * d_out[0]
+        out.append(None if corner is None or turn == 0.0 else
+                   (np.asarray(corner, dtype=float), 1.0 if turn > 0 else -1.0))  # fmt: skip
+    return out
 
 
 def _wall_portals(portals, lat: Lattice, walled: np.ndarray, r: float, tol: float):
@@ -112,14 +164,15 @@ def _nearest_wall(a: np.ndarray, b: np.ndarray, walls: np.ndarray, r: float):
     return near[k] if dist[k] < r else None
 
 
-def _round_corners(path: np.ndarray, corners, r: float) -> np.ndarray | None:
+def _round_corners(path: np.ndarray, corners, r: float):
     """The taut string from ``path[0]`` to ``path[-1]`` round circles of radius ``r`` at the
     ``corners`` (one per interior vertex: a point passed on the side the path turns to there,
     a ``(point, side)`` pair, side +1 for a corner on the left, or None for a vertex kept as a
     point); every arc replaced by the polygon circumscribed about it (:func:`_arc_polygon`), so
     no segment comes closer than ``r`` to a corner. Also returns, for every vertex, the index
-    of the path vertex whose circle it lies on. None when two circles on opposite sides overlap
-    or an arc would turn back (the corners do not make a taut string)."""
+    of the path vertex whose circle it lies on. None when two circles on opposite sides overlap;
+    the index ``k`` of the first path vertex whose arc would turn back (the string, pulled
+    round the others, no longer touches that circle: it is to be released)."""
     centres, side = [path[0]], [0.0]
     for k, corner in enumerate(corners, start=1):
         d_in, d_out = path[k] - path[k - 1], path[k + 1] - path[k]
@@ -160,7 +213,7 @@ def _round_corners(path: np.ndarray, corners, r: float) -> np.ndarray | None:
             continue
         arc = _arc_polygon(c[k], r, arrive[k - 1], leave[k], s[k])
         if arc is None:
-            return None
+            return k
         out.extend(arc)
         owner.extend([k] * len(arc))
     out.append(c[-1])

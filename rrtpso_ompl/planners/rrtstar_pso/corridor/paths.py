@@ -15,6 +15,7 @@ from scipy.sparse.csgraph import dijkstra
 from ....model.geometry import path_length, shortcut
 from ....model.grid_graph import entry_cell, walk
 from ....model.raster import Lattice
+from .corner_routes import CORNER_BAND_SLACK, CORNER_CELLS_PER_SECOND, corner_routes
 from .corners import circumscribe_corners, wrapped_funnel
 from .funnel import (
     FunnelEnds,
@@ -131,7 +132,7 @@ def corridor_path(
 
 
 def route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0, stages,
-                      routes=None) -> CorridorResult:  # fmt: skip
+                      routes=None, corner_reach=0) -> CorridorResult:  # fmt: skip
     """Route over ``free`` (or take ``routes``), funnel each route, keep the shortest valid."""
 
     def done(reason: str, **kw) -> CorridorResult:
@@ -147,7 +148,21 @@ def route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0,
     t1 = time.perf_counter()
     if routes is None:
         apart = max(3.0, ALTERNATIVE_APART * math.hypot(lat.nx, lat.ny))
-        routes = alternative_routes(free, s_cell, g_cell, alternatives, ALTERNATIVE_SLACK, apart)
+        if not corner_reach:
+            routes = alternative_routes(free, s_cell, g_cell, alternatives, ALTERNATIVE_SLACK,
+                                        apart)  # fmt: skip
+        else:
+            routes, near = alternative_routes(
+                free, s_cell, g_cell, alternatives, ALTERNATIVE_SLACK, apart, CORNER_BAND_SLACK
+            )
+            if routes and _corner_fits(int(near.sum()), corner_reach, terminate):
+                a = start if not s_hop else np.asarray(lat.centre(s_cell))
+                b = goal if not g_hop else np.asarray(lat.centre(g_cell))
+                # Over the cells of the routes within the slack: the corner lattice's work
+                # follows the corridors worth telling apart, not the whole map.
+                routes = routes + corner_routes(lat, free & near, ((s_cell, a), (g_cell, b)),
+                                                alternatives, ALTERNATIVE_SLACK, apart,
+                                                corner_reach)  # fmt: skip
     stages["route"] = stages.get("route", 0.0) + time.perf_counter() - t1
     if not routes:
         return done("no route through the lattice", lattice=lat, cells=n_free)
@@ -167,6 +182,13 @@ def route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0,
                           stages, len(routes), which)  # fmt: skip
 
 
+def _corner_fits(cells: int, reach: int, terminate) -> bool:
+    """Whether the corner lattice over ``cells`` cells fits the time ``terminate`` leaves
+    (:data:`.corner_routes.CORNER_CELLS_PER_SECOND`); always without a time limit."""
+    left = getattr(terminate, "left", None)
+    return reach > 0 and (left is None or cells <= CORNER_CELLS_PER_SECOND * left())
+
+
 def _funnel_routes(model, lat: Lattice, free, routes, ends: FunnelEnds, terminate):
     """``(path, length, route cells, route index)`` of the shortest checked funnel path over
     ``routes`` (portals shrunk by the touch tolerance, then by a thousandth of a cell), or
@@ -177,11 +199,21 @@ def _funnel_routes(model, lat: Lattice, free, routes, ends: FunnelEnds, terminat
         if k and terminate is not None and terminate():
             break
         seq = rectangle_channel(channel(route), label)
-        for shrink in (max(1e-6 * lat.h, 16.0 * model.tol), 1e-3 * lat.h):
-            inner = funnel(ends.a, ends.b, channel_portals(seq, rects, lat, shrink))
-            if model.robot_radius <= 0.0:
-                inner = push_off_corners(inner, lat, free, 2.0 * shrink)
-            candidate = ends.path(inner)
+        for shrink in (max(1e-6 * lat.h, 16.0 * model.tol), 1e-3 * lat.h, None):
+            if shrink is None:
+                # A point robot's path along a wall between two of its corners, lifted off the
+                # corners diagonally, may cut the wall's cells: the taut string round the
+                # corners at the touch tolerance instead (maps; None elsewhere).
+                if model.robot_radius > 0.0 or (terminate is not None and terminate()):
+                    break
+                candidate = wrapped_funnel(model, lat, free, route, ends, terminate)
+                if candidate is None:
+                    break
+            else:
+                inner = funnel(ends.a, ends.b, channel_portals(seq, rects, lat, shrink))
+                if model.robot_radius <= 0.0:
+                    inner = push_off_corners(inner, lat, free, 2.0 * shrink)
+                candidate = ends.path(inner)
             if model.path_valid(candidate):
                 length = path_length(candidate)
                 if best is None or length < best[1]:

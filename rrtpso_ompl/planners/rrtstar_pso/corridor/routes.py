@@ -52,39 +52,60 @@ def lattice_route(free: np.ndarray, source: tuple[int, int], target: tuple[int, 
 
 
 def alternative_routes(
-    free: np.ndarray, source, target, count: int, slack: float, apart: float
-) -> list[list[tuple[int, int]]]:
-    """The shortest route and up to ``count`` others through different corridors.
+    free: np.ndarray, source, target, count: int, slack: float, apart: float, within=None
+):
+    """The shortest route of cells and up to ``count`` others through different corridors
+    (:func:`via_routes` over :func:`lattice_graph`).
 
-    With Dijkstra distances from both ends, the best route through a cell ``v`` has length
-    ``d_s(v) + d_t(v)``. An alternative goes through the cell of least such length that lies
-    more than ``apart`` cells from every route taken so far, if that length is within ``slack``
-    (relative) of the best: a different door, aisle or side of an obstacle (the *via-node* method
-    of alternative route planning on road networks).
+    With ``within`` (a relative slack), also the (nx, ny) booleans of the cells some route
+    through which is at most ``1 + within`` times the shortest: ``(routes, cells)``.
     """
-    nx, ny = free.shape
+    ny = free.shape[1]
     s = source[0] * ny + source[1]
     t = target[0] * ny + target[1]
-    dist, pred = dijkstra(lattice_graph(free), directed=False, indices=[s, t],
-                          return_predecessors=True)  # fmt: skip
+    found = via_routes(lattice_graph(free), free.shape, s, t, count, slack, apart, within)
+    routes, cells = found if within is not None else (found, None)
+    routes = [[(v // ny, v % ny) for v in r] for r in routes]
+    return routes if within is None else (routes, cells)
+
+
+def via_routes(graph, shape: tuple[int, int], s: int, t: int, count: int, slack: float,
+               apart: float, within: float | None = None):  # fmt: skip
+    """The shortest route from node ``s`` to node ``t`` of an undirected ``graph`` over a grid of
+    ``shape`` nodes (node ``i * shape[1] + j``; nodes past the grid's, such as end points joined
+    to it, are never via nodes), and up to ``count`` others through different corridors.
+
+    With Dijkstra distances from both ends, the best route through a node ``v`` has length
+    ``d_s(v) + d_t(v)``. An alternative goes through the node of least such length that lies
+    more than ``apart`` nodes from every route taken so far, if that length is within ``slack``
+    (relative) of the best: a different door, aisle or side of an obstacle (the *via-node* method
+    of alternative route planning on road networks). Node lists, the shortest first; with
+    ``within``, also the grid's booleans of the nodes some route through which is at most
+    ``1 + within`` times the shortest.
+    """
+    n = shape[0] * shape[1]
+    if count <= 0 and within is None:  # the shortest alone: one search, from one end
+        dist, pred = dijkstra(graph, directed=False, indices=s, return_predecessors=True)
+        return [walk(pred, t)] if np.isfinite(dist[t]) else []
+    dist, pred = dijkstra(graph, directed=False, indices=[s, t], return_predecessors=True)
     best = dist[0, t]
+    through = (dist[0] + dist[1])[:n]
     if not np.isfinite(best):
-        return []
-    through = dist[0] + dist[1]
+        return [] if within is None else ([], np.zeros(shape, dtype=bool))
     routes = [walk(pred[0], t)]
-    near = np.zeros(nx * ny, dtype=bool)
+    near = np.zeros(n, dtype=bool)
     for _ in range(count):
-        mask = np.ones((nx, ny), dtype=bool)
-        for r in routes[-1:]:
-            near[np.asarray(r)] = True
-        mask = ~near.reshape(nx, ny)
-        far = ndimage.distance_transform_edt(mask) > apart
+        last = np.asarray(routes[-1])
+        near[last[last < n]] = True
+        far = ndimage.distance_transform_edt(~near.reshape(shape)) > apart
         ok = far.ravel() & (through <= best * (1.0 + slack))
         if not ok.any():
             break
         v = int(np.flatnonzero(ok)[np.argmin(through[ok])])
         routes.append(walk(pred[0], v) + walk(pred[1], v)[::-1][1:])
-    return [[(v // ny, v % ny) for v in r] for r in routes]
+    if within is None:
+        return routes
+    return routes, (through <= best * (1.0 + within)).reshape(shape)
 
 
 def channel(route: list[tuple[int, int]]) -> list[tuple[int, int]]:

@@ -1,6 +1,7 @@
 """The corridor stage's orchestration within its time: the lattice sized by the time, a map
-searched whole or coarse-to-fine, shapes through bands of marked cells, the centre route as the
-last resort."""
+searched whole (with the corner lattice's routes, or its shortest route alone) or coarse-to-fine,
+a thin disc through the map's own cells, shapes through bands of marked cells, the centre route
+as the last resort."""
 
 from __future__ import annotations
 
@@ -15,8 +16,10 @@ from scipy import ndimage
 
 from ....model.raster import Lattice
 from ....model.world import MarkingStopped
+from .corner_routes import CORNER_CELLS_PER_SECOND, CORNER_REACH, corner_routes
+from .funnel import channel_portals, free_rectangles, funnel, rectangle_channel
 from .paths import CorridorResult, centre_route, route_and_funnel
-from .routes import ALTERNATIVE_APART, ALTERNATIVE_SLACK, alternative_routes
+from .routes import ALTERNATIVE_APART, ALTERNATIVE_SLACK, alternative_routes, channel
 
 #: Lattice cells the corridor stage builds, searches and funnels per second, on the safe side
 #: (measured on the reference machine: 2-3 million on maps, fewer among many shapes).
@@ -42,6 +45,12 @@ MARK_CELLS_PER_SECOND = 8_000_000
 DIRECT_CELLS_PER_SECOND = 1_200_000
 
 
+#: Lattice cells of a map per second its shortest route alone is found and funnelled (no
+#: alternatives, no corner lattice), on the safe side (measured 2-4 million on 256 x 256 mazes,
+#: caves and random maps).
+LEAN_CELLS_PER_SECOND = 2_000_000
+
+
 #: Lattice cells per second :func:`centre_route` builds and routes over among shapes, on the
 #: safe side (measured 0.6-1 million among 10,000 circles).
 CENTRE_CELLS_PER_SECOND = 600_000
@@ -65,6 +74,12 @@ SHAPE_BAND_SHARE = 0.5
 SHAPE_SPLIT = 4
 
 
+#: For a disc narrower than a map cell, the most fine cells per map cell side in the bands
+#: (:func:`_thin_disc_corridors`): at 16, gaps are kept open for a radius up to 7/16 of a cell
+#: (wider discs through the free cell centres of the band).
+THIN_SPLIT = 16
+
+
 def find_corridor_path(
     model: Any,
     start,
@@ -78,7 +93,11 @@ def find_corridor_path(
     """The corridor stage within ``seconds`` (None: no limit but ``max_cells``).
 
     A map whose fine lattice fits the time (:data:`DIRECT_CELLS_PER_SECOND`) is searched whole
-    (:func:`route_and_funnel`). Otherwise:
+    (:func:`route_and_funnel`), with the corner lattice's routes where their band fits
+    (:mod:`.corner_routes`); one that fits only by the no-route time
+    (:data:`LEAN_CELLS_PER_SECOND`) by its shortest route alone. A disc narrower than a map
+    cell whose lattice would close one-cell gaps goes through :func:`_thin_disc_corridors`
+    first. Otherwise:
 
     1. **Coarse routes** on a lattice small enough to route on in a third of the time
        (:data:`CELLS_PER_SECOND`), its cells open generously (a map's when any fine cell they
@@ -209,18 +228,87 @@ def _map_corridors(model, fine_cells, route_cells, start, goal, alternatives, te
     fine = model.lattice(fine_cells)
     if fine.nx < 2 or fine.ny < 2:
         return CorridorResult(None, reason="the lattice is too small")
+    if _closes_thin_gaps(model, fine):
+        # No route yet (the lattice of this time would close the gaps): up to the grace time.
+        grace = _Deadline(terminate.grace_end, terminate.terminate)
+        thin = _thin_disc_corridors(model, fine_cells, start, goal, alternatives, grace, t0,
+                                    stages)  # fmt: skip
+        if thin.path is not None or terminate():
+            return thin
     free = model.free_cells(fine)
     stages["cells"] = time.perf_counter() - t0
     k = max(1, math.ceil(math.sqrt(fine.n_cells / route_cells)))
     nx, ny = fine.nx // k, fine.ny // k
-    if k == 1 or nx < 2 or ny < 2 or fine.n_cells <= DIRECT_CELLS_PER_SECOND * left():
+    direct = k == 1 or nx < 2 or ny < 2 or fine.n_cells <= DIRECT_CELLS_PER_SECOND * left()
+    # Too little time for the whole lattice with alternatives, enough for its shortest route by
+    # the time a stage with no route may take: better than pooling, which opens gaps through
+    # walls a cell thick (in a maze every coarse route then fails at the fine level).
+    lean = not direct and fine.n_cells <= LEAN_CELLS_PER_SECOND * terminate.grace_left()
+    if lean:
+        terminate = _Deadline(terminate.grace_end, terminate.terminate)
+        alternatives = 0
+    if direct or lean:
+        reach = CORNER_REACH if direct else 0  # where its band fits the time (route_and_funnel)
         return route_and_funnel(model, fine, free, start, goal, alternatives, terminate, t0,
-                                 stages)  # fmt: skip
+                                stages, corner_reach=reach)  # fmt: skip
     result = _pooled_corridors(model, fine, free, k, start, goal, alternatives, terminate, t0,
                                stages)  # fmt: skip
     if result.path is None and fine.n_cells <= DIRECT_CELLS_PER_SECOND * left():
         return route_and_funnel(model, fine, free, start, goal, 0, terminate, t0, stages)
     return result
+
+
+def _closes_thin_gaps(model, lat: Lattice) -> bool:
+    """Whether ``model`` is a map alone with a disc robot narrower than a map cell, and the
+    cells of ``lat`` wholly free for it miss a gap one map cell wide: no whole cell of ``lat``
+    fits between ``r`` and ``res - r`` across it (``lat`` is aligned with the map's cells)."""
+    raster = getattr(model, "raster", None)
+    r = model.robot_radius
+    if raster is None or not 0.0 < 2.0 * r < raster.resolution:
+        return False
+    if getattr(model, "non_raster_index", None) is None or model.non_raster_index.n_obstacles:
+        return False
+    res, h = raster.resolution, lat.h
+    if h >= res:
+        return True
+    first = math.ceil(r / h - 1e-9)  # the first fine line at least r from the wall
+    return (first + 1) * h > res - r + 1e-9 * res
+
+
+def _thin_disc_corridors(model, max_cells, start, goal, alternatives, terminate, t0,
+                         stages) -> CorridorResult:  # fmt: skip
+    """A disc robot narrower than a map cell: corridors over the map's own cells no obstacle
+    enters, each searched again on cells fine enough for the gaps the disc fits through.
+
+    The lattice of cells wholly free *for the disc* closes a gap one map cell wide (free width
+    ``res - 2 r`` for the robot's centre) unless a whole fine cell fits in that width: at a
+    quarter of a map cell, not for a radius over a quarter cell. With the radius under half a
+    map cell, two blocked cells close the way between them exactly when they touch (any other
+    pair is a cell apart, more than ``2 r``): the disc's corridors are the point robot's, the
+    routes over the map's free cells (a diagonal needs a free cell beside it). Each corridor is
+    then searched on cells of at most half the gap's free width (:data:`THIN_SPLIT` at most per
+    map cell), marked in its band only. No path (reason given) for any other robot or world.
+    """
+    raster = getattr(model, "raster", None)
+    if raster is None or not 0.0 < 2.0 * model.robot_radius < raster.resolution:
+        return CorridorResult(None, reason="not a disc narrower than a map cell on a map")
+    coarse = model.lattice(max_cells, split=1)
+    point = model.point_free_cells(coarse)
+    if point is None or coarse.h != raster.resolution or coarse.nx < 2 or coarse.ny < 2:
+        return CorridorResult(None, reason="not a map alone at its own cells")
+    if coarse.n_cells > LEAN_CELLS_PER_SECOND * terminate.grace_left():
+        return CorridorResult(None, reason="too little time to route over the map's cells")
+    gap = raster.resolution - 2.0 * model.robot_radius
+    k = min(THIN_SPLIT, max(4, math.ceil(2.0 * raster.resolution / gap)))
+
+    def fine_band(r0, r1, c0, c1, mask):
+        box = Lattice((coarse.origin[0] + r0 * coarse.h, coarse.origin[1] + c0 * coarse.h),
+                      coarse.h / k, (r1 - r0) * k, (c1 - c0) * k)  # fmt: skip
+        near = np.repeat(np.repeat(mask, k, axis=0), k, axis=1)
+        return box, model.free_cells(box, near), k
+
+    return _corridors(model, coarse, point, fine_band, start, goal, alternatives, terminate,
+                      t0, stages, band_cells=1)  # fmt: skip
 
 
 def _pooled_corridors(model, fine, free, k, start, goal, alternatives, terminate, t0,
@@ -270,7 +358,7 @@ def _shape_corridors(model, route_cells, max_cells, start, goal, alternatives, t
 
 
 def _corridors(model, coarse: Lattice, opened, fine_band, start, goal, alternatives, terminate,
-               t0, stages) -> CorridorResult:  # fmt: skip
+               t0, stages, band_cells: float = BAND_CELLS) -> CorridorResult:  # fmt: skip
     """Coarse routes over ``opened``, then the funnel path of the fine route in each one's band
     (``fine_band(r0, r1, c0, c1)`` gives, for a box of coarse cells, its fine lattice, which of
     its cells are wholly free and the fine cells per coarse side); the shortest valid one."""
@@ -283,11 +371,18 @@ def _corridors(model, coarse: Lattice, opened, fine_band, start, goal, alternati
                                   "a free lattice cell")  # fmt: skip
         ends.append(cell)
     t1 = time.perf_counter()
+    if coarse.n_cells > DIRECT_CELLS_PER_SECOND * terminate.left():
+        alternatives = 0  # too little time for them (a thin disc's "coarse" lattice is the map)
     apart = max(3.0, ALTERNATIVE_APART * math.hypot(nx, ny))
     routes = alternative_routes(opened, ends[0], ends[1], alternatives, ALTERNATIVE_SLACK, apart)
+    reach = _reach(coarse.n_cells, terminate.left)
+    if routes and reach:  # corridors told apart by their taut lengths (:mod:`.corner_routes`)
+        at = [(cell, coarse.centre(cell)) for cell in ends]
+        routes += corner_routes(coarse, opened, at, alternatives, ALTERNATIVE_SLACK, apart, reach)
+    routes = _by_taut_length(coarse, opened, routes, ends)
     stages["coarse_route"] = time.perf_counter() - t1
     best = None
-    grow = math.ceil(BAND_CELLS)
+    grow = math.ceil(band_cells)
     for route in routes:
         if terminate():
             break
@@ -300,7 +395,7 @@ def _corridors(model, coarse: Lattice, opened, fine_band, start, goal, alternati
             box, free, k = fine_band(r0, r1, c0, c1, mask[r0:r1, c0:c1])
             near = np.repeat(np.repeat(mask[r0:r1, c0:c1], k, axis=0), k, axis=1)
             result = route_and_funnel(model, box, free & near, start, goal, 0, terminate, t0,
-                                       stages)  # fmt: skip
+                                       stages, corner_reach=CORNER_REACH)  # fmt: skip
             if result.path is None and not terminate():
                 # The corridor's gaps are narrower than wholly free fine cells: through the
                 # centres of the fine cells that are free, every segment checked.
@@ -314,6 +409,27 @@ def _corridors(model, coarse: Lattice, opened, fine_band, start, goal, alternati
     return dataclasses.replace(best, routes=len(routes))
 
 
+def _by_taut_length(lat: Lattice, opened, routes, ends):
+    """``routes`` in the order of their taut length through the coarse cells (the funnel between
+    the end cells' centres), shortest first: the fine searches go to the likeliest first."""
+    if len(routes) < 2:
+        return routes
+    rects, label = free_rectangles(opened)
+    a, b = np.asarray(lat.centre(ends[0])), np.asarray(lat.centre(ends[1]))
+    lengths = []
+    for route in routes:
+        seq = rectangle_channel(channel(route), label)
+        path = funnel(a, b, channel_portals(seq, rects, lat, 0.0))
+        lengths.append(float(np.hypot(*np.diff(path, axis=0).T).sum()))
+    return [routes[i] for i in np.argsort(lengths, kind="stable")]
+
+
+def _reach(cells: int, left) -> int:
+    """The corner lattice's reach for a search over ``cells`` cells with ``left()`` seconds:
+    :data:`CORNER_REACH` when it fits (:data:`CORNER_CELLS_PER_SECOND`), else 0 (none)."""
+    return CORNER_REACH if cells <= CORNER_CELLS_PER_SECOND * left() else 0
+
+
 class _Deadline:
     """A termination test: ``terminate()``, or the clock past ``end``; :meth:`grace` the same
     with ``grace_end`` (later) for a step that improves a path already found."""
@@ -325,6 +441,12 @@ class _Deadline:
     def left(self) -> float:
         """Seconds until ``end`` (infinite without one)."""
         return math.inf if self.end is None else max(self.end - time.perf_counter(), 0.0)
+
+    def grace_left(self) -> float:
+        """Seconds until ``grace_end`` (infinite without one)."""
+        if self.grace_end is None:
+            return math.inf
+        return max(self.grace_end - time.perf_counter(), 0.0)
 
     def grace(self) -> bool:
         return bool(self.terminate is not None and self.terminate()) or (
