@@ -14,8 +14,9 @@ The protocol (docs/benchmarking.md):
 - **tuning set**: family seeds 1-3 (the corner lattice, the thin-disc search and their time
   rates were shaped on these);
 - **report set**: fresh family seeds 401-403 unless ``--seeds``, never used in tuning;
-- ``--maps DIR``: MovingAI ``.map`` files (real game, city and maze maps; none are shipped), two
-  seeded queries each, point robot.
+- ``--maps DIR``: MovingAI ``.map`` files (real maps, none shipped:
+  ``benchmarks/fetch_real_maps.py`` fetches the Berlin city map, MovingAI's mazes and rooms and
+  a house's floor plan), four seeded queries each, point robot, never tuned on.
 
 Every run goes through :func:`rrtpso_ompl.planners.solve` (as ``rrtpso solve``), each in a child
 process of its own, one at a time; every path is checked with the exact checker.
@@ -42,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from families import percentile, run_one, summary
+from families import in_child, percentile, run_one, summary
 
 #: Families: ``rrtpso generate`` kind and options.
 FAMILIES = {
@@ -101,11 +102,11 @@ def problem_files(which: str, seeds, folder: Path, maps_dir=None,
                 generate_to_file(kind, seed, path, **options, query=q)
                 out.append((family, path))
     for map_file in sorted(Path(maps_dir).glob("*.map")) if maps_dir else []:
-        out += [(f"movingai_{map_file.stem}", p) for p in movingai_problems(map_file, folder)]
+        out += [(f"real_{map_file.stem}", p) for p in movingai_problems(map_file, folder)]
     return out
 
 
-def movingai_problems(map_file: Path, folder: Path, queries: int = 2) -> list[Path]:
+def movingai_problems(map_file: Path, folder: Path, queries: int = 4) -> list[Path]:
     """Problem files for a MovingAI ``.map`` (``.`` and ``G`` passable, the rest blocked; one
     unit per cell): the map as a PGM with its map_server YAML, and ``queries`` seeded start and
     goal pairs, free cell centres of the largest 8-connected free region, far apart."""
@@ -139,6 +140,15 @@ def movingai_problems(map_file: Path, folder: Path, queries: int = 2) -> list[Pa
             "start": a[k].tolist(), "goal": b[k].tolist(), "robot": {"radius": 0.0}}))  # fmt: skip
         out.append(path)
     return out
+
+
+def optimum(path: Path) -> float:
+    """The exact optimum's length of the problem file ``path``."""
+    from rrtpso_ompl.groundtruth import shortest_path
+    from rrtpso_ompl.model import World, load_problem
+
+    problem = load_problem(path)
+    return shortest_path(problem, World.from_problem(problem)).length
 
 
 def pooled(rows: list[dict], budget: float, planner: str, families=None) -> dict:
@@ -213,10 +223,9 @@ def main(argv: list[str] | None = None) -> int:
     args.argv = sys.argv[1:] if argv is None else argv
     args.planners = args.planners.split(",")
 
-    import rrtpso_ompl.planners  # noqa: F401  (loaded once, used in the forked children)
-    from rrtpso_ompl.groundtruth import shortest_path
+    import rrtpso_ompl.groundtruth  # (loaded once, used in the forked children)
+    import rrtpso_ompl.planners  # noqa: F401
     from rrtpso_ompl.harness.report import write_markdown
-    from rrtpso_ompl.model import World, load_problem
 
     seeds = args.seeds or (TUNING_SEEDS if args.set == "tuning" else REPORT_SEEDS)
     if args.set == "large" and not args.seeds:
@@ -225,8 +234,9 @@ def main(argv: list[str] | None = None) -> int:
     t_start = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         for family, path in problem_files(args.set, seeds, Path(tmp), args.maps, args.families):
-            problem = load_problem(path)
-            best = shortest_path(problem, World.from_problem(problem)).length
+            # The optimum in a child too: a parent grown by it would make every forked run pay
+            # for its pages and its garbage collection, which a real `rrtpso solve` never does.
+            best = in_child(lambda p=path: {"best": optimum(p)}, {})["best"]
             for budget in args.time:
                 for planner in args.planners:
                     row = run_one(path, planner, budget, 1, {})

@@ -225,6 +225,38 @@ class MapRaster:
         dist = ndimage.distance_transform_edt(~grown) * lat.h
         return dist[ext : ext + lat.nx, ext : ext + lat.ny] >= clearance
 
+    def thin_free_cells(self, i0: int, j0: int, near: np.ndarray, k: int,
+                        clearance: float) -> np.ndarray:  # fmt: skip
+        """Booleans of the cells of map cells ``[i0, i0 + n0) x [j0, j0 + n1)`` split ``k`` x ``k``
+        (``n0 k`` x ``n1 k``, a lattice aligned with the map), true where every point keeps
+        ``clearance`` from every blocked map cell; only map cells where ``near`` ((n0, n1)
+        booleans) is true are asked about, the others come back False.
+
+        Exact for ``clearance`` up to a map cell, where only the 8 neighbours of a cell can come
+        that close: per neighbour, the sub-cells within ``clearance`` of it are a fixed ``k`` x
+        ``k`` pattern, so the work is ``9 k^2`` per cell asked about, however large the box
+        (:meth:`free_cells` transforms the whole box).
+        """
+        if not 0.0 <= clearance <= self.resolution:
+            raise ValueError("thin_free_cells needs a clearance of at most one map cell")
+        n0, n1 = near.shape
+        window = self._window(i0 - 1, j0 - 1, n0 + 2, n1 + 2)
+        c = clearance / self.resolution
+        lo, hi = np.arange(k) / k, np.arange(1, k + 1) / k
+        # Gap along one axis between sub-cell a and the neighbour at offset d (map-cell units).
+        gap = {d: np.maximum(np.maximum(d - hi, lo - (d + 1)), 0.0) for d in (-1, 0, 1)}
+        asked = near & ~window[1:-1, 1:-1]
+        out = np.repeat(np.repeat(asked, k, axis=0), k, axis=1)
+        view = out.reshape(n0, k, n1, k)
+        for di in (-1, 0, 1):
+            for dj in (-1, 0, 1):
+                close = np.hypot(gap[di][:, None], gap[dj][None, :]) < c
+                if (di, dj) == (0, 0) or not close.any():
+                    continue
+                blocked = window[1 + di : 1 + di + n0, 1 + dj : 1 + dj + n1] & asked
+                view &= ~(blocked[:, None, :, None] & close[None, :, None, :])
+        return out
+
     @property
     def extent(self):
         """``((xmin, ymin), (xmax, ymax))`` of the map."""

@@ -182,3 +182,55 @@ def test_a_pinch_between_two_touching_blocked_cells_is_no_way_through():
     graph = coo_matrix((np.ones(len(t)), (t, h)), shape=(9, 9)).tocsr()
     dist = dijkstra(graph, directed=False, indices=0)  # corner (0, 0)
     assert not np.isfinite(dist[2 * 3 + 2])  # corner (2, 2), across the pinch
+
+
+def test_routes_within_a_slack_are_the_cells_of_near_shortest_routes():
+    """The band the corner lattice searches: every cell some route through which is within the
+    slack of the shortest, and no other."""
+    from rrtpso_ompl.planners.rrtstar_pso.corridor import alternative_routes
+
+    free = np.ones((12, 9), dtype=bool)
+    free[3:9, 2:7] = False  # one block: round it below or above
+    routes, near = alternative_routes(free, (0, 4), (11, 4), 2, 0.06, 3.0, within=0.15)
+    assert routes and near[0, 4] and near[11, 4]
+    assert not (near & ~free).any()
+    assert near[:, 0].sum() > 6 or near[:, 8].sum() > 6  # the ways round are in it
+    routes2, wide = alternative_routes(free, (0, 4), (11, 4), 2, 0.06, 3.0, within=1.0)
+    assert routes2 == routes and (near <= wide).all() and wide.sum() > near.sum()
+
+
+@pytest.mark.parametrize(("h", "radius", "closes"), [
+    (1.0, 0.3, True),    # the map's own cells: no whole cell fits in a 0.4-wide band
+    (0.25, 0.3, True),   # quarter cells: [0.25, 0.5] and [0.5, 0.75] both leave [0.3, 0.7]
+    (0.25, 0.25, False),  # [0.25, 0.5] fits in [0.25, 0.75]
+    (0.125, 0.3, False),  # [0.375, 0.5] fits
+    (0.25, 0.0, False),  # a point robot: no thin-disc search
+    (0.25, 0.6, False),  # wider than half a cell: the disc's corridors are not the point's
+])  # fmt: skip
+def test_which_lattices_close_a_thin_discs_one_cell_gaps(h, radius, closes):
+    from rrtpso_ompl.model.raster import MapRaster
+
+    class Model:  # a map alone, as the World answers it
+        raster = MapRaster(np.zeros((4, 4), dtype=bool), (0.0, 0.0), 1.0)
+        robot_radius = radius
+        non_raster_index = type("Index", (), {"n_obstacles": 0})()
+
+    lat = Lattice((0.0, 0.0), h, round(4 / h), round(4 / h))
+    assert search._closes_thin_gaps(Model(), lat) is closes
+
+
+def test_a_map_that_fits_only_by_the_no_route_time_is_searched_by_its_shortest_route(tmp_path):
+    """No time left for the whole lattice with alternatives but time by the no-route grace: the
+    shortest route alone, not pooled cells (which open gaps through one-cell walls and miss a
+    maze's only corridor). The deadlines are built past and far ahead: no clock decides."""
+    problem, world, best = _generated(tmp_path, "maze_map", 1, 0, cells=128, corridor=1,
+                                      wall_cells=1, robot_radius=0.0)  # fmt: skip
+    deadline = search._Deadline(0.0)  # long past
+    deadline.grace_end = 1e18  # far ahead
+    stages: dict = {}
+    found = search._map_corridors(world, 1 << 20, 1024, np.asarray(problem.start),
+                                  np.asarray(problem.goal), 3, deadline, 0.0, stages,
+                                  deadline.left)  # fmt: skip
+    assert found.path is not None and world.path_valid(found.path)
+    assert found.routes == 1  # the shortest alone
+    assert found.length == pytest.approx(best, rel=1e-3)

@@ -45,7 +45,7 @@ search on one lattice), :mod:`.routes` (routes on the lattice of free cells), :m
 cells is :mod:`rrtpso_ompl.model.grid_graph`'s.
 """
 
-from .corner_routes import CORNER_BAND_SLACK, CORNER_CELLS_PER_SECOND, CORNER_REACH, corner_routes
+from .corner_routes import CORNER_BAND_SLACK, CORNER_CELLS_PER_SECOND, CORNER_REACH
 from .funnel import free_rectangles, funnel
 from .paths import CENTRE_ROUTE_ROUNDS, CorridorResult, centre_route, corridor_path
 from .routes import (
@@ -91,7 +91,6 @@ __all__ = [
     "band",
     "centre_route",
     "channel",
-    "corner_routes",
     "corridor_path",
     "find_corridor_path",
     "free_rectangles",

@@ -147,22 +147,8 @@ def route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0,
                     cells=n_free)  # fmt: skip
     t1 = time.perf_counter()
     if routes is None:
-        apart = max(3.0, ALTERNATIVE_APART * math.hypot(lat.nx, lat.ny))
-        if not corner_reach:
-            routes = alternative_routes(free, s_cell, g_cell, alternatives, ALTERNATIVE_SLACK,
-                                        apart)  # fmt: skip
-        else:
-            routes, near = alternative_routes(
-                free, s_cell, g_cell, alternatives, ALTERNATIVE_SLACK, apart, CORNER_BAND_SLACK
-            )
-            if routes and _corner_fits(int(near.sum()), corner_reach, terminate):
-                a = start if not s_hop else np.asarray(lat.centre(s_cell))
-                b = goal if not g_hop else np.asarray(lat.centre(g_cell))
-                # Over the cells of the routes within the slack: the corner lattice's work
-                # follows the corridors worth telling apart, not the whole map.
-                routes = routes + corner_routes(lat, free & near, ((s_cell, a), (g_cell, b)),
-                                                alternatives, ALTERNATIVE_SLACK, apart,
-                                                corner_reach)  # fmt: skip
+        routes = _routes(lat, free, n_free, (s_cell, s_hop), (g_cell, g_hop), start, goal,
+                         alternatives, terminate, corner_reach)  # fmt: skip
     stages["route"] = stages.get("route", 0.0) + time.perf_counter() - t1
     if not routes:
         return done("no route through the lattice", lattice=lat, cells=n_free)
@@ -180,6 +166,29 @@ def route_and_funnel(model, lat, free, start, goal, alternatives, terminate, t0,
     path, length, n_route, which = best
     return CorridorResult(path, length, lat, n_free, n_route, time.perf_counter() - t0, "",
                           stages, len(routes), which)  # fmt: skip
+
+
+def _routes(lat, free, n_free: int, s_end, g_end, start, goal, alternatives: int, terminate,
+            corner_reach: int):  # fmt: skip
+    """The cell lattice's routes and, where its band fits the time, the corner lattice's
+    (:mod:`.corner_routes`), between the entry cells ``s_end`` and ``g_end`` (``(cell, hop)``)."""
+    (s_cell, s_hop), (g_cell, g_hop) = s_end, g_end
+    apart = max(3.0, ALTERNATIVE_APART * math.hypot(lat.nx, lat.ny))
+    # The band comes with the alternatives' search from both ends; alone, it doubles the
+    # search, worth it only where the whole lattice would fit the corner lattice's time.
+    if not corner_reach or (not alternatives and not _corner_fits(n_free, corner_reach,
+                                                                      terminate)):  # fmt: skip
+        return alternative_routes(free, s_cell, g_cell, alternatives, ALTERNATIVE_SLACK, apart)
+    routes, near = alternative_routes(free, s_cell, g_cell, alternatives, ALTERNATIVE_SLACK, apart,
+                                      CORNER_BAND_SLACK)  # fmt: skip
+    if not routes or not _corner_fits(int(near.sum()), corner_reach, terminate):
+        return routes
+    a = start if not s_hop else np.asarray(lat.centre(s_cell))
+    b = goal if not g_hop else np.asarray(lat.centre(g_cell))
+    # Over the cells of the routes within the slack: the corner lattice's work follows the
+    # corridors worth telling apart, not the whole map.
+    return routes + corner_routes(lat, free & near, ((s_cell, a), (g_cell, b)), alternatives,
+                                  ALTERNATIVE_SLACK, apart, corner_reach)  # fmt: skip
 
 
 def _corner_fits(cells: int, reach: int, terminate) -> bool:

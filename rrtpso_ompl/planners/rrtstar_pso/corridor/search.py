@@ -94,10 +94,8 @@ def find_corridor_path(
 
     A map whose fine lattice fits the time (:data:`DIRECT_CELLS_PER_SECOND`) is searched whole
     (:func:`route_and_funnel`), with the corner lattice's routes where their band fits
-    (:mod:`.corner_routes`); one that fits only by the no-route time
-    (:data:`LEAN_CELLS_PER_SECOND`) by its shortest route alone. A disc narrower than a map
-    cell whose lattice would close one-cell gaps goes through :func:`_thin_disc_corridors`
-    first. Otherwise:
+    (:mod:`.corner_routes`). A disc narrower than a map cell whose lattice would close one-cell
+    gaps goes through :func:`_thin_disc_corridors` first. Otherwise:
 
     1. **Coarse routes** on a lattice small enough to route on in a third of the time
        (:data:`CELLS_PER_SECOND`), its cells open generously (a map's when any fine cell they
@@ -108,7 +106,8 @@ def find_corridor_path(
        over them and its funnel path. The shortest valid path wins.
 
     With no route yet, the search may go on until ``no_route_seconds`` (nothing is left for the
-    later stages to refine meanwhile): a map's whole fine lattice if it fits, then, for free
+    later stages to refine meanwhile): a map's whole fine lattice by its shortest route alone if
+    it fits (:data:`LEAN_CELLS_PER_SECOND`), then, for free
     space too thin for any wholly free fine cell, :func:`centre_route`.
 
     Marking a lattice's cells stops at the deadline too (:meth:`World.marking_stops
@@ -223,8 +222,9 @@ def _map_corridors(model, fine_cells, route_cells, start, goal, alternatives, te
                    stages, left) -> CorridorResult:  # fmt: skip
     """:func:`search` on a map: the fine cells marked once, searched whole when the time
     ``left()`` affords it (:data:`DIRECT_CELLS_PER_SECOND`), else pooled into a coarse lattice;
-    when no coarse corridor holds a fine route, the whole fine lattice without alternatives if
-    it still fits."""
+    when no coarse corridor holds a fine route, the whole fine lattice's shortest route alone if
+    it fits by the no-route time. A thin disc whose gaps this lattice closes first goes through
+    :func:`_thin_disc_corridors`."""
     fine = model.lattice(fine_cells)
     if fine.nx < 2 or fine.ny < 2:
         return CorridorResult(None, reason="the lattice is too small")
@@ -239,22 +239,17 @@ def _map_corridors(model, fine_cells, route_cells, start, goal, alternatives, te
     stages["cells"] = time.perf_counter() - t0
     k = max(1, math.ceil(math.sqrt(fine.n_cells / route_cells)))
     nx, ny = fine.nx // k, fine.ny // k
-    direct = k == 1 or nx < 2 or ny < 2 or fine.n_cells <= DIRECT_CELLS_PER_SECOND * left()
-    # Too little time for the whole lattice with alternatives, enough for its shortest route by
-    # the time a stage with no route may take: better than pooling, which opens gaps through
-    # walls a cell thick (in a maze every coarse route then fails at the fine level).
-    lean = not direct and fine.n_cells <= LEAN_CELLS_PER_SECOND * terminate.grace_left()
-    if lean:
-        terminate = _Deadline(terminate.grace_end, terminate.terminate)
-        alternatives = 0
-    if direct or lean:
-        reach = CORNER_REACH if direct else 0  # where its band fits the time (route_and_funnel)
+    if k == 1 or nx < 2 or ny < 2 or fine.n_cells <= DIRECT_CELLS_PER_SECOND * left():
         return route_and_funnel(model, fine, free, start, goal, alternatives, terminate, t0,
-                                stages, corner_reach=reach)  # fmt: skip
+                                stages, corner_reach=CORNER_REACH)  # fmt: skip
     result = _pooled_corridors(model, fine, free, k, start, goal, alternatives, terminate, t0,
                                stages)  # fmt: skip
-    if result.path is None and fine.n_cells <= DIRECT_CELLS_PER_SECOND * left():
-        return route_and_funnel(model, fine, free, start, goal, 0, terminate, t0, stages)
+    # No coarse corridor held a fine route (pooling opens gaps through walls a cell thick: in a
+    # maze every coarse route fails at the fine level): the whole fine lattice's shortest route
+    # alone, if it fits by the time a stage with no route may take.
+    if result.path is None and fine.n_cells <= LEAN_CELLS_PER_SECOND * terminate.grace_left():
+        grace = _Deadline(terminate.grace_end, terminate.terminate)
+        return route_and_funnel(model, fine, free, start, goal, 0, grace, t0, stages)
     return result
 
 
@@ -301,11 +296,15 @@ def _thin_disc_corridors(model, max_cells, start, goal, alternatives, terminate,
     gap = raster.resolution - 2.0 * model.robot_radius
     k = min(THIN_SPLIT, max(4, math.ceil(2.0 * raster.resolution / gap)))
 
+    # The coarse cells are the map's: their index in the map's cell grid.
+    mi = round((coarse.origin[0] - raster.origin[0]) / raster.resolution)
+    mj = round((coarse.origin[1] - raster.origin[1]) / raster.resolution)
+
     def fine_band(r0, r1, c0, c1, mask):
         box = Lattice((coarse.origin[0] + r0 * coarse.h, coarse.origin[1] + c0 * coarse.h),
                       coarse.h / k, (r1 - r0) * k, (c1 - c0) * k)  # fmt: skip
-        near = np.repeat(np.repeat(mask, k, axis=0), k, axis=1)
-        return box, model.free_cells(box, near), k
+        # Marked in the band's cells only (a diagonal band's box may be most of the map).
+        return box, raster.thin_free_cells(mi + r0, mj + c0, mask, k, model.threshold), k
 
     return _corridors(model, coarse, point, fine_band, start, goal, alternatives, terminate,
                       t0, stages, band_cells=1)  # fmt: skip
@@ -371,8 +370,9 @@ def _corridors(model, coarse: Lattice, opened, fine_band, start, goal, alternati
                                   "a free lattice cell")  # fmt: skip
         ends.append(cell)
     t1 = time.perf_counter()
-    if coarse.n_cells > DIRECT_CELLS_PER_SECOND * terminate.left():
-        alternatives = 0  # too little time for them (a thin disc's "coarse" lattice is the map)
+    if coarse.n_cells > 0.5 * DIRECT_CELLS_PER_SECOND * terminate.left():
+        alternatives = 0  # too little time for them and the bands (a thin disc's coarse cells
+        # are the map's)
     apart = max(3.0, ALTERNATIVE_APART * math.hypot(nx, ny))
     routes = alternative_routes(opened, ends[0], ends[1], alternatives, ALTERNATIVE_SLACK, apart)
     reach = _reach(coarse.n_cells, terminate.left)
