@@ -234,3 +234,22 @@ def test_a_map_that_fits_only_by_the_no_route_time_is_searched_by_its_shortest_r
     assert found.path is not None and world.path_valid(found.path)
     assert found.routes == 1  # the shortest alone
     assert found.length == pytest.approx(best, rel=1e-3)
+
+
+def test_a_wider_disc_is_routed_through_the_map_cells_whose_centre_keeps_its_radius(tmp_path):
+    """A disc of 1.2 cells among rooms: a lattice of half cells (what 0.1 s affords) closes the
+    doors, where a whole half cell does not fit between the radius and the jamb; over the map
+    cells whose centre keeps the radius, each route searched again on quarter cells, the doors
+    are open. No clock decides: the deadline is far ahead."""
+    problem, world, best = _generated(tmp_path, "rooms_map", 501, 0, cells=128,
+                                      robot_radius=100 / 128 * 1.2)  # fmt: skip
+    half = world.lattice(1 << 16)  # cells of half a map cell
+    assert half.h == pytest.approx(0.5 * world.raster.resolution)
+    start, goal = np.asarray(problem.start), np.asarray(problem.goal)
+    closed = paths.route_and_funnel(world, half, world.free_cells(half), start, goal, 0, None,
+                                    0.0, {})  # fmt: skip
+    assert closed.path is None
+    deadline = search._Deadline(1e18)
+    found = search._disc_corridors(world, 1 << 20, start, goal, 3, deadline, 0.0, {})
+    assert world.path_valid(found.path)
+    assert best * (1 - 1e-9) <= found.length <= best * 1.02

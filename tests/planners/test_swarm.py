@@ -448,8 +448,9 @@ def test_a_deadline_stops_the_swarm_before_an_evaluation_that_would_end_after_it
 
 
 def test_the_first_evaluation_of_a_swarm_with_a_deadline_stops_between_particles():
-    """Nothing is measured before the first evaluation: it runs a few particles at a time and
-    leaves the rest unevaluated (never the best) when the next few would end too late."""
+    """Nothing is measured before the first evaluation: it runs a few particles at a time (the
+    seed and one drawn particle first) and leaves the rest unevaluated (never the best) when the
+    next few would end too late."""
     import time
 
     calls = []
@@ -465,7 +466,7 @@ def test_the_first_evaluation_of_a_swarm_with_a_deadline_stops_between_particles
     init[1:] = 0.5
     res = minimize(slow, lo, hi, opts, np.random.default_rng(0), init=init,
                    deadline=time.perf_counter() + 0.3)  # fmt: skip
-    assert calls == [8] and res.stopped_by == "deadline" and res.n_iterations == 0
+    assert calls == [2] and res.stopped_by == "deadline" and res.n_iterations == 0
     assert res.cost == 0.0 and np.array_equal(res.position, [0.0, 0.0])  # the seed particle
     # Costs come out the same whether the swarm is evaluated at once or in parts.
     a = minimize(sphere, lo, hi, opts, np.random.default_rng(3), deadline=time.perf_counter() + 60)
@@ -494,3 +495,29 @@ def test_blocks_are_independent_swarms_that_beat_one_swarm_over_everything():
     assert np.all(np.diff(split.history) <= 0)  # the summed best never rises
     with pytest.raises(ValueError, match="blocks"):
         minimize(per_block, lo, hi, opts, np.random.default_rng(1), blocks=5)
+
+
+def test_an_iteration_near_the_deadline_stops_between_particles(monkeypatch):
+    """An evaluation's cost varies with where the particles went: near the end an iteration
+    goes a few particles at a time, so one that turns slow stops between chunks (the costs
+    measured count, the rest are never a best) instead of running past the deadline. The clock
+    is the cost function's own: no machine's speed decides."""
+    from rrtpso_ompl.planners.pso import swarm as swarm_module
+
+    clock = [0.0]
+    monkeypatch.setattr(swarm_module.time, "perf_counter", lambda: clock[0])
+    calls = []
+
+    def turning_slow(x):  # 0.1 ms a particle, then 10 ms once past 0.25 s
+        calls.append(len(x))
+        clock[0] += len(x) * (1e-4 if clock[0] < 0.25 else 1e-2)
+        return sphere(x)
+
+    opts = PSOOptions(swarm_size=30, iterations=10_000, tolerance=0.0)
+    lo, hi = -np.ones(2), np.ones(2)
+    res = minimize(turning_slow, lo, hi, opts, np.random.default_rng(0), deadline=0.3)
+    assert res.stopped_by == "deadline"
+    # Late by at most one chunk (of at most 8 particles) measured at the old speed.
+    assert clock[0] <= 0.3 + swarm_module._MAX_CHUNK * 1e-2 + 1e-9
+    assert swarm_module._FIRST_CHUNK in calls[1:]  # the iterations near the end went in chunks
+    assert np.isfinite(res.cost) and res.n_iterations > 10

@@ -153,7 +153,9 @@ def minimize(
         then returns ``(n_particles, blocks)``.
     deadline : float, optional
         ``time.perf_counter()`` seconds: the run stops before an iteration whose evaluation, as
-        long as the last one, would end after it (an evaluation cannot be interrupted).
+        long as the last one, would end after it; the first evaluation, and those near the end,
+        go a few particles at a time and stop between them (an evaluation cannot be
+        interrupted, and its cost varies with where the particles went).
 
     Returns
     -------
@@ -166,7 +168,7 @@ def minimize(
     def evaluate(pos: np.ndarray) -> np.ndarray:
         return np.asarray(cost(pos), dtype=float).reshape(len(pos), blocks)
 
-    f, cut, t_eval = _first_evaluation(evaluate, x, deadline, blocks)
+    f, cut, t_eval = _first_evaluation(evaluate, x, deadline)
     best = _Bests.start(x, f, blocks)
     history = [best.cost]
     stopped_by = "deadline"
@@ -196,14 +198,14 @@ def _checked_box(lower, upper, blocks: int, v_max: float | None):
     return lower, upper
 
 
-def _first_evaluation(evaluate, x: np.ndarray, deadline: float | None, blocks: int):
+def _first_evaluation(evaluate, x: np.ndarray, deadline: float | None):
     """The first swarm's costs, whether the deadline cut it short, and its seconds."""
     t_eval = time.perf_counter()
     cut = False
     if deadline is None:
         f = evaluate(x)
     else:
-        f, cut = _first_costs(evaluate, x, deadline, blocks)
+        f, cut = _costs(evaluate, x, deadline)
     return f, cut, time.perf_counter() - t_eval
 
 
@@ -218,14 +220,20 @@ def _iterate(evaluate, x, v, best: _Bests, history: list, options: PSOOptions, r
     for k in range(1, options.iterations + 1):
         if terminate is not None and terminate():
             return "terminate"
-        if deadline is not None and time.perf_counter() + t_eval > deadline:
+        now = time.perf_counter()
+        if deadline is not None and now + t_eval > deadline:
             return "deadline"
         x, v = _move(x, v, best, w, options, rng, lower, upper, v_max)
-        t_eval = time.perf_counter()
-        f = evaluate(x)
-        t_eval = time.perf_counter() - t_eval
+        # Near the end, in chunks: an evaluation's cost varies with where the particles went
+        # (a segment cutting obstacles costs far more to measure), and the last one may be no
+        # guide to the next (a swarm over a 1024 x 1024 map's path overran by 0.3 s).
+        near_end = deadline is not None and now + NEAR_END_EVALUATIONS * t_eval > deadline
+        f, cut = _costs(evaluate, x, deadline) if near_end else (evaluate(x), False)
+        t_eval = time.perf_counter() - now
         best.update(x, f)
         history.append(best.cost)
+        if cut:
+            return "deadline"
         w *= options.w_damping
         if _converged(history, options, k):
             return "tolerance"
@@ -309,23 +317,33 @@ def _by_block(a: np.ndarray, blocks: int) -> np.ndarray:
     return a.reshape(a.shape[0], blocks, -1)
 
 
-#: Particles evaluated at a time in the first evaluation of a swarm with a deadline.
-_FIRST_CHUNK = 8
+#: Particles evaluated first when a swarm with a deadline evaluates in chunks (the seed and one
+#: drawn particle: a drawn particle's segments may cut obstacles, whose exact violation costs far
+#: more than the seed's check); later chunks double, up to :data:`_MAX_CHUNK`.
+_FIRST_CHUNK = 2
+_MAX_CHUNK = 8
+
+#: An iteration evaluates in chunks (:func:`_costs`) once the deadline is within this many of
+#: the last evaluation's durations (an evaluation may cost ten times the last one when the
+#: particles move onto obstacles; cheap ones are chunked only in their last milliseconds).
+NEAR_END_EVALUATIONS = 20.0
 
 
-def _first_costs(
-    cost: CostFunction, x: np.ndarray, deadline: float, blocks: int = 1
-) -> tuple[np.ndarray, bool]:
-    """The costs of the initial swarm, a few particles at a time, and whether they were cut
-    short (``inf`` for the rest) because the next few would end after ``deadline``: with
-    nothing measured yet, this bounds how far the first evaluation can overrun. Particle 0 (the
-    seed, when there is one) comes first. The costs are those of one call: each particle's
-    depends on it alone."""
-    f = np.full((len(x), blocks), np.inf)
-    for c0 in range(0, len(x), _FIRST_CHUNK):
+def _costs(cost: CostFunction, x: np.ndarray, deadline: float) -> tuple[np.ndarray, bool]:
+    """The swarm's costs, a few particles at a time, and whether they were cut short (``inf``,
+    never a best, for the rest) because the next chunk, at the last one's cost per particle,
+    would end after ``deadline``: this bounds how far an evaluation can overrun by about one
+    particle's evaluation. Particle 0 (the seed, when there is one) comes first. The costs are
+    those of one call: each particle's depends on it alone."""
+    parts: list[np.ndarray] = []
+    c0, size = 0, _FIRST_CHUNK
+    while c0 < len(x):  # at most len(x) chunks
         t = time.perf_counter()
-        f[c0 : c0 + _FIRST_CHUNK] = cost(x[c0 : c0 + _FIRST_CHUNK])
+        parts.append(cost(x[c0 : c0 + size]))
         now = time.perf_counter()
-        if c0 + _FIRST_CHUNK < len(x) and now + (now - t) > deadline:
-            return f, True
-    return f, False
+        per_particle = (now - t) / len(parts[-1])
+        c0, size = c0 + size, min(2 * size, _MAX_CHUNK)
+        if c0 < len(x) and now + per_particle * min(size, len(x) - c0) > deadline:
+            parts.append(np.full((len(x) - c0, parts[0].shape[1]), np.inf))
+            return np.concatenate(parts), True
+    return np.concatenate(parts), False

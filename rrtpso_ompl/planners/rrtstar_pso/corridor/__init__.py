@@ -31,7 +31,7 @@ corridor at once, at the resolution of a lattice:
    map cell wide once the disc is wider than a quarter cell. With the radius under half a cell,
    two blocked cells close the way between them exactly when they touch, so the corridors are
    the point robot's: routes over the map's free cells, each searched again on cells fine enough
-   for the gap (:func:`.search._thin_disc_corridors`) and wrapped round the wall corners.
+   for the gap (:func:`.search._disc_corridors`) and wrapped round the wall corners.
 
 The path stays inside cells that are wholly free, so it is valid without further checks; it is
 checked once anyway (exactly, or through the user's checker, whose lattice answers are not

@@ -75,7 +75,7 @@ SHAPE_SPLIT = 4
 
 
 #: For a disc narrower than a map cell, the most fine cells per map cell side in the bands
-#: (:func:`_thin_disc_corridors`): at 16, gaps are kept open for a radius up to 7/16 of a cell
+#: (:func:`_disc_corridors`): at 16, gaps are kept open for a radius up to 7/16 of a cell
 #: (wider discs through the free cell centres of the band).
 THIN_SPLIT = 16
 
@@ -95,7 +95,8 @@ def find_corridor_path(
     A map whose fine lattice fits the time (:data:`DIRECT_CELLS_PER_SECOND`) is searched whole
     (:func:`route_and_funnel`), with the corner lattice's routes where their band fits
     (:mod:`.corner_routes`). A disc narrower than a map cell whose lattice would close one-cell
-    gaps goes through :func:`_thin_disc_corridors` first. Otherwise:
+    gaps goes through :func:`_disc_corridors` first (a wider disc whose doors the lattice
+    closes, after). Otherwise:
 
     1. **Coarse routes** on a lattice small enough to route on in a third of the time
        (:data:`CELLS_PER_SECOND`), its cells open generously (a map's when any fine cell they
@@ -105,9 +106,10 @@ def find_corridor_path(
        coarse cells of it (marked in a box round the band: the work follows the band), the route
        over them and its funnel path. The shortest valid path wins.
 
-    With no route yet, the search may go on until ``no_route_seconds`` (nothing is left for the
-    later stages to refine meanwhile): a map's whole fine lattice by its shortest route alone if
-    it fits (:data:`LEAN_CELLS_PER_SECOND`), then, for free
+    A map lattice that fits only by ``no_route_seconds`` is searched by its shortest route alone
+    (:data:`LEAN_CELLS_PER_SECOND`). With no route yet, the search may go on until
+    ``no_route_seconds`` (nothing is left for the later stages to refine meanwhile): a map's
+    whole fine lattice if it fits, then, for free
     space too thin for any wholly free fine cell, :func:`centre_route`.
 
     Marking a lattice's cells stops at the deadline too (:meth:`World.marking_stops
@@ -221,18 +223,17 @@ def _coarse_tries(model, start, goal, max_cells, alternatives, out_of_time, firs
 def _map_corridors(model, fine_cells, route_cells, start, goal, alternatives, terminate, t0,
                    stages, left) -> CorridorResult:  # fmt: skip
     """:func:`search` on a map: the fine cells marked once, searched whole when the time
-    ``left()`` affords it (:data:`DIRECT_CELLS_PER_SECOND`), else pooled into a coarse lattice;
-    when no coarse corridor holds a fine route, the whole fine lattice's shortest route alone if
-    it fits by the no-route time. A thin disc whose gaps this lattice closes first goes through
-    :func:`_thin_disc_corridors`."""
+    ``left()`` affords it (:data:`DIRECT_CELLS_PER_SECOND`), else by its shortest route alone if
+    that fits by the no-route time (:data:`LEAN_CELLS_PER_SECOND`), else pooled into a coarse
+    lattice. A thin disc whose gaps this lattice closes first goes through
+    :func:`_disc_corridors`, as does a wider one the lattice finds no route for."""
     fine = model.lattice(fine_cells)
     if fine.nx < 2 or fine.ny < 2:
         return CorridorResult(None, reason="the lattice is too small")
+    grace = _Deadline(terminate.grace_end, terminate.terminate)
     if _closes_thin_gaps(model, fine):
         # No route yet (the lattice of this time would close the gaps): up to the grace time.
-        grace = _Deadline(terminate.grace_end, terminate.terminate)
-        thin = _thin_disc_corridors(model, fine_cells, start, goal, alternatives, grace, t0,
-                                    stages)  # fmt: skip
+        thin = _disc_corridors(model, fine_cells, start, goal, alternatives, grace, t0, stages)
         if thin.path is not None or terminate():
             return thin
     free = model.free_cells(fine)
@@ -240,16 +241,24 @@ def _map_corridors(model, fine_cells, route_cells, start, goal, alternatives, te
     k = max(1, math.ceil(math.sqrt(fine.n_cells / route_cells)))
     nx, ny = fine.nx // k, fine.ny // k
     if k == 1 or nx < 2 or ny < 2 or fine.n_cells <= DIRECT_CELLS_PER_SECOND * left():
-        return route_and_funnel(model, fine, free, start, goal, alternatives, terminate, t0,
-                                stages, corner_reach=CORNER_REACH)  # fmt: skip
-    result = _pooled_corridors(model, fine, free, k, start, goal, alternatives, terminate, t0,
-                               stages)  # fmt: skip
-    # No coarse corridor held a fine route (pooling opens gaps through walls a cell thick: in a
-    # maze every coarse route fails at the fine level): the whole fine lattice's shortest route
-    # alone, if it fits by the time a stage with no route may take.
-    if result.path is None and fine.n_cells <= LEAN_CELLS_PER_SECOND * terminate.grace_left():
-        grace = _Deadline(terminate.grace_end, terminate.terminate)
-        return route_and_funnel(model, fine, free, start, goal, 0, grace, t0, stages)
+        result = route_and_funnel(model, fine, free, start, goal, alternatives, terminate, t0,
+                                  stages, corner_reach=CORNER_REACH)  # fmt: skip
+    elif fine.n_cells <= LEAN_CELLS_PER_SECOND * terminate.grace_left():
+        # Too little time for the whole lattice with alternatives, enough for its shortest route
+        # by the time a stage with no route may take: better than pooling, which opens gaps
+        # through walls a cell thick (in a 256 x 256 maze at 0.1 s every coarse route then
+        # failed at the fine level and left no time; on open 1024 x 1024 maps the two measured
+        # alike).
+        result = route_and_funnel(model, fine, free, start, goal, 0, grace, t0, stages)
+    else:
+        result = _pooled_corridors(model, fine, free, k, start, goal, alternatives, terminate,
+                                   t0, stages)  # fmt: skip
+    if result.path is None and model.robot_radius > 0.0 and not grace():
+        # A disc's doors closed by this lattice's cells (too coarse for the time): routes over
+        # the map's cells whose centre keeps the radius, each searched again on finer cells.
+        wide = _disc_corridors(model, fine_cells, start, goal, alternatives, grace, t0, stages)
+        if wide.path is not None:
+            return wide
     return result
 
 
@@ -270,32 +279,41 @@ def _closes_thin_gaps(model, lat: Lattice) -> bool:
     return (first + 1) * h > res - r + 1e-9 * res
 
 
-def _thin_disc_corridors(model, max_cells, start, goal, alternatives, terminate, t0,
-                         stages) -> CorridorResult:  # fmt: skip
-    """A disc robot narrower than a map cell: corridors over the map's own cells no obstacle
-    enters, each searched again on cells fine enough for the gaps the disc fits through.
+def _disc_corridors(model, max_cells, start, goal, alternatives, terminate, t0,
+                    stages) -> CorridorResult:  # fmt: skip
+    """A disc robot on a map: corridors over the map's own cells, each searched again on cells
+    fine enough for the gaps the disc fits through, marked in its band only.
 
     The lattice of cells wholly free *for the disc* closes a gap one map cell wide (free width
     ``res - 2 r`` for the robot's centre) unless a whole fine cell fits in that width: at a
     quarter of a map cell, not for a radius over a quarter cell. With the radius under half a
-    map cell, two blocked cells close the way between them exactly when they touch (any other
-    pair is a cell apart, more than ``2 r``): the disc's corridors are the point robot's, the
-    routes over the map's free cells (a diagonal needs a free cell beside it). Each corridor is
-    then searched on cells of at most half the gap's free width (:data:`THIN_SPLIT` at most per
-    map cell), marked in its band only. No path (reason given) for any other robot or world.
+    map cell (a *thin* disc), two blocked cells close the way between them exactly when they
+    touch (any other pair is a cell apart, more than ``2 r``): the disc's corridors are the
+    point robot's, the routes over the map's free cells (a diagonal needs a free cell beside
+    it), each searched again on cells of at most half the gap's free width (:data:`THIN_SPLIT`
+    at most per map cell, :meth:`MapRaster.thin_free_cells
+    <rrtpso_ompl.model.raster.MapRaster.thin_free_cells>`). A wider disc is routed over the map
+    cells whose centre keeps its radius (a door's middle cells do), each route searched again
+    on cells a quarter of a map cell. No path (reason given) for any other robot or world.
     """
     raster = getattr(model, "raster", None)
-    if raster is None or not 0.0 < 2.0 * model.robot_radius < raster.resolution:
-        return CorridorResult(None, reason="not a disc narrower than a map cell on a map")
+    r = model.robot_radius
+    if raster is None or not r > 0.0:
+        return CorridorResult(None, reason="not a disc on a map")
     coarse = model.lattice(max_cells, split=1)
     point = model.point_free_cells(coarse)
     if point is None or coarse.h != raster.resolution or coarse.nx < 2 or coarse.ny < 2:
         return CorridorResult(None, reason="not a map alone at its own cells")
     if coarse.n_cells > LEAN_CELLS_PER_SECOND * terminate.grace_left():
         return CorridorResult(None, reason="too little time to route over the map's cells")
-    gap = raster.resolution - 2.0 * model.robot_radius
-    k = min(THIN_SPLIT, max(4, math.ceil(2.0 * raster.resolution / gap)))
-
+    thin = 2.0 * r < raster.resolution
+    if thin:
+        k = min(
+            THIN_SPLIT, max(4, math.ceil(2.0 * raster.resolution / (raster.resolution - 2 * r)))
+        )
+        opened = point
+    else:
+        k, opened = 4, model.centres_free(coarse)
     # The coarse cells are the map's: their index in the map's cell grid.
     mi = round((coarse.origin[0] - raster.origin[0]) / raster.resolution)
     mj = round((coarse.origin[1] - raster.origin[1]) / raster.resolution)
@@ -303,10 +321,11 @@ def _thin_disc_corridors(model, max_cells, start, goal, alternatives, terminate,
     def fine_band(r0, r1, c0, c1, mask):
         box = Lattice((coarse.origin[0] + r0 * coarse.h, coarse.origin[1] + c0 * coarse.h),
                       coarse.h / k, (r1 - r0) * k, (c1 - c0) * k)  # fmt: skip
-        # Marked in the band's cells only (a diagonal band's box may be most of the map).
-        return box, raster.thin_free_cells(mi + r0, mj + c0, mask, k, model.threshold), k
+        if thin:  # marked in the band's cells only (a diagonal band's box may be most of the map)
+            return box, raster.thin_free_cells(mi + r0, mj + c0, mask, k, model.threshold), k
+        return box, model.free_cells(box, np.repeat(np.repeat(mask, k, axis=0), k, axis=1)), k
 
-    return _corridors(model, coarse, point, fine_band, start, goal, alternatives, terminate,
+    return _corridors(model, coarse, opened, fine_band, start, goal, alternatives, terminate,
                       t0, stages, band_cells=1)  # fmt: skip
 
 
