@@ -325,8 +325,17 @@ def _disc_corridors(model, max_cells, start, goal, alternatives, terminate, t0,
             return box, raster.thin_free_cells(mi + r0, mj + c0, mask, k, model.threshold), k
         return box, model.free_cells(box, np.repeat(np.repeat(mask, k, axis=0), k, axis=1)), k
 
-    return _corridors(model, coarse, opened, fine_band, start, goal, alternatives, terminate,
-                      t0, stages, band_cells=1)  # fmt: skip
+    quick = CorridorResult(None)
+    t1 = time.perf_counter()
+    if thin:
+        # First the shortest route over the map's cells wrapped round its wall corners (cheap:
+        # the map's own cells), then, while twice its time is left, the bands' finer searches.
+        quick = route_and_funnel(model, coarse, point, start, goal, 0, terminate, t0, stages)
+        if quick.path is not None and terminate.left() < 2.0 * (time.perf_counter() - t1):
+            return quick
+    banded = _corridors(model, coarse, opened, fine_band, start, goal, alternatives, terminate,
+                        t0, stages, band_cells=1)  # fmt: skip
+    return banded if banded.path is not None and banded.length < quick.length else quick
 
 
 def _pooled_corridors(model, fine, free, k, start, goal, alternatives, terminate, t0,
