@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pytest
 from helpers import REPO as ROOT
 
 from rrtpso_ompl.harness.bench import overview_markdown, read_report_csv
@@ -145,3 +146,21 @@ def test_the_turned_maps_report_finds_the_unturned_optimum_on_every_turned_map()
         cells = [c.strip().split(" ")[0] for c in row.strip("|").split("|")[1:]]
         assert cells[0] == cells[1] and cells[2] == cells[3], row
     assert "(turned-maps.md)" in (DOCS / "problem-format.md").read_text()
+
+
+@pytest.mark.parametrize("name", ["real-maps", "real-maps-fresh"])
+def test_benchmarking_guide_quotes_the_real_map_reports_verbatim(name):
+    """docs/benchmarking.md repeats the pooled tables of docs/real-maps*.md (written by
+    benchmarks/real_maps.py, issue 37); every path of their runs was valid and none failed."""
+    import json
+
+    report = (DOCS / f"{name}.md").read_text()
+    guide = (DOCS / "benchmarking.md").read_text()
+    tables = [b for b in report.split("\n\n") if b.startswith("| planner |")]
+    assert len(tables) == 2  # 1 s and 0.1 s
+    for table in tables:
+        assert table in guide
+    rows = [json.loads(line) for line in (DOCS / f"{name}.jsonl").read_text().splitlines()]
+    assert {r["budget"] for r in rows} == {1.0, 0.1}
+    assert not [r for r in rows if r["solved"] and not r["valid"]]
+    assert not [r for r in rows if r.get("error")]
