@@ -212,7 +212,6 @@ def report(rows: list[dict], args, seeds, planners) -> list[str]:
         f"{args.set} part of problems/ (see docs/benchmarking.md). *Deadline*: RRTstarPSO's "
         "largest planning time over the budget.",
     ]
-    invalid = [r for r in rows if r.get("solved") and not r.get("valid")]
     for budget in args.time:
         table, behind = summary(rows, budget, planners)
         lines += [
@@ -225,12 +224,16 @@ def report(rows: list[dict], args, seeds, planners) -> list[str]:
             + ("; ".join(behind) if behind else "nowhere")
             + ".",
         ]
-    lines += ["", f"Invalid paths: {len(invalid)}."]
+    return lines + footer(rows)
+
+
+def footer(rows: list[dict]) -> list[str]:
+    """A report's last lines: invalid paths and failed runs (the first 20 named)."""
+    invalid = [r for r in rows if r.get("solved") and not r.get("valid")]
     errors = [r for r in rows if r.get("error")]
-    lines += [f"Failed runs: {len(errors)}."] + [
+    return ["", f"Invalid paths: {len(invalid)}.", f"Failed runs: {len(errors)}."] + [
         f"- {r['file']} {r['planner']} {r['budget']:g} s: {r['error']}" for r in errors[:20]
     ]
-    return lines
 
 
 def main(argv: list[str] | None = None) -> int:

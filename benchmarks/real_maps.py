@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from families import in_child, percentile, run_one, summary
+from families import footer, in_child, percentile, run_one, summary
 
 #: Families: ``rrtpso generate`` kind and options.
 FAMILIES = {
@@ -175,7 +175,6 @@ def report(rows: list[dict], args, seeds) -> list[str]:
         "a process of its own. Path length over the exact optimum; every path was checked valid "
         "with the exact checker. *Deadline*: RRTstarPSO's largest planning time over the budget.",
     ]
-    invalid = [r for r in rows if r.get("solved") and not r.get("valid")]
     for budget in args.time:
         head = ["planner", "runs", "solved", "median", "p90", "worst"]
         body = []
@@ -201,12 +200,7 @@ def report(rows: list[dict], args, seeds) -> list[str]:
             + ("; ".join(behind) if behind else "nowhere")
             + ".",
         ]
-    lines += ["", f"Invalid paths: {len(invalid)}."]
-    errors = [r for r in rows if r.get("error")]
-    lines += [f"Failed runs: {len(errors)}."] + [
-        f"- {r['file']} {r['planner']} {r['budget']:g} s: {r['error']}" for r in errors[:20]
-    ]
-    return lines
+    return lines + footer(rows)
 
 
 def main(argv: list[str] | None = None) -> int:
