@@ -265,6 +265,10 @@ def shortcut(
 # ----------------------------------------------------------------------------------------------
 def segment_box_distance_xy(ax, ay, bx, by, x0, y0, x1, y1) -> float:
     """Exact distance from segment a-b to the closed box [x0, x1] x [y0, y1] (0 when they meet)."""
+    # Python floats: a segment a denormal long divides to inf, which the clipping handles, where a
+    # numpy scalar would warn of an overflow.
+    ax, ay, bx, by = float(ax), float(ay), float(bx), float(by)
+    x0, y0, x1, y1 = float(x0), float(y0), float(x1), float(y1)
     # Liang-Barsky: does the segment meet the box?
     dx, dy = bx - ax, by - ay
     t0, t1 = 0.0, 1.0

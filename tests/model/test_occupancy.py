@@ -265,3 +265,17 @@ def test_a_map_too_fine_for_its_bounds_is_refused_at_the_documented_minimum(tmp_
     # With bounds of a plannable size the same fine map is fine.
     doc["bounds"] = [[0, 0], [1e-6, 1e-6]]
     assert problem_from_dict(doc, str(tmp_path / "p.yaml")).map.resolution == 1e-9
+
+
+def test_a_denormal_segment_is_measured_without_overflow_warnings():
+    """The case hypothesis found: a segment 2e-313 long, its ends numpy scalars. Its direction
+    divides to inf, which the clipping handles; numpy scalars warned of an overflow."""
+    import warnings
+
+    from rrtpso_ompl.model.geometry import segment_box_distance_xy
+
+    a = np.float64(0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        d = segment_box_distance_xy(a, a, a, np.float64(2.2250738585e-313), -1.0, 1.0, 1.0, 2.0)
+    assert d == pytest.approx(1.0)
