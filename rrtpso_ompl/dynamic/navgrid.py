@@ -20,7 +20,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse.csgraph import dijkstra
 
-from ..model.grid_graph import MOVES_8, grid_graph, move_pairs, walk
+from ..model.grid_graph import MOVES_8, grid_graph, move_pairs, node_dtype, walk
 from ..model.world import World
 
 __all__ = ["MAX_CELLS", "OCTILE", "NavGrid"]
@@ -68,7 +68,8 @@ class NavGrid:
         """The symmetric adjacency of the free cells (8-connected; a diagonal step needs both
         cells beside it free, so the wavefront never slips between two blocked corners)."""
         nx, ny = self.nx, self.ny
-        index = np.where(self.free, np.arange(nx * ny).reshape(nx, ny), -1)
+        nodes = np.arange(nx * ny, dtype=node_dtype(nx * ny)).reshape(nx, ny)
+        index = np.where(self.free, nodes, -1)
         pairs = [move_pairs(index, step, passed) for step, passed, _ in MOVES_8]
         weights = [np.full(len(a), self.h * math.hypot(*step))
                    for (a, _), (step, _, _) in zip(pairs, MOVES_8, strict=True)]  # fmt: skip

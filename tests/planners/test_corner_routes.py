@@ -16,6 +16,7 @@ from scipy.sparse.csgraph import dijkstra
 from rrtpso_ompl.groundtruth.generate import generate_to_file
 from rrtpso_ompl.groundtruth.optimum import shortest_path
 from rrtpso_ompl.model import World, load_problem
+from rrtpso_ompl.model.geometry import path_length
 from rrtpso_ompl.model.raster import Lattice
 from rrtpso_ompl.planners.rrtstar_pso.corridor import corner_routes as cr
 from rrtpso_ompl.planners.rrtstar_pso.corridor import find_corridor_path, paths, search
@@ -253,3 +254,74 @@ def test_a_wider_disc_is_routed_through_the_map_cells_whose_centre_keeps_its_rad
     found = search._disc_corridors(world, 1 << 20, start, goal, 3, deadline, 0.0, {})
     assert world.path_valid(found.path)
     assert best * (1 - 1e-9) <= found.length <= best * 1.02
+
+
+def test_a_point_robots_fine_lattice_is_the_maps_own_cells_whatever_the_time(tmp_path):
+    """A point robot's free cells on a map alone are the map's own free cells, read off the
+    raster at no cost: the fine lattice is the map's, not the coarser one marking other worlds
+    affords in the time (a 1024 x 1024 city map at 1 s kept 26 % of its cells free on the
+    2 x 2-cell lattice, 35 % on its own), when the route over them fits the stage's grace. With
+    no time for marking, the rooms' doors of one map cell stay open and the stage's path is the
+    optimum's; without the grace, and for a disc, the lattice follows the time."""
+    problem, world, best = _generated(tmp_path, "rooms_map", 3, 0, cells=128, robot_radius=0.0,
+                                      door=(1, 1))  # fmt: skip
+    cells = search._map_fine_cells(world, 1 << 22, 1e-6, 1.0)
+    assert world.lattice(cells).h == world.raster.resolution
+    coarse = world.lattice(4096)  # what the time would afford: 2 x 2 map cells
+    assert coarse.h == 2 * world.raster.resolution
+    start, goal = np.asarray(problem.start), np.asarray(problem.goal)
+    assert paths.route_and_funnel(world, coarse, world.free_cells(coarse), start, goal, 0, None,
+                                  0.0, {}).path is None  # fmt: skip
+    deadline = search._Deadline(1e18)
+    found = search._map_corridors(world, cells, cells, start, goal, 3, deadline, 0.0, {},
+                                  deadline.left)  # fmt: skip
+    assert world.path_valid(found.path)
+    assert best * (1 - 1e-9) <= found.length <= best * 1.001
+    disc = World.from_problem(load_problem(
+        generate_to_file("rooms_map", 3, tmp_path / "disc.yaml", cells=128, door=(1, 1),
+                     robot_radius=0.3)))  # fmt: skip
+    assert search._map_fine_cells(world, 1 << 22, 1e-6, 1e-6) == 4096
+    assert search._map_fine_cells(disc, 1 << 22, 1e-6, 1.0) == 4096
+
+
+def test_graphs_number_their_nodes_in_32_bits_while_they_fit():
+    """SciPy keeps 32-bit indices for such graphs; handed 64-bit ones it scans and narrows them
+    (5-9 times the cost of building the graph on a million cells)."""
+    from rrtpso_ompl.model.grid_graph import grid_graph, node_dtype
+    from rrtpso_ompl.planners.rrtstar_pso.corridor import lattice_graph
+
+    assert node_dtype(2**31 - 2) is np.int32 and node_dtype(2**31) is np.int64
+    graph = lattice_graph(np.ones((5, 4), dtype=bool))
+    assert graph.indices.dtype == np.int32 and graph.shape == (20, 20)
+    # every move once: 16 + 15 axis moves, 12 + 12 diagonals, 9 + 8 + 9 + 8 knight's moves
+    assert graph.nnz == 16 + 15 + 24 + 34
+    wide = grid_graph(3, np.array([0, 1], dtype=np.int64), np.array([1, 2]), np.array([1.0, 2.0]))
+    assert wide.indices.dtype == np.int32 and wide[1, 2] == 2.0
+
+
+def test_a_route_found_after_the_stages_deadline_is_still_wrapped_taut(tmp_path):
+    """On a map of a million cells the route alone can take the stage's whole time; the string
+    round its corners (a bounded step) then runs to the planner's outer deadline rather than
+    leaving the staircase of the route's cells (+2 to +25 % measured). The stage's deadline is
+    long past, the outer one never comes: no clock decides."""
+    from rrtpso_ompl.model.grid_graph import entry_cell
+    from rrtpso_ompl.planners.rrtstar_pso.corridor import alternative_routes
+    from rrtpso_ompl.planners.rrtstar_pso.corridor.funnel import FunnelEnds
+
+    problem, world, best = _generated(tmp_path, "rooms_map", 401, 0, cells=128,
+                                      robot_radius=100 / 128 * 0.25)  # fmt: skip
+    lat = world.lattice(1 << 20, split=1)
+    free = world.point_free_cells(lat)
+    start, goal = np.asarray(problem.start), np.asarray(problem.goal)
+    (s_cell, s_hop), (g_cell, g_hop) = (entry_cell(lat, free, p, 2, world.segments_free)
+                                        for p in (start, goal))  # fmt: skip
+    routes = alternative_routes(free, s_cell, g_cell, 0, 0.06, 10.0)
+    ends = FunnelEnds(lat.centre(s_cell) if s_hop else start, lat.centre(g_cell) if g_hop else goal,
+                      start, goal, s_hop, g_hop)  # fmt: skip
+    late = search._Deadline(0.0, lambda: False)  # the stage's time is up, the planner's is not
+    path, length, _, _ = paths._pulled_taut(world, lat, free, routes, ends, late, None)
+    assert world.path_valid(path) and length == pytest.approx(path_length(path))
+    assert best * (1 - 1e-9) <= length <= best * 1.01
+    stop = search._Deadline(0.0, lambda: True)  # both past: the cells' centres, shortcut
+    _, staircase, _, _ = paths._pulled_taut(world, lat, free, routes, ends, stop, None)
+    assert staircase > best * 1.01

@@ -30,8 +30,8 @@ import itertools
 import math
 
 import numpy as np
-from scipy.sparse import coo_matrix
 
+from ....model.grid_graph import grid_graph, node_dtype
 from ....model.raster import Lattice
 from .routes import via_routes
 
@@ -123,7 +123,7 @@ def corner_edges(free: np.ndarray, reach: int = CORNER_REACH):
     nx, ny = free.shape
     shape = (nx + 1, ny + 1)
     nodes = _corner_nodes(free)
-    index = np.arange(shape[0] * shape[1]).reshape(shape)
+    index = np.arange(shape[0] * shape[1], dtype=node_dtype(shape[0] * shape[1] + 2)).reshape(shape)
     tails, heads, weights = [], [], []
     for (a, b), crossed, beside in corner_moves(reach):
         ok = nodes & _shifted(nodes, a, b, shape)
@@ -171,11 +171,8 @@ def corner_routes(lat: Lattice, free: np.ndarray, ends, count: int, slack: float
                 extra_t.append(node)
                 extra_h.append((ci + di) * (ny + 1) + cj + dj)
                 extra_w.append(max(d, 1e-9))  # zero weights are no edges to csgraph
-    graph = coo_matrix(
-        (np.concatenate([weights, extra_w]),
-         (np.concatenate([tails, extra_t]), np.concatenate([heads, extra_h]))),
-        shape=(n + 2, n + 2),
-    ).tocsr()  # fmt: skip
+    graph = grid_graph(n + 2, np.concatenate([tails, extra_t]), np.concatenate([heads, extra_h]),
+                       np.concatenate([weights, extra_w]))  # fmt: skip
     routes = via_routes(graph, (nx + 1, ny + 1), n, n + 1, count, slack, apart)
     out = []
     for route in routes:

@@ -10,7 +10,7 @@ import numpy as np
 from scipy import ndimage
 from scipy.sparse.csgraph import dijkstra
 
-from ....model.grid_graph import MOVES_16, grid_graph, move_pairs, walk
+from ....model.grid_graph import MOVES_16, grid_graph, move_pairs, node_dtype, walk
 from ....model.raster import Lattice
 
 #: Alternative routes are tried when their lattice length is within this share of the best's
@@ -30,7 +30,7 @@ def lattice_graph(free: np.ndarray):
     """The 16-connected graph of the free cells (CSR, undirected; cell ``(i, j)`` is node
     ``i * ny + j``; move lengths in cells)."""
     nx, ny = free.shape
-    index = np.where(free, np.arange(nx * ny).reshape(nx, ny), -1)
+    index = np.where(free, np.arange(nx * ny, dtype=node_dtype(nx * ny)).reshape(nx, ny), -1)
     pairs = [move_pairs(index, step, passed) for step, passed, _ in MOVES_16]
     weights = [np.full(len(a), math.hypot(*step)) for (a, _), (step, _, _) in
                zip(pairs, MOVES_16, strict=True)]  # fmt: skip
