@@ -262,7 +262,7 @@ def test_a_point_robots_fine_lattice_is_the_maps_own_cells_whatever_the_time(tmp
     affords in the time (a 1024 x 1024 city map at 1 s kept 26 % of its cells free on the
     2 x 2-cell lattice, 35 % on its own), when the route over them fits the stage's grace. With
     no time for marking, the rooms' doors of one map cell stay open and the stage's path is the
-    optimum's; without the grace, and for a disc, the lattice follows the time."""
+    optimum's; without the grace the lattice follows the time."""
     problem, world, best = _generated(tmp_path, "rooms_map", 3, 0, cells=128, robot_radius=0.0,
                                       door=(1, 1))  # fmt: skip
     cells = search._map_fine_cells(world, 1 << 22, 1e-6, 1.0)
@@ -281,7 +281,9 @@ def test_a_point_robots_fine_lattice_is_the_maps_own_cells_whatever_the_time(tmp
         generate_to_file("rooms_map", 3, tmp_path / "disc.yaml", cells=128, door=(1, 1),
                      robot_radius=0.3)))  # fmt: skip
     assert search._map_fine_cells(world, 1 << 22, 1e-6, 1e-6) == 4096
-    assert search._map_fine_cells(disc, 1 << 22, 1e-6, 1.0) == 4096
+    # a disc's own cells are marked (a distance transform): they too when that fits the grace
+    assert search._map_fine_cells(disc, 1 << 22, 1e-6, 1.0) == 128 * 128
+    assert search._map_fine_cells(disc, 1 << 22, 1e-6, 1e-3) == 4096
 
 
 def test_graphs_number_their_nodes_in_32_bits_while_they_fit():
@@ -325,3 +327,16 @@ def test_a_route_found_after_the_stages_deadline_is_still_wrapped_taut(tmp_path)
     stop = search._Deadline(0.0, lambda: True)  # both past: the cells' centres, shortcut
     _, staircase, _, _ = paths._pulled_taut(world, lat, free, routes, ends, stop, None)
     assert staircase > best * 1.01
+
+
+def test_pooling_keeps_walls_thicker_than_itself_and_loses_thin_ones():
+    """Pooled corridors (ranked by taut length) only where the walls survive the pooling: a wall
+    one cell thick vanishes in 2 x 2 pooling (coarse routes through it fail at the fine level),
+    a wall four cells thick keeps its inner cells."""
+    thin = np.ones((16, 16), dtype=bool)
+    thin[7, :] = thin[:, 9] = False
+    assert not search._pooling_keeps_walls(thin, 2)
+    thick = np.ones((16, 16), dtype=bool)
+    thick[4:8, :] = thick[:, 8:12] = False
+    assert search._pooling_keeps_walls(thick, 2)
+    assert not search._pooling_keeps_walls(thick, 8)  # coarser than the walls

@@ -206,3 +206,23 @@ def test_obstacles_too_detailed_to_mark_in_time_end_the_stage_at_once():
 
     result = find_corridor_path(_detailed_world(), (5.0, 5.0), (95.0, 95.0), 0.0)
     assert result.path is None and "too slow" in result.reason and result.lattice is None
+
+
+def test_a_wall_corner_passed_on_the_line_between_two_bends_is_pushed_off_too():
+    """Three wall corners on one line, the walls on alternate sides (a zig-zag of zero
+    clearance, common among random blocked cells): the funnel bends at the outer two only.
+    Pushed apart, their segment would cross the middle corner exactly (it touches the wall,
+    which counts as entering); the middle corner becomes a vertex pushed off its own wall."""
+    from rrtpso_ompl.planners.rrtstar_pso.corridor.funnel import push_off_corners
+
+    free = np.ones((5, 4), dtype=bool)
+    free[3, 1] = free[1, 2] = False  # A below the line y = 2, right; B above it, left
+    lat = Lattice((0.0, 0.0), 1.0, 5, 4)
+    # round A's top-left corner (3, 2), along y = 2 past B's bottom-right corner (2, 2), round
+    # B's bottom-left corner (1, 2)
+    path = np.array([(4.5, 2.5), (3.0, 2.0), (1.0, 2.0), (0.5, 1.5)])
+    pushed = push_off_corners(path, lat, free, 1e-3)
+    walls = shapely.union_all([shapely.box(3, 1, 4, 2), shapely.box(1, 2, 2, 3)])
+    assert shapely.LineString(pushed).distance(walls) > 1e-4
+    assert len(pushed) == 5  # the middle corner inserted
+    assert path_length(pushed) == pytest.approx(path_length(path), abs=1e-2)

@@ -109,23 +109,62 @@ def push_off_corners(path: np.ndarray, lat: Lattice, free: np.ndarray, step: flo
 
     For a point robot the funnel's corners lie on the corners of blocked cells, and a segment
     between two corners of one wall runs along it: zero clearance, which counts as entering.
-    Pushed diagonally off the corner, the path keeps a clearance of about ``step``.
+    Pushed diagonally off the corner, the path keeps a clearance of about ``step``. A wall
+    corner a segment passes through between two of its corners (three on one line, the walls
+    on alternate sides: the funnel does not bend there) becomes a vertex first and is pushed
+    off too: pushed apart, the two ends alone would leave the line through it.
     """
+    path = _with_passed_corners(path, lat, free)
     out = path.copy()
-    (ox, oy), h = lat.origin, lat.h
     for k in range(1, len(path) - 1):
-        ci = round((path[k, 0] - ox) / h)
-        cj = round((path[k, 1] - oy) / h)
-        away = np.zeros(2)
-        for di in (-1, 0):
-            for dj in (-1, 0):
-                i, j = ci + di, cj + dj
-                if not (0 <= i < lat.nx and 0 <= j < lat.ny) or not free[i, j]:
-                    away -= (di + 0.5, dj + 0.5)
+        away = _away_from_walls(path[k], lat, free)
         norm = math.hypot(*away)
         if norm > 0.0:
             out[k] += step * away / norm
     return out
+
+
+def _corner_of(point, lat: Lattice) -> tuple[int, int]:
+    """The lattice corner nearest ``point`` (``(i, j)``: the lower-left corner of cell
+    ``(i, j)``)."""
+    (ox, oy), h = lat.origin, lat.h
+    return round((point[0] - ox) / h), round((point[1] - oy) / h)
+
+
+def _away_from_walls(point, lat: Lattice, free: np.ndarray) -> np.ndarray:
+    """The sum of the directions from the blocked cells (or the lattice's outside) at the corner
+    nearest ``point`` towards it (zero where none or all four are blocked)."""
+    ci, cj = _corner_of(point, lat)
+    away = np.zeros(2)
+    for di in (-1, 0):
+        for dj in (-1, 0):
+            i, j = ci + di, cj + dj
+            if not (0 <= i < lat.nx and 0 <= j < lat.ny) or not free[i, j]:
+                away -= (di + 0.5, dj + 0.5)
+    return away
+
+
+def _with_passed_corners(path: np.ndarray, lat: Lattice, free: np.ndarray) -> np.ndarray:
+    """``path`` with the wall corners its interior segments pass through inserted: between two
+    vertices at lattice corners ``(di, dj)`` apart, the ``gcd(di, dj) - 1`` corners on the line
+    (at most the segment's length in cells, each checked in O(1))."""
+    (ox, oy), h = lat.origin, lat.h
+    out = [path[0]]
+    for k in range(len(path) - 1):
+        a, b = path[k], path[k + 1]
+        if 0 < k < len(path) - 2:
+            ca, cb = np.array(_corner_of(a, lat)), np.array(_corner_of(b, lat))
+            d = cb - ca
+            g = math.gcd(int(d[0]), int(d[1]))
+            on_corners = (np.abs(a - (ox, oy) - h * ca).max() < 1e-2 * h
+                          and np.abs(b - (ox, oy) - h * cb).max() < 1e-2 * h)  # fmt: skip
+            for m in range(1, g if on_corners else 1):
+                c = ca + (d // g) * m
+                point = np.array([ox + h * c[0], oy + h * c[1]])
+                if _away_from_walls(point, lat, free).any():
+                    out.append(point)
+        out.append(b)
+    return np.array(out)
 
 
 def _area2(a, b, c) -> float:
