@@ -256,7 +256,8 @@ def test_a_wider_disc_is_routed_through_the_map_cells_whose_centre_keeps_its_rad
     assert best * (1 - 1e-9) <= found.length <= best * 1.02
 
 
-def test_a_point_robots_fine_lattice_is_the_maps_own_cells_whatever_the_time(tmp_path):
+def test_a_point_robots_fine_lattice_is_the_maps_own_cells_whatever_the_time(tmp_path,
+                                                                            monkeypatch):
     """A point robot's free cells on a map alone are the map's own free cells, read off the
     raster at no cost: the fine lattice is the map's, not the coarser one marking other worlds
     affords in the time (a 1024 x 1024 city map at 1 s kept 26 % of its cells free on the
@@ -281,7 +282,10 @@ def test_a_point_robots_fine_lattice_is_the_maps_own_cells_whatever_the_time(tmp
         generate_to_file("rooms_map", 3, tmp_path / "disc.yaml", cells=128, door=(1, 1),
                      robot_radius=0.3)))  # fmt: skip
     assert search._map_fine_cells(world, 1 << 22, 1e-6, 1e-6) == 4096
-    # a disc's own cells are marked (a distance transform): they too when that fits the grace
+    # a disc's own cells are marked (a distance transform): on maps of a million cells or more,
+    # when that and the route fit the grace
+    assert search._map_fine_cells(disc, 1 << 22, 1e-6, 1.0) == 4096
+    monkeypatch.setattr(search, "DISC_OWN_CELLS", 128 * 128)
     assert search._map_fine_cells(disc, 1 << 22, 1e-6, 1.0) == 128 * 128
     assert search._map_fine_cells(disc, 1 << 22, 1e-6, 1e-3) == 4096
 

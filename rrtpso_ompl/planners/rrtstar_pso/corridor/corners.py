@@ -168,7 +168,7 @@ def _round_corners(path: np.ndarray, corners, r: float):
     """The taut string from ``path[0]`` to ``path[-1]`` round circles of radius ``r`` at the
     ``corners`` (one per interior vertex: a point passed on the side the path turns to there,
     a ``(point, side)`` pair, side +1 for a corner on the left, or None for a vertex kept as a
-    point); every arc replaced by the polygon circumscribed about it (:func:`_arc_polygon`), so
+    point); every arc replaced by the polygon circumscribed about it (:func:`round_circles`), so
     no segment comes closer than ``r`` to a corner. Also returns, for every vertex, the index
     of the path vertex whose circle it lies on. None when two circles on opposite sides overlap;
     the index ``k`` of the first path vertex whose arc would turn back (the string, pulled
@@ -188,55 +188,66 @@ def _round_corners(path: np.ndarray, corners, r: float):
             side.append(1.0 if turn > 0 else -1.0)
     centres.append(path[-1])
     side.append(0.0)
-    c, s = np.asarray(centres), np.asarray(side)
+    return round_circles(np.asarray(centres), np.full(len(centres), r), np.asarray(side))
+
+
+def round_circles(c: np.ndarray, radii: np.ndarray, s: np.ndarray, piece: float = 0.25 * math.pi,
+                  every_back: bool = False):  # fmt: skip
+    """The taut string from ``c[0]`` to ``c[-1]`` round the circles of centres ``c[1:-1]`` and
+    ``radii`` (a radius per centre; the ends' are not used), each passed on its side ``s`` (+1:
+    the circle on the left; 0: the centre is a vertex of the string).
+
+    Every arc is replaced by the polygon circumscribed about it, in pieces of at most ``piece``
+    radians with vertices at ``r / cos(delta / 2)``: its edges are tangent to the circle, and it
+    is longer than the arc by ``tan(piece / 2) / (piece / 2) - 1`` (5.5 % at 45 degrees, 0.06 %
+    at 5; a corner's arc at the robot's radius is short, a circle's may not be).
+
+    Returns ``(path, owner)`` (for every vertex, the index of the centre whose circle it lies
+    on); None when two circles on opposite sides overlap (or two centres coincide); or the index
+    ``k`` of the first centre whose arc would turn back by more than half a turn (the string,
+    pulled round the others, no longer touches that circle; with ``every_back``, the indices of
+    all such centres, an array).
+    """
+    r = np.where(s != 0.0, radii, 0.0)
     d = np.diff(c, axis=0)
     length = np.hypot(d[:, 0], d[:, 1])
     if not np.all(length > 0.0):
         return None
     u = d / length[:, None]
     # The common tangent of consecutive circles: travel t at angle phi to the line of centres,
-    # sin(phi) = (s_k - s_k+1) r / L; the tangent points lie s r along t's right normal m.
-    sin_phi = (s[:-1] - s[1:]) * r / length
+    # sin(phi) = (s_k r_k - s_k+1 r_k+1) / L; the tangent points lie s r along t's right normal.
+    sin_phi = (s[:-1] * r[:-1] - s[1:] * r[1:]) / length
     if np.any(np.abs(sin_phi) >= 1.0):
         return None
     t = np.sqrt(1.0 - sin_phi**2)[:, None] * u + sin_phi[:, None] * np.column_stack(
         [-u[:, 1], u[:, 0]]
     )
     m = np.column_stack([t[:, 1], -t[:, 0]])
-    leave = c[:-1] + (s[:-1] * r)[:, None] * m
-    arrive = c[1:] + (s[1:] * r)[:, None] * m
-    out, owner = [c[0]], [0]
-    for k in range(1, len(c) - 1):
-        if s[k] == 0.0:
-            out.append(c[k])
-            owner.append(k)
-            continue
-        arc = _arc_polygon(c[k], r, arrive[k - 1], leave[k], s[k])
-        if arc is None:
-            return k
-        out.extend(arc)
-        owner.extend([k] * len(arc))
-    out.append(c[-1])
-    owner.append(len(c) - 1)
-    return np.asarray(out), np.asarray(owner)
-
-
-def _arc_polygon(centre, r: float, enter, leave, side: float) -> np.ndarray | None:
-    """The polygon circumscribed about the arc of radius ``r`` round ``centre`` from ``enter``
-    to ``leave`` (counter-clockwise for ``side`` +1), in pieces of at most 45 degrees, vertices
-    at ``r / cos(delta / 2)``: its edges are tangent to the circle. None for an arc of more
-    than half a turn (the string would turn back)."""
-    a_in = math.atan2(enter[1] - centre[1], enter[0] - centre[0])
-    a_out = math.atan2(leave[1] - centre[1], leave[0] - centre[0])
-    sweep = (a_out - a_in) % (2.0 * math.pi)
-    if side < 0:
-        sweep -= 2.0 * math.pi
-    if abs(sweep) > math.pi:
-        return None
-    pieces = max(1, math.ceil(abs(sweep) / (0.25 * math.pi)))
+    leave = c[:-1] + (s[:-1] * r[:-1])[:, None] * m
+    arrive = c[1:] + (s[1:] * r[1:])[:, None] * m
+    # Every arc at once: from the tangent point arriving at circle k to the one leaving it.
+    inner = np.arange(1, len(c) - 1)
+    wrapped = inner[s[inner] != 0.0]
+    e_in, e_out = arrive[wrapped - 1] - c[wrapped], leave[wrapped] - c[wrapped]
+    a_in = np.arctan2(e_in[:, 1], e_in[:, 0])
+    sweep = (np.arctan2(e_out[:, 1], e_out[:, 0]) - a_in) % (2.0 * math.pi)
+    sweep = np.where(s[wrapped] < 0, sweep - 2.0 * math.pi, sweep)
+    back = np.flatnonzero(np.abs(sweep) > math.pi)
+    if len(back):  # more than half a turn: the string would turn back
+        return wrapped[back] if every_back else int(wrapped[back[0]])
+    pieces = np.maximum(1, np.ceil(np.abs(sweep) / piece)).astype(np.int64)
     delta = sweep / pieces
-    ang = a_in + (np.arange(pieces) + 0.5) * delta
-    return centre + (r / math.cos(0.5 * delta)) * np.column_stack([np.cos(ang), np.sin(ang)])
+    arc_of = np.repeat(np.arange(len(wrapped)), pieces)
+    within = np.arange(len(arc_of)) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+    ang = a_in[arc_of] + (within + 0.5) * delta[arc_of]
+    rho = (r[wrapped] / np.cos(0.5 * delta))[arc_of]
+    arcs = c[wrapped][arc_of] + rho[:, None] * np.column_stack([np.cos(ang), np.sin(ang)])
+    # Each centre's vertices in order: the arc's polygon, or the centre itself (side 0).
+    owner_of = np.concatenate([[0], np.repeat(inner, np.where(s[inner] != 0.0, 0, 1)),
+                               wrapped[arc_of], [len(c) - 1]])  # fmt: skip
+    points = np.vstack([c[:1], c[inner][s[inner] == 0.0], arcs, c[-1:]])
+    order = np.argsort(owner_of, kind="stable")
+    return points[order], owner_of[order]
 
 
 def circumscribe_corners(path: np.ndarray, lat: Lattice, free: np.ndarray, r: float) -> np.ndarray:

@@ -14,12 +14,14 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
+from ....model.geometry import path_length
 from ....model.raster import Lattice
 from ....model.world import MarkingStopped
 from .corner_routes import CORNER_CELLS_PER_SECOND, CORNER_REACH, corner_routes
 from .funnel import channel_portals, free_rectangles, funnel, rectangle_channel
 from .paths import CorridorResult, centre_route, route_and_funnel
 from .routes import ALTERNATIVE_APART, ALTERNATIVE_SLACK, alternative_routes, channel
+from .taut import taut_string
 
 #: Lattice cells the corridor stage builds, searches and funnels per second, on the safe side
 #: (measured on the reference machine: 2-3 million on maps, fewer among many shapes).
@@ -58,6 +60,10 @@ CENTRE_CELLS_PER_SECOND = 600_000
 
 #: Cells of the small lattice on which the cost of marking cells among shapes is measured.
 MARKING_PROBE_CELLS = 1_600
+
+
+#: Probes of the marking cost (the fastest counts).
+MARKING_PROBES = 3
 
 
 #: The share of the stage's time the probe may take: obstacles so detailed that marking the
@@ -129,7 +135,24 @@ def find_corridor_path(
                              no_route_seconds, out_of_time, t0, stages)  # fmt: skip
         except MarkingStopped:
             result = CorridorResult(None, reason="out of time marking the lattice's cells")
+    t1 = time.perf_counter()
+    result = _tautened(model, result, terminate)  # a centre route's too
+    stages["taut"] = stages.get("taut", 0.0) + time.perf_counter() - t1
     return dataclasses.replace(result, time=time.perf_counter() - t0, stages=stages)
+
+
+def _tautened(model, result: CorridorResult, terminate) -> CorridorResult:
+    """Among circles, ``result`` with its path replaced by the taut string of its homotopy
+    (:func:`.taut.taut_string`, which declines other worlds) where that is shorter: the funnel
+    runs through cells wholly free, up to a cell off every circle (among 10,000 circles +3 % in
+    the right corridor, taut +0.7 %). A bounded step, stopped by ``terminate`` (the outer
+    deadline)."""
+    if result.path is None or getattr(model, "raster", None) is not None:
+        return result
+    taut = taut_string(model, np.asarray(result.path), terminate)
+    if taut is None or not path_length(taut) < result.length:
+        return result
+    return dataclasses.replace(result, path=taut, length=path_length(taut))
 
 
 def _marking_stops(model, stop):
@@ -177,22 +200,30 @@ def _search(model, start, goal, seconds, max_cells, alternatives, no_route_secon
 
 def _marking_rate(model, seconds: float) -> float | None:
     """Lattice cells per second ``model`` marks (its free cell centres), measured on a small
-    lattice; at most :data:`CELLS_PER_SECOND`. None when the probe takes more than
-    :data:`MARKING_PROBE_SHARE` of ``seconds`` (it is stopped there)."""
+    lattice, the fastest of :data:`MARKING_PROBES` (one probe of a few milliseconds varied
+    fourfold from run to run, and the lattice with it); at most :data:`CELLS_PER_SECOND`. None
+    when the probes take more than :data:`MARKING_PROBE_SHARE` of ``seconds`` (they are
+    stopped there)."""
     probe = model.lattice(MARKING_PROBE_CELLS)
-    t = time.perf_counter()
-    end = t + MARKING_PROBE_SHARE * seconds
+    end = time.perf_counter() + MARKING_PROBE_SHARE * seconds
     outer = getattr(model, "mark_stop", None)
 
     def stop() -> bool:
         return time.perf_counter() >= end or bool(outer is not None and outer())
 
+    fastest = math.inf
     try:
         with _marking_stops(model, stop):
-            model.centres_free(probe)
+            for _ in range(MARKING_PROBES):
+                t = time.perf_counter()
+                model.centres_free(probe)
+                fastest = min(fastest, time.perf_counter() - t)
+                if time.perf_counter() + fastest >= end:
+                    break  # no time for another probe: one is enough
     except MarkingStopped:
-        return None
-    return min(CELLS_PER_SECOND, probe.n_cells / max(time.perf_counter() - t, 1e-6))
+        if not math.isfinite(fastest):
+            return None
+    return min(CELLS_PER_SECOND, probe.n_cells / max(fastest, 1e-6))
 
 
 def _coarse_tries(model, start, goal, max_cells, alternatives, out_of_time, first, t0, stages,
@@ -220,6 +251,11 @@ def _coarse_tries(model, start, goal, max_cells, alternatives, out_of_time, firs
         route_cells = min(2 * route_cells, max_cells)
 
 
+#: A disc's fine lattice may be the map's own cells on maps of at least this many cells
+#: (:func:`_map_fine_cells`).
+DISC_OWN_CELLS = 1 << 20
+
+
 def _map_fine_cells(model, max_cells: int, seconds: float, grace_seconds: float) -> int:
     """The fine lattice's cells on a map: as many as marking affords in ``seconds``
     (:data:`MARK_CELLS_PER_SECOND`), or the map's own cells (up to ``max_cells``) on a map alone
@@ -229,14 +265,21 @@ def _map_fine_cells(model, max_cells: int, seconds: float, grace_seconds: float)
     Coarser cells close passages: one-cell doors for a point robot (on a 1024 x 1024 city map
     the 2 x 2-cell lattice kept 26 % of the cells free, the map's own 35 %), and for a disc up to
     a cell along every wall, which on a warehouse of 2 million cells at 5 cm left the best
-    corridor closed (its path +1.35 % on cells of 10 cm, +0.24 % on the map's own). Where the
+    corridor closed (its path +1.35 % on cells of 10 cm, +0.24 % on the map's own); on smaller
+    maps (:data:`DISC_OWN_CELLS`) the time's lattice with alternatives measured better for a
+    disc (a 192,000-cell lab at 0.25 s: +0.3 % against the own cells' shortest route's +0.9 %,
+    a corridor of nearly equal lattice length). Where the
     route does not fit, the map's cells would be pooled for coarse routes, which measured worse
     than the time's lattice (a 596 x 397 house plan at 0.1 s: 2 of 4 queries unsolved)."""
     cells = int(min(max_cells, max(0.4 * MARK_CELLS_PER_SECOND * seconds, 4096)))
     if not _map_alone(model):
         return cells
     own = model.lattice(max_cells, split=1).n_cells
-    marking = 0.0 if model.robot_radius <= 0.0 else own / MARK_CELLS_PER_SECOND
+    marking = 0.0
+    if model.robot_radius > 0.0:
+        if own < DISC_OWN_CELLS:
+            return cells
+        marking = own / MARK_CELLS_PER_SECOND
     return max(cells, own) if marking + own / LEAN_CELLS_PER_SECOND <= grace_seconds else cells
 
 
@@ -274,15 +317,15 @@ def _map_corridors(model, fine_cells, route_cells, start, goal, alternatives, te
         result = route_and_funnel(model, fine, free, start, goal, alternatives, terminate, t0,
                                   stages, corner_reach=CORNER_REACH)  # fmt: skip
     elif fine.n_cells <= LEAN_CELLS_PER_SECOND * terminate.grace_left() and not (
-        fine.h > model.raster.resolution and _pooling_keeps_walls(free, k)
+        _may_pool(model, fine) and _pooling_keeps_walls(free, k)
     ):
         # Too little time for the whole lattice with alternatives, enough for its shortest route
         # by the time a stage with no route may take: better than pooling, which opens gaps
         # through walls a cell thick (in a 256 x 256 maze at 0.1 s every coarse route then
         # failed at the fine level and left no time; on 1024 x 1024 maps pooling measured worse
-        # too). Pooled corridors, ranked by their taut length, where the lattice is already
-        # coarser than the map and its walls are thicker than the pooling: among the aisles of a
-        # 1.7-million-cell warehouse at 0.25 s, 1.033 of the optimum against the lean 1.054.
+        # too). Pooled corridors, ranked by their taut length, where the walls are thicker than
+        # the pooling and the lattice is not one of the map's own cells kept for their exact
+        # corridors (:func:`_may_pool`).
         result = route_and_funnel(model, fine, free, start, goal, 0, grace, t0, stages)
     else:
         result = _pooled_corridors(model, fine, free, k, start, goal, alternatives, terminate,
@@ -294,6 +337,19 @@ def _map_corridors(model, fine_cells, route_cells, start, goal, alternatives, te
         if wide.path is not None:
             return wide
     return result
+
+
+def _may_pool(model, fine: Lattice) -> bool:
+    """Whether the map lattice ``fine`` may be pooled for coarse routes (when its walls survive
+    the pooling) rather than searched by its shortest route alone: when it is coarser than the
+    map, or a disc's on a map under :data:`DISC_OWN_CELLS` cells; not the map's own cells kept
+    for their exact corridors (a point robot's; a disc's on a larger map). Measured at 0.25 s:
+    among the aisles of a 1.7-million-cell warehouse (cells of 3 x 3) pooled 1.033 of the
+    optimum against the lean 1.054, a 192,000-cell lab with a disc 1.003 against 1.009; on the
+    2-million-cell warehouse at 2 s the lean route over the own cells 1.0024, pooled 1.010."""
+    if fine.h > model.raster.resolution:
+        return True
+    return model.robot_radius > 0.0 and fine.n_cells < DISC_OWN_CELLS
 
 
 #: Pooling keeps a lattice's walls when the coarse cells it blocks wholly hold at least this
@@ -437,13 +493,10 @@ def _corridors(model, coarse: Lattice, opened, fine_band, start, goal, alternati
     (``fine_band(r0, r1, c0, c1)`` gives, for a box of coarse cells, its fine lattice, which of
     its cells are wholly free and the fine cells per coarse side); the shortest valid one."""
     nx, ny = coarse.nx, coarse.ny
-    ends = []
-    for point in (start, goal):
-        cell = _nearest_open(opened, coarse.cell_of(point))
-        if cell is None:
-            return CorridorResult(None, lattice=coarse, reason="start or goal is not next to "
-                                  "a free lattice cell")  # fmt: skip
-        ends.append(cell)
+    ends = _joined_ends(opened, coarse.cell_of(start), coarse.cell_of(goal))
+    if ends is None:
+        return CorridorResult(None, lattice=coarse, reason="start or goal is not next to "
+                              "a free lattice cell joined to the other's")  # fmt: skip
     t1 = time.perf_counter()
     if coarse.n_cells > 0.5 * DIRECT_CELLS_PER_SECOND * terminate.left():
         alternatives = 0  # too little time for them and the bands (a thin disc's coarse cells
@@ -477,6 +530,8 @@ def _corridors(model, coarse: Lattice, opened, fine_band, start, goal, alternati
                 result = centre_route(model, start, goal, 0, terminate, box, near)
         except MarkingStopped:
             break  # out of time in this corridor: the best of those before it
+        # Corridors compared by their taut strings among circles (the funnel's cells distort).
+        result = _tautened(model, result, getattr(terminate, "terminate", None))
         if result.path is not None and (best is None or result.length < best.length):
             best = result
     if best is None:
@@ -534,13 +589,28 @@ class _Deadline:
         )
 
 
-def _nearest_open(opened: np.ndarray, cell, reach: int = 2):
-    """``cell`` when open, else the nearest open cell within ``reach`` (Manhattan), or None."""
-    if opened[cell]:
-        return cell
-    i0, j0 = max(cell[0] - reach, 0), max(cell[1] - reach, 0)
-    near = np.argwhere(opened[i0 : cell[0] + reach + 1, j0 : cell[1] + reach + 1])
-    if not len(near):
-        return None
-    near += (i0, j0)
-    return tuple(int(c) for c in near[np.argmin(np.abs(near - cell).sum(axis=1))])
+def _joined_ends(opened: np.ndarray, s_cell, g_cell, reach: int = 2):
+    """Open cells near ``s_cell`` and ``g_cell`` (each itself when open, else within ``reach``,
+    Manhattan) that a route joins, nearest first: ``(start's, goal's)``, or None.
+
+    The lattice's routes join exactly the edge-connected open cells (a diagonal or knight's
+    move needs the cells beside it), so a component label decides; the nearest open cell alone
+    may be a dead end (among 10,000 circles the start's was walled in on a lattice of 70,000
+    cells, and the stage found no route at all).
+    """
+    label, _ = ndimage.label(opened)  # edge-connected
+    near = []
+    for cell in (s_cell, g_cell):
+        i0, j0 = max(cell[0] - reach, 0), max(cell[1] - reach, 0)
+        found = np.argwhere(opened[i0 : cell[0] + reach + 1, j0 : cell[1] + reach + 1])
+        found += (i0, j0)
+        found = found[np.abs(found - cell).sum(axis=1) <= reach]
+        near.append(found[np.argsort(np.abs(found - cell).sum(axis=1), kind="stable")])
+    best = None
+    for a in near[0]:
+        for b in near[1]:
+            if label[tuple(a)] == label[tuple(b)]:
+                cost = np.abs(a - s_cell).sum() + np.abs(b - g_cell).sum()
+                if best is None or cost < best[0]:
+                    best = (cost, tuple(int(c) for c in a), tuple(int(c) for c in b))
+    return None if best is None else best[1:]

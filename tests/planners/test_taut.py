@@ -1,0 +1,108 @@
+"""The taut string of a path's homotopy among circles (corridor/taut.py): exact against the
+optimum where the homotopy is the optimum's, valid, passing circles on the reference's side."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import shapely
+
+from rrtpso_ompl.groundtruth.optimum import shortest_path
+from rrtpso_ompl.model import World
+from rrtpso_ompl.model.geometry import path_length
+from rrtpso_ompl.planners.rrtstar_pso.corridor import search
+from rrtpso_ompl.planners.rrtstar_pso.corridor.corners import round_circles
+from rrtpso_ompl.planners.rrtstar_pso.corridor.taut import TAUT_PIECE, sides_along, taut_string
+
+
+def _optimum(world: World, start, goal) -> float:
+    class P:  # the few fields shortest_path reads
+        pass
+
+    p = P()
+    p.start, p.goal, p.goal_tolerance, p.name, p.source = start, goal, 0.0, "t", "t"
+    p.bounds = world.bounds
+    return shortest_path(p, world, upper_bound=math.inf).length
+
+
+#: The polygon of a 5-degree piece is this much longer than its arc.
+PIECE_EXCESS = math.tan(0.5 * TAUT_PIECE) / (0.5 * TAUT_PIECE) - 1.0
+
+
+@pytest.mark.parametrize("robot", [0.0, 0.4])
+def test_the_string_round_circles_is_the_optimum_in_the_optimums_homotopy(robot):
+    world = World(((0, 0), (20, 10)), circles=[(6, 5.2, 2.0), (13, 4.6, 1.5), (9, 1.0, 0.8)],
+                  robot_radius=robot)  # fmt: skip
+    start, goal = (1.0, 5.0), (19.0, 5.0)
+    best = _optimum(world, start, goal)
+    # Detours above the two large circles and below them (above the small one): the optimum
+    # takes one of the two homotopies; its string is the optimum.
+    above = np.array([start, (6, 9.5), (13, 9.5), goal])
+    below = np.array([start, (3, 2.8), (6, 2.6), (9, 2.3), (13, 2.5), goal])
+    lengths = []
+    for reference in (above, below):
+        assert world.path_valid(reference)
+        string = taut_string(world, reference)
+        assert string is not None and world.path_valid(string)
+        lengths.append(path_length(string))
+    assert lengths and min(lengths) >= best * (1 - 1e-9)
+    assert min(lengths) <= best * (1 + PIECE_EXCESS + 1e-6)
+
+
+def test_the_string_keeps_the_reference_side_of_every_obstacle():
+    world = World(((0, 0), (20, 10)), circles=[(10, 5, 2.0)], robot_radius=0.25)
+    start, goal = (1.0, 5.2), (19.0, 5.2)
+    for reference, side in ((np.array([start, (10, 9), goal]), 1.0),
+                            (np.array([start, (10, 1), goal]), -1.0)):  # fmt: skip
+        string = taut_string(world, reference)
+        assert world.path_valid(string)
+        # the circle lies right of a path above it (-1), left of one below (+1)
+        assert sides_along(string, np.array([[10.0, 5.0]]))[1][0] == -side
+        assert path_length(string) < path_length(reference)
+
+
+def test_worlds_with_boxes_or_polygons_are_declined():
+    """A segment may cross a polygon far from its corners (no anchor entered): such worlds keep
+    the funnel path."""
+    world = World(((0, 0), (10, 10)), boxes=[(4, 0, 5, 6)], circles=[(7, 7, 1.0)])
+    reference = np.array([(1.0, 1.0), (2, 7.5), (5.5, 7.5), (5.5, 3.0), (9.0, 1.0)])
+    assert world.path_valid(reference)
+    assert taut_string(world, reference) is None
+
+
+def test_round_circles_with_radii_of_their_own():
+    """Two circles of different radii passed on opposite sides: the inner tangent, of length
+    sqrt(L^2 - (r1 + r2)^2), joins them; the polygons stay outside both circles."""
+    c = np.array([(0.0, 0.0), (3.0, 0.0), (9.0, 0.0), (12.0, 0.0)])
+    path, owner = round_circles(c, np.array([0.0, 1.0, 2.0, 0.0]), np.array([0.0, 1.0, -1.0, 0.0]),
+                                TAUT_PIECE)  # fmt: skip
+    assert owner[0] == 0 and owner[-1] == 3 and np.all(np.diff(owner) >= 0)
+    for centre, radius in ((c[1], 1.0), (c[2], 2.0)):
+        assert shapely.LineString(path).distance(shapely.Point(centre)) >= radius - 1e-9
+    # The polygons' vertices lie on the tangents at the arcs' ends, a piece's half beyond them:
+    # the longest segment is the inner tangent so lengthened.
+    seg = np.hypot(*np.diff(path, axis=0).T).max()
+    tangent = math.sqrt(6.0**2 - 3.0**2)
+    assert tangent <= seg <= tangent + 3.0 * math.tan(0.5 * TAUT_PIECE) + 1e-9
+    # A circle off the line, on the side it would have to be wrapped the long way round.
+    back = round_circles(np.array([(0.0, 0.0), (5.0, 3.0), (10.0, 0.0)]), np.array([0, 1.0, 0]),
+                         np.array([0, 1.0, 0]), every_back=True)  # fmt: skip
+    assert list(back) == [1]
+    assert round_circles(np.array([(0.0, 0.0), (5.0, 3.0), (10.0, 0.0)]), np.array([0, 1.0, 0]),
+                         np.array([0, 1.0, 0])) == 1  # fmt: skip
+
+
+def test_routes_start_from_an_open_cell_joined_to_the_goals():
+    """The nearest open cell to the start may be walled in (a diagonal needs the cells beside
+    it): the ends are the nearest pair the lattice joins."""
+    opened = np.ones((6, 6), dtype=bool)
+    opened[1, 0] = opened[0, 1] = False  # (0, 0) walled in: its diagonal needs (1, 0), (0, 1)
+    opened[1, 1] = False
+    opened[0, 0] = True
+    ends = search._joined_ends(opened, (0, 0), (5, 5))
+    assert ends is not None and ends[0] != (0, 0) and ends[1] == (5, 5)
+    walled = np.zeros((6, 6), dtype=bool)
+    walled[0, 0] = walled[5, 5] = True
+    assert search._joined_ends(walled, (0, 0), (5, 5)) is None
