@@ -304,3 +304,19 @@ INFLATED_DOOR = {
                   {"type": "rectangle", "min": [4.8, 5.4], "max": [5.2, 10]},
                   {"type": "circle", "center": [7.5, 3.5], "radius": 0.5}],
 }  # fmt: skip
+
+
+def exact_length(world, start, goal) -> float:
+    """The exact optimum's length between two points of a World (no problem file: the few
+    fields :func:`~rrtpso_ompl.groundtruth.optimum.shortest_path` reads)."""
+    import math
+
+    from rrtpso_ompl.groundtruth.optimum import shortest_path
+
+    class P:
+        pass
+
+    p = P()
+    p.start, p.goal, p.goal_tolerance, p.name, p.source = start, goal, 0.0, "t", "t"
+    p.bounds = world.bounds
+    return shortest_path(p, world, upper_bound=math.inf).length

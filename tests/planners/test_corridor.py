@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 import shapely
+from helpers import exact_length
 
 from rrtpso_ompl.model import World
 from rrtpso_ompl.model.geometry import path_length
@@ -108,21 +109,9 @@ def test_a_one_cell_maze_gives_the_exact_shortest_path():
     start, goal = (1.5, 5.5), (5.5, 1.5)  # top-left corridor to bottom-right
     res = corridor_path(world, start, goal, 10_000)
     assert res.path is not None and world.path_valid(res.path)
-    exact = _optimum(world, start, goal)  # the exact optimum of the same world
+    exact = exact_length(world, start, goal)  # the exact optimum of the same world
     assert res.length == pytest.approx(exact, rel=1e-4)
     assert res.length >= exact * (1 - 1e-9)
-
-
-def _optimum(world: World, start, goal) -> float:
-    from rrtpso_ompl.groundtruth.optimum import shortest_path
-
-    class P:  # the few fields shortest_path reads
-        pass
-
-    p = P()
-    p.start, p.goal, p.goal_tolerance, p.name, p.source = start, goal, 0.0, "t", "t"
-    p.bounds = world.bounds
-    return shortest_path(p, world, upper_bound=math.inf).length
 
 
 def test_no_route_is_reported_honestly():
@@ -167,7 +156,7 @@ def test_a_disc_robot_on_a_map_is_pulled_round_the_door_jambs(radius):
     start, goal = (1.5, 1.5), (32.5, 1.5)
     res = corridor_path(world, start, goal, 10_000)
     assert res.path is not None and world.path_valid(res.path)
-    exact = _optimum(world, start, goal)
+    exact = exact_length(world, start, goal)
     assert exact * (1 - 1e-9) <= res.length <= exact * 1.002
 
 

@@ -8,24 +8,13 @@ import math
 import numpy as np
 import pytest
 import shapely
+from helpers import exact_length
 
-from rrtpso_ompl.groundtruth.optimum import shortest_path
 from rrtpso_ompl.model import World
 from rrtpso_ompl.model.geometry import path_length
 from rrtpso_ompl.planners.rrtstar_pso.corridor import search
 from rrtpso_ompl.planners.rrtstar_pso.corridor.corners import round_circles
 from rrtpso_ompl.planners.rrtstar_pso.corridor.taut import TAUT_PIECE, sides_along, taut_string
-
-
-def _optimum(world: World, start, goal) -> float:
-    class P:  # the few fields shortest_path reads
-        pass
-
-    p = P()
-    p.start, p.goal, p.goal_tolerance, p.name, p.source = start, goal, 0.0, "t", "t"
-    p.bounds = world.bounds
-    return shortest_path(p, world, upper_bound=math.inf).length
-
 
 #: The polygon of a 5-degree piece is this much longer than its arc.
 PIECE_EXCESS = math.tan(0.5 * TAUT_PIECE) / (0.5 * TAUT_PIECE) - 1.0
@@ -36,7 +25,7 @@ def test_the_string_round_circles_is_the_optimum_in_the_optimums_homotopy(robot)
     world = World(((0, 0), (20, 10)), circles=[(6, 5.2, 2.0), (13, 4.6, 1.5), (9, 1.0, 0.8)],
                   robot_radius=robot)  # fmt: skip
     start, goal = (1.0, 5.0), (19.0, 5.0)
-    best = _optimum(world, start, goal)
+    best = exact_length(world, start, goal)
     # Detours above the two large circles and below them (above the small one): the optimum
     # takes one of the two homotopies; its string is the optimum.
     above = np.array([start, (6, 9.5), (13, 9.5), goal])

@@ -32,6 +32,9 @@ corridor at once, at the resolution of a lattice:
    two blocked cells close the way between them exactly when they touch, so the corridors are
    the point robot's: routes over the map's free cells, each searched again on cells fine enough
    for the gap (:func:`.search._disc_corridors`) and wrapped round the wall corners.
+6. **Among circles, the taut string.** Wholly free cells keep up to a cell off every circle;
+   each corridor's path becomes the shortest path passing every circle on the same side
+   (:mod:`.taut`), and corridors are compared by it.
 
 The path stays inside cells that are wholly free, so it is valid without further checks; it is
 checked once anyway (exactly, or through the user's checker, whose lattice answers are not
