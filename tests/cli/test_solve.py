@@ -152,7 +152,9 @@ def test_same_seed_same_path_iteration_bounded(circle_file, tmp_path):
     assert rows[0]["stages"]["rrt_iterations"] == 600  # the bound, not the clock, stopped RRT*
     texts = [json.dumps(_without_times(r), sort_keys=True) for r in rows]
     assert texts[0] == texts[1]
-    assert rows[0]["path"] != rows[2]["path"]
+    # Another seed grows another tree (the returned path may agree: among circles the corridor
+    # stage's path is the taut string of its corridor, the same for every seed).
+    assert rows[0]["stages"]["rrt_path"] != rows[2]["stages"]["rrt_path"]
 
 
 def _without_times(value):

@@ -265,12 +265,12 @@ def _map_fine_cells(model, max_cells: int, seconds: float, grace_seconds: float)
     Coarser cells close passages: one-cell doors for a point robot (on a 1024 x 1024 city map
     the 2 x 2-cell lattice kept 26 % of the cells free, the map's own 35 %), and for a disc up to
     a cell along every wall, which on a warehouse of 2 million cells at 5 cm left the best
-    corridor closed (its path +1.35 % on cells of 10 cm, +0.24 % on the map's own); on smaller
+    corridor closed (its path +1.35 % on cells of 10 cm, +0.24 % on the map's own). On smaller
     maps (:data:`DISC_OWN_CELLS`) the time's lattice with alternatives measured better for a
     disc (a 192,000-cell lab at 0.25 s: +0.3 % against the own cells' shortest route's +0.9 %,
-    a corridor of nearly equal lattice length). Where the
-    route does not fit, the map's cells would be pooled for coarse routes, which measured worse
-    than the time's lattice (a 596 x 397 house plan at 0.1 s: 2 of 4 queries unsolved)."""
+    a corridor of nearly equal lattice length). Where the route does not fit, the map's cells
+    would be pooled for coarse routes, which measured worse than the time's lattice (a
+    596 x 397 house plan at 0.1 s: 2 of 4 queries unsolved)."""
     cells = int(min(max_cells, max(0.4 * MARK_CELLS_PER_SECOND * seconds, 4096)))
     if not _map_alone(model):
         return cells

@@ -32,6 +32,9 @@ TAUT_PIECE = math.radians(5.0)
 #: Most point-segment pairs :func:`sides_along` holds at once (memory: a few arrays of them).
 PAIRS = 1 << 20
 
+#: Most points along a segment at which the circles near it are looked up.
+SEGMENT_SAMPLES = 4096
+
 #: Most releases of anchors the string no longer touches, per round.
 TAUT_RELEASES = 256
 
@@ -53,12 +56,13 @@ class Anchors:
             return np.empty(0, dtype=np.int64)
         d = b - a
         length = float(np.hypot(*d))
-        # Points along the segment at most one reach apart: every centre within reach of the
-        # segment is within twice the reach of one of them.
-        n = max(2, int(np.ceil(length / max(self.reach, 1e-12))) + 1)
+        # Points along the segment ``spacing`` apart (about a reach, at most SEGMENT_SAMPLES of
+        # them): every centre within reach of the segment is within reach + spacing / 2 of one.
+        n = min(SEGMENT_SAMPLES, max(2, math.ceil(length / max(self.reach, 1e-300)) + 1))
         pts = a + np.linspace(0.0, 1.0, n)[:, None] * d
+        radius = self.reach + 0.5 * length / (n - 1) + 1e-9 * (1.0 + length)
         near = np.unique(np.concatenate(
-            [np.asarray(x, dtype=np.int64) for x in self.tree.query_ball_point(pts, 2 * self.reach)]
+            [np.asarray(x, dtype=np.int64) for x in self.tree.query_ball_point(pts, radius)]
             + [np.empty(0, dtype=np.int64)]))  # fmt: skip
         if not len(near):
             return near
