@@ -215,3 +215,27 @@ def test_a_wall_corner_passed_on_the_line_between_two_bends_is_pushed_off_too():
     assert shapely.LineString(pushed).distance(walls) > 1e-4
     assert len(pushed) == 5  # the middle corner inserted
     assert path_length(pushed) == pytest.approx(path_length(path), abs=1e-2)
+
+
+def test_among_shapes_a_stage_with_no_route_tries_the_coarse_lattice_again(monkeypatch):
+    """The first coarse tries among shapes have half the stage's time; when they and the route
+    through free cell centres find nothing, the coarse lattice is tried again while the no-route
+    time lasts (among 10,000 circles one run in ten went unsolved without it). The first try and
+    the centre route are made to fail; no clock decides (the deadlines are far ahead)."""
+    from rrtpso_ompl.planners.rrtstar_pso.corridor import search
+
+    world = World(((0, 0), (20, 10)), circles=[(6, 5.2, 2.0), (13, 4.6, 1.5)], robot_radius=0.2)
+    real, calls = search._shape_corridors, []
+
+    def first_fails(*args, **kwargs):
+        calls.append(args[1])
+        if len(calls) == 1:
+            return search.CorridorResult(None, reason="no route through the lattice")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(search, "_shape_corridors", first_fails)
+    monkeypatch.setattr(search, "centre_route",
+                        lambda *a, **k: search.CorridorResult(None, reason="none"))  # fmt: skip
+    found = search.find_corridor_path(world, (1.0, 5.0), (19.0, 5.0), 100.0, max_cells=4096,
+                                      no_route_seconds=1000.0)  # fmt: skip
+    assert len(calls) == 2 and found.path is not None and world.path_valid(found.path)
