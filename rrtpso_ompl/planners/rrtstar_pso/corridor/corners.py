@@ -10,7 +10,14 @@ import numpy as np
 from scipy import ndimage
 
 from ....model.raster import Lattice
-from .funnel import FunnelEnds, channel_portals, free_rectangles, funnel, rectangle_channel
+from .funnel import (
+    FunnelEnds,
+    away_from_walls,
+    channel_portals,
+    free_rectangles,
+    funnel,
+    rectangle_channel,
+)
 from .routes import channel
 
 #: Most rounds of :func:`wrapped_funnel` adding a wall corner its path passed without a bend, or
@@ -98,14 +105,8 @@ def _wall_side(corner: np.ndarray, d: np.ndarray, a: np.ndarray, lat: Lattice, p
     corner ``corner`` is to be passed on: the side it lies on, or, for a corner on the path's
     line (a path along a wall, touching it), the side of the blocked cells at it (their mean
     centre), not one by chance."""
-    (ox, oy), h = lat.origin, lat.h
-    ci, cj = round((corner[0] - ox) / h), round((corner[1] - oy) / h)
-    mass = np.zeros(2)
-    for di in (-1, 0):
-        for dj in (-1, 0):
-            i, j = ci + di, cj + dj
-            if not (0 <= i < lat.nx and 0 <= j < lat.ny) or not point[i, j]:
-                mass += (di + 0.5, dj + 0.5)
+    h = lat.h
+    mass = -away_from_walls(corner, lat, point)  # towards the blocked cells' mean centre
     e = corner - a
     cross = d[0] * e[1] - d[1] * e[0]
     if abs(cross) <= 1e-9 * float(np.hypot(*d)) * h:  # on the line: the wall's side decides

@@ -117,7 +117,7 @@ def push_off_corners(path: np.ndarray, lat: Lattice, free: np.ndarray, step: flo
     path = _with_passed_corners(path, lat, free)
     out = path.copy()
     for k in range(1, len(path) - 1):
-        away = _away_from_walls(path[k], lat, free)
+        away = away_from_walls(path[k], lat, free)
         norm = math.hypot(*away)
         if norm > 0.0:
             out[k] += step * away / norm
@@ -131,7 +131,7 @@ def _corner_of(point, lat: Lattice) -> tuple[int, int]:
     return round((point[0] - ox) / h), round((point[1] - oy) / h)
 
 
-def _away_from_walls(point, lat: Lattice, free: np.ndarray) -> np.ndarray:
+def away_from_walls(point, lat: Lattice, free: np.ndarray) -> np.ndarray:
     """The sum of the directions from the blocked cells (or the lattice's outside) at the corner
     nearest ``point`` towards it (zero where none or all four are blocked)."""
     ci, cj = _corner_of(point, lat)
@@ -161,7 +161,7 @@ def _with_passed_corners(path: np.ndarray, lat: Lattice, free: np.ndarray) -> np
             for m in range(1, g if on_corners else 1):
                 c = ca + (d // g) * m
                 point = np.array([ox + h * c[0], oy + h * c[1]])
-                if _away_from_walls(point, lat, free).any():
+                if away_from_walls(point, lat, free).any():
                     out.append(point)
         out.append(b)
     return np.array(out)
