@@ -19,6 +19,9 @@ Usage::
     python benchmarks/families.py --set report --time 0.25 1 4 --out docs/families.md
     python benchmarks/families.py --set tuning --time 1 --out -    # print only
     python benchmarks/families.py --set tuning --param corridor_fraction=0.4  # a variant
+    python benchmarks/families.py --set report --time 0.25 1 4 --planners RRTstarPSO \
+        --families circles --merge docs/families.jsonl --rows docs/families.jsonl \
+        --out docs/families.md                                    # re-run some rows only
 """
 
 from __future__ import annotations
@@ -210,7 +213,10 @@ def report(rows: list[dict], args, seeds, planners) -> list[str]:
         "Median (and 90th percentile) of path length over the exact optimum; every path was "
         "checked valid with the exact checker. The library rows are the "
         f"{args.set} part of problems/ (see docs/benchmarking.md). *Deadline*: RRTstarPSO's "
-        "largest planning time over the budget.",
+        "largest planning time over the budget."
+        + (f" Runs of {', '.join(args.families or ['every family'])} by "
+           f"{args.planners.replace(',', ', ')} from this command; the others kept from "
+           f"`{args.merge}`'s earlier run." if args.merge else ""),
     ]
     for budget in args.time:
         table, behind = summary(rows, budget, planners)
@@ -225,6 +231,21 @@ def report(rows: list[dict], args, seeds, planners) -> list[str]:
             + ".",
         ]
     return lines + footer(rows)
+
+
+def merged(earlier: Path, rows: list[dict]) -> tuple[list[dict], list[str]]:
+    """The runs of ``earlier`` (JSON lines) with those ``rows`` repeat replaced, in their order,
+    and ``rows``' others after them; the planners of both, in :data:`PLANNERS`' order."""
+
+    def key(r: dict) -> tuple:
+        return r["file"], r["planner"], r["budget"], r["seed"]
+
+    new = {key(r): r for r in rows}
+    old = [json.loads(line) for line in earlier.read_text().splitlines() if line.strip()]
+    out = [new.pop(key(r), r) for r in old]
+    out += [r for r in rows if key(r) in new]
+    named = {r["planner"] for r in out}
+    return out, [p for p in PLANNERS if p in named] + sorted(named - set(PLANNERS))
 
 
 def footer(rows: list[dict]) -> list[str]:
@@ -247,6 +268,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--families", nargs="+", help="only these families (or library)")
     ap.add_argument("--out", default="-", help="markdown file to write (default: print)")
     ap.add_argument("--rows", help="JSON lines of every run, to write")
+    ap.add_argument("--merge", help="JSON lines of an earlier run: its runs this one does not "
+                    "repeat are kept, in rows and report (re-run a planner or family after a "
+                    "change)")
     args = ap.parse_args(argv)
     args.argv = sys.argv[1:] if argv is None else argv
 
@@ -282,6 +306,8 @@ def main(argv: list[str] | None = None) -> int:
                         )
                         rows.append(row)
             print(f"{path.name} done ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
+    if args.merge:
+        rows, planners = merged(Path(args.merge), rows)
     if args.rows:
         Path(args.rows).write_text("".join(json.dumps(r) + "\n" for r in rows))
     write_markdown(report(rows, args, seeds, planners), args.out)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import time
 
 import numpy as np
 import pytest
@@ -344,3 +345,31 @@ def test_pooling_keeps_walls_thicker_than_itself_and_loses_thin_ones():
     thick[4:8, :] = thick[:, 8:12] = False
     assert search._pooling_keeps_walls(thick, 2)
     assert not search._pooling_keeps_walls(thick, 8)  # coarser than the walls
+
+
+def test_a_thin_discs_band_begins_only_when_its_box_fits_the_time_left(tmp_path, monkeypatch):
+    """Marking and wrapping a band's box of fine cells cannot be stopped midway (a box of 970,000
+    cells begun with 0.05 s left ran 0.08 s past a 0.25 s budget): a band whose box does not fit
+    the time left at :data:`LEAN_CELLS_PER_SECOND` is not begun, and the map-cell route stands.
+    No clock decides: the rate is set so that the map's 4,096 cells fit 1,000 s and no band's box
+    of fine cells (5 per map cell's side) does."""
+    problem, world, _ = _generated(tmp_path, "random_map", 1, 0, cells=64, density=0.2,
+                                   robot_radius=0.3 * 100 / 64)  # fmt: skip
+    start, goal = np.asarray(problem.start), np.asarray(problem.goal)
+    calls = []
+    real = search.route_and_funnel
+
+    def counted(model, lat, *args, **kwargs):
+        calls.append(lat.n_cells)
+        return real(model, lat, *args, **kwargs)
+
+    monkeypatch.setattr(search, "route_and_funnel", counted)
+    far = search._Deadline(time.perf_counter() + 1000.0)
+    roomy = search._disc_corridors(world, 1 << 20, start, goal, 0, far, 0.0, {})
+    assert len(calls) >= 2 and min(calls[1:]) > 5 * 1000  # the map's route, then bands
+    calls.clear()
+    monkeypatch.setattr(search, "LEAN_CELLS_PER_SECOND", 5)
+    far = search._Deadline(time.perf_counter() + 1000.0)
+    tight = search._disc_corridors(world, 1 << 20, start, goal, 0, far, 0.0, {})
+    assert calls == [64 * 64]  # the map's own cells only
+    assert world.path_valid(tight.path) and tight.length >= roomy.length * (1 - 1e-9)

@@ -234,6 +234,7 @@ def test_among_shapes_a_stage_with_no_route_tries_the_coarse_lattice_again(monke
         return real(*args, **kwargs)
 
     monkeypatch.setattr(search, "_shape_corridors", first_fails)
+    monkeypatch.setattr(search, "lattice_route", lambda *a: None)  # no taut string of a route
     monkeypatch.setattr(search, "centre_route",
                         lambda *a, **k: search.CorridorResult(None, reason="none"))  # fmt: skip
     found = search.find_corridor_path(world, (1.0, 5.0), (19.0, 5.0), 100.0, max_cells=4096,

@@ -95,3 +95,46 @@ def test_routes_start_from_an_open_cell_joined_to_the_goals():
     walled = np.zeros((6, 6), dtype=bool)
     walled[0, 0] = walled[5, 5] = True
     assert search._joined_ends(walled, (0, 0), (5, 5)) is None
+
+
+def _circle_field(n: int, seed: int, robot: float) -> World:
+    """``n`` x ``n`` circles on a jittered lattice in 100 x 100 (the scaling benchmark's worlds,
+    smaller): many corridors of nearly equal length."""
+    rng = np.random.default_rng(seed)
+    cell = 100.0 / n
+    centres = (np.stack(np.meshgrid(np.arange(n), np.arange(n)), -1).reshape(-1, 2) + 0.5) * cell
+    centres += rng.uniform(-0.2, 0.2, centres.shape) * cell
+    radii = rng.uniform(0.2, 0.3, len(centres)) * cell
+    return World(((0, 0), (100, 100)), circles=np.column_stack([centres, radii]),
+                 robot_radius=robot * cell)  # fmt: skip
+
+
+@pytest.mark.parametrize(("seed", "robot"), [(1, 0.0), (2, 0.05)])
+def test_among_circles_alone_the_stage_pulls_taut_the_route_of_a_fine_lattice(seed, robot):
+    """Among circles alone the stage's path is the taut string of the shortest route on the
+    lattice of free centres (no bands), valid and within 1 % of the optimum on a field of 400
+    circles."""
+    world = _circle_field(20, seed, robot)
+    start, goal = (0.5, 0.5), (99.5, 99.5)
+    result = search.find_corridor_path(world, start, goal, None, max_cells=65_536)
+    assert "taut_routes" in result.stages and result.routes == 1
+    assert result.lattice.n_cells <= 65_536 and result.path is not None
+    assert world.path_valid(result.path)
+    best = exact_length(world, start, goal)
+    assert best * (1 - 1e-9) <= result.length <= best * 1.01
+
+
+def test_without_a_string_of_a_route_the_bands_take_over(monkeypatch):
+    world = _circle_field(10, 3, 0.05)
+    start, goal = (0.5, 0.5), (99.5, 99.5)
+    monkeypatch.setattr(search, "lattice_route", lambda *a: None)
+    result = search.find_corridor_path(world, start, goal, None, max_cells=16_384)
+    assert result.path is not None and world.path_valid(result.path)
+    assert result.routes >= 1 and "funnel" in result.stages
+
+
+def test_worlds_with_boxes_go_through_the_bands():
+    world = World(((0, 0), (20, 10)), boxes=[(9, 0, 10, 6)], circles=[(5, 5, 1.0)])
+    result = search.find_corridor_path(world, (1.0, 2.0), (19.0, 2.0), None, max_cells=16_384)
+    assert result.path is not None and world.path_valid(result.path)
+    assert "taut_routes" not in result.stages

@@ -34,7 +34,10 @@ corridor at once, at the resolution of a lattice:
    for the gap (:func:`.search._disc_corridors`) and wrapped round the wall corners.
 6. **Among circles, the taut string.** Wholly free cells keep up to a cell off every circle;
    each corridor's path becomes the shortest path passing every circle on the same side
-   (:mod:`.taut`), and corridors are compared by it.
+   (:mod:`.taut`), and corridors are compared by it. Among circles alone the string needs only
+   the side a route passes each circle: the stage first pulls taut the shortest route over the
+   free cell centres of a lattice as fine as its time affords, without bands
+   (:func:`.search._taut_routes`); the bands take over when that gives no string.
 
 The path stays inside cells that are wholly free, so it is valid without further checks; it is
 checked once anyway (exactly, or through the user's checker, whose lattice answers are not
@@ -72,6 +75,7 @@ from .search import (
     THIN_SPLIT,
     find_corridor_path,
 )
+from .taut import circles_alone
 
 __all__ = [
     "ALTERNATIVE_APART",
@@ -94,6 +98,7 @@ __all__ = [
     "band",
     "centre_route",
     "channel",
+    "circles_alone",
     "corridor_path",
     "find_corridor_path",
     "free_rectangles",

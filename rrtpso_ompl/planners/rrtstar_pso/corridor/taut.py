@@ -104,7 +104,7 @@ def taut_string(world, reference: np.ndarray, terminate=None) -> np.ndarray | No
     than the reference: ordered along the reference, two neighbouring circles traded places
     and were anchored and released in turn), and pulls the string round them.
     """
-    if not _circles_alone(world):
+    if not circles_alone(world):
         return None
     anchors = Anchors(world)
     start, goal = reference[0], reference[-1]
@@ -130,8 +130,9 @@ def taut_string(world, reference: np.ndarray, terminate=None) -> np.ndarray | No
     return None
 
 
-def _circles_alone(world) -> bool:
-    """Whether ``world`` is a World whose obstacles are circles only."""
+def circles_alone(world) -> bool:
+    """Whether ``world`` is a World whose obstacles are circles only (where :func:`taut_string`
+    applies)."""
     if getattr(world, "raster", None) is not None or not hasattr(world, "circles"):
         return False
     return len(world.circles) > 0 and not len(world.boxes) and not world.polygons
