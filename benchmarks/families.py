@@ -238,7 +238,7 @@ def merged(earlier: Path, rows: list[dict]) -> tuple[list[dict], list[str]]:
     and ``rows``' others after them; the planners of both, in :data:`PLANNERS`' order."""
 
     def key(r: dict) -> tuple:
-        return r["file"], r["planner"], r["budget"], r["seed"]
+        return r["file"], r["planner"], r["budget"], r.get("seed", 1)
 
     new = {key(r): r for r in rows}
     old = [json.loads(line) for line in earlier.read_text().splitlines() if line.strip()]

@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from families import footer, in_child, percentile, run_one, summary
+from families import footer, in_child, merged, percentile, run_one, summary
 
 #: Families: ``rrtpso generate`` kind and options.
 FAMILIES = {
@@ -173,7 +173,9 @@ def report(rows: list[dict], args, seeds) -> list[str]:
         f"{platform.python_version()}: family seeds {', '.join(map(str, seeds))} (queries "
         f"{', '.join(map(str, QUERIES))} of each map), planner seed 1, one run at a time, each in "
         "a process of its own. Path length over the exact optimum; every path was checked valid "
-        "with the exact checker. *Deadline*: RRTstarPSO's largest planning time over the budget.",
+        "with the exact checker. *Deadline*: RRTstarPSO's largest planning time over the budget."
+        + (f" Runs of {', '.join(args.planners_run)} from this command; the others kept from "
+           f"`{args.merge}`'s earlier run." if args.merge else ""),
     ]
     for budget in args.time:
         head = ["planner", "runs", "solved", "median", "p90", "worst"]
@@ -213,9 +215,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--planners", default=",".join(PLANNERS))
     ap.add_argument("--out", default="-", help="markdown file to write (default: print)")
     ap.add_argument("--rows", help="JSON lines of every run, to write")
+    ap.add_argument("--merge", help="JSON lines of an earlier run: its runs this one does not "
+                    "repeat are kept, in rows and report")
     args = ap.parse_args(argv)
     args.argv = sys.argv[1:] if argv is None else argv
-    args.planners = args.planners.split(",")
+    args.planners = args.planners_run = args.planners.split(",")
 
     import rrtpso_ompl.groundtruth  # (loaded once, used in the forked children)
     import rrtpso_ompl.planners  # noqa: F401
@@ -240,6 +244,8 @@ def main(argv: list[str] | None = None) -> int:
                                ratio=length / best if row["valid"] and best else None)  # fmt: skip
                     rows.append(row)
             print(f"{path.name} done ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
+    if args.merge:
+        rows, args.planners = merged(Path(args.merge), rows)
     if args.rows:
         Path(args.rows).write_text("".join(json.dumps(r) + "\n" for r in rows))
     write_markdown(report(rows, args, seeds), args.out)

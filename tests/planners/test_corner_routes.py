@@ -349,10 +349,10 @@ def test_pooling_keeps_walls_thicker_than_itself_and_loses_thin_ones():
 
 def test_a_thin_discs_band_begins_only_when_its_box_fits_the_time_left(tmp_path, monkeypatch):
     """Marking and wrapping a band's box of fine cells cannot be stopped midway (a box of 970,000
-    cells begun with 0.05 s left ran 0.08 s past a 0.25 s budget): a band whose box does not fit
-    the time left at :data:`LEAN_CELLS_PER_SECOND` is not begun, and the map-cell route stands.
-    No clock decides: the rate is set so that the map's 4,096 cells fit 1,000 s and no band's box
-    of fine cells (5 per map cell's side) does."""
+    cells begun with 0.05 s left ran 0.08 s past a 0.25 s budget): with the map-cell route's path
+    in hand, a band whose box does not fit the time left at :data:`BOX_CELLS_PER_SECOND` is not
+    begun, and that path stands. No clock decides: the rate is set so that no band's box of fine
+    cells (5 per map cell's side) fits 1,000 s."""
     problem, world, _ = _generated(tmp_path, "random_map", 1, 0, cells=64, density=0.2,
                                    robot_radius=0.3 * 100 / 64)  # fmt: skip
     start, goal = np.asarray(problem.start), np.asarray(problem.goal)
@@ -368,7 +368,7 @@ def test_a_thin_discs_band_begins_only_when_its_box_fits_the_time_left(tmp_path,
     roomy = search._disc_corridors(world, 1 << 20, start, goal, 0, far, 0.0, {})
     assert len(calls) >= 2 and min(calls[1:]) > 5 * 1000  # the map's route, then bands
     calls.clear()
-    monkeypatch.setattr(search, "LEAN_CELLS_PER_SECOND", 5)
+    monkeypatch.setattr(search, "BOX_CELLS_PER_SECOND", 5)
     far = search._Deadline(time.perf_counter() + 1000.0)
     tight = search._disc_corridors(world, 1 << 20, start, goal, 0, far, 0.0, {})
     assert calls == [64 * 64]  # the map's own cells only
