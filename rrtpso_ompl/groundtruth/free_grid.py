@@ -50,7 +50,7 @@ from ..model.world import World
 if TYPE_CHECKING:
     from scipy.sparse import csr_matrix
 
-__all__ = ["FreeGrid", "Stopped"]
+__all__ = ["FreeGrid", "Stopped", "box_lattice"]
 
 _SQRT2 = math.sqrt(2.0)
 #: Most cells of the raster over a world without a map, along the longer side of the bounds (16
@@ -135,7 +135,7 @@ class FreeGrid:
         between stages (:class:`Stopped`).
         """
         thr = world.threshold
-        lattice = _box_lattice(world)
+        lattice = box_lattice(world)
         _poll(terminate)
         if lattice is not None:
             origin, h, blocked = lattice
@@ -404,7 +404,7 @@ def _sorted_unique(key: np.ndarray) -> np.ndarray:
     return key[keep]
 
 
-def _box_lattice(world: World) -> tuple[tuple[float, float], float, np.ndarray] | None:
+def box_lattice(world: World) -> tuple[tuple[float, float], float, np.ndarray] | None:
     """``(origin, h, blocked)`` when every box edge and the bounds lie on one square lattice of
     at most :data:`MAX_LATTICE_CELLS` cells (a map's merged cells), else None. ``blocked`` has
     rows from the bottom; a cell is blocked when a box covers it."""

@@ -5,7 +5,8 @@
 polygons), rounds a point robot's corners (radius ``2 tol``), settles the trivial and the
 unsolvable cases with the conservative raster (:mod:`..free_grid`), and runs the tangent search
 (:mod:`.search`) in rounds of growing bounds until one finds a path within its bound: the
-package docstring tells why the answer is exact.
+package docstring tells why the answer is exact. A point robot on a map alone goes through the
+interval search instead (:mod:`.intervals`, :func:`_on_map`).
 """
 
 from __future__ import annotations
@@ -19,8 +20,10 @@ import numpy as np
 
 from ...model.problem_types import Problem
 from ...model.world import World
-from ..free_grid import FreeGrid, Stopped
+from ..free_grid import FreeGrid, Stopped, box_lattice
 from .circles import NodeCircles
+from .intervals import corner_sides, interval_path, rounded
+from .mesh import RectMesh
 from .result import OptimumResult, Piece
 from .search import TangentSearch
 
@@ -105,20 +108,25 @@ def shortest_path_in_world(
     if frame is not None:
         world = _boxes_as_polygons(world)
     t0 = time.perf_counter()
-    radius = max(world.robot_radius, 2.0 * world.tol)  # see the package docstring for R = 0
-    if radius != world.robot_radius:
-        world = world.with_robot_radius(radius)
     start = np.asarray(start, dtype=float)[:2]
     goal = np.asarray(goal, dtype=float)[:2]
     goal_tol = float(goal_tolerance)
-    exact = goal_tol == 0.0 or bool(
-        world.point_clearance(goal[None])[0] >= goal_tol + world.threshold
-    )
     if math.dist(start, goal) <= goal_tol or np.array_equal(start, goal):
         still = Piece("line", tuple(map(float, start)), tuple(map(float, start)))
         return OptimumResult(name, 0.0, [still], True, 1, 0, time.perf_counter() - t0)
+    cap = math.inf if upper_bound is None else float(upper_bound)
+    lattice = _point_on_map(world, goal_tol)
+    if lattice is not None:
+        return _on_map(lattice, 2.0 * world.tol, start, goal, cap, terminate, source,
+                       _Report(name, True, t0))  # fmt: skip
+    radius = max(world.robot_radius, 2.0 * world.tol)  # see the package docstring for R = 0
+    if radius != world.robot_radius:
+        world = world.with_robot_radius(radius)
+    exact = goal_tol == 0.0 or bool(
+        world.point_clearance(goal[None])[0] >= goal_tol + world.threshold
+    )
     report = _Report(name, exact, t0)
-    return _search(world, start, goal, goal_tol, upper_bound, terminate, source, report)
+    return _search(world, start, goal, goal_tol, cap, terminate, source, report)
 
 
 @dataclass(frozen=True)
@@ -143,11 +151,12 @@ class _Report:
                              rounds)  # fmt: skip
 
 
-def _search(world: World, start: np.ndarray, goal: np.ndarray, goal_tol: float,
-            upper_bound: float | None, terminate: Callable[[], bool] | None, source: str,
+def _search(world: World, start: np.ndarray, goal: np.ndarray, goal_tol: float, cap: float,
+            terminate: Callable[[], bool] | None, source: str,
             report: _Report) -> OptimumResult:  # fmt: skip
-    """The raster's proof or bounds, then the tangent search in rounds of growing bounds
-    (package docstring); start and goal apart, the robot radius at least twice the tolerance."""
+    """The raster's proof or bounds, then the tangent search in rounds of growing bounds up to
+    ``cap`` (package docstring); start and goal apart, the robot radius at least twice the
+    tolerance."""
     stop = terminate if terminate is not None else (lambda: False)
     if stop():
         return report(None, stopped=True)
@@ -160,7 +169,6 @@ def _search(world: World, start: np.ndarray, goal: np.ndarray, goal_tol: float,
     if stop():
         return report(None, stopped=True)
     nodes = NodeCircles.build(world, grid, start, goal, world.robot_radius)
-    cap = math.inf if upper_bound is None else float(upper_bound)
     lower = float(grid.lower_bound(1, start[None])[0])
     search = None
     kind = "lattice" if grid.blocked is not None else "generic"
@@ -172,6 +180,48 @@ def _search(world: World, start: np.ndarray, goal: np.ndarray, goal_tol: float,
         if found is not None or bound >= cap:
             return report(found, search, rounds=k + 1)
     return report(None, search)  # pragma: no cover - the last bound is the cap
+
+
+def _point_on_map(world: World, goal_tol: float):
+    """:func:`~..free_grid.box_lattice` of a point robot's world of a map alone (no circles or
+    polygons) and a goal point, else None."""
+    if world.robot_radius > 0.0 or goal_tol > 0.0 or len(world.circles) or world.polygons:
+        return None
+    return box_lattice(world)
+
+
+def _on_map(lattice, rho: float, start: np.ndarray, goal: np.ndarray, cap: float,
+            terminate: Callable[[], bool] | None, source: str,
+            report: _Report) -> OptimumResult:  # fmt: skip
+    """A point robot on a map alone (``lattice``: :func:`~..free_grid.box_lattice`'s origin,
+    cell side and blocked cells): the interval search over the rectangles of its free cells
+    (:mod:`.intervals`), whose work follows the region it explores rather than the number of
+    wall corners (a 1024 x 1024 maze of one-cell corridors: 2-3 s, where the tangent search did
+    not finish in 300 s). Its path bends at the corners themselves; the package rounds a point
+    robot's corners (radius ``rho``, twice the tolerance: package docstring), so the path is
+    drawn round them, with the corners it touches between its bends
+    (:func:`.intervals.corner_sides`, :func:`.intervals.rounded`): the tangent search's answer
+    for the same query, the same to 4e-15 on the benchmarks' 100 point-robot map queries (the
+    sharp path is shorter by up to 3e-7 relative on a maze). No path beyond ``cap``, as the
+    tangent search. No raster, no copy of the world: on 4 million cells those took 3.4 s."""
+    if terminate is not None and terminate():
+        return report(None, stopped=True)
+    (x0, y0), h, blocked = lattice
+    mesh = RectMesh.build(~blocked)
+    a, b = ((start[0] - x0) / h, (start[1] - y0) / h), ((goal[0] - x0) / h, (goal[1] - y0) / h)
+    try:
+        found = interval_path(mesh, a, b, terminate, source)
+    except Stopped:
+        return report(None, stopped=True)
+    if found is None:
+        return report(None, found, rounds=1)
+    points, sides = corner_sides(mesh, found.vertices)
+    corners = [(x0 + x * h, y0 + y * h) for x, y in points]
+    corners[0], corners[-1] = tuple(map(float, start)), tuple(map(float, goal))
+    length, pieces = rounded(corners, sides, rho)
+    if length > cap:
+        return report(None, found, rounds=1)
+    return report((length, pieces), found, rounds=1)
 
 
 def _grid_frame_world(world: World) -> World:
