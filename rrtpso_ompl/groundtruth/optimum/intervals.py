@@ -11,9 +11,14 @@ walls). An end of the interval that is a wall corner becomes a root: from there 
 into every rectangle that touches the corner, through all of their pieces (a superset of
 Polyanya's non-observable successors, which keeps the search simple: every corner is opened once,
 at its least cost, and a later, costlier arrival is pruned, Polyanya's root-level pruning). The
-heuristic is the straight distance from the root through the interval to the goal (the goal
-mirrored in the interval's line when it lies on the root's side), admissible, so the first goal
-taken from the queue is the optimum.
+heuristic is the larger of the straight distance from the root through the interval to the goal
+(the goal mirrored in the interval's line when it lies on the root's side) and the distance to
+the interval plus its piece's bound (:meth:`.mesh.RectMesh.bounds_to`, which follows a maze's
+corridors); both are admissible, so the first goal taken from the queue is the optimum.
+
+The search's path bends at the corners themselves. :func:`corner_sides` adds the corners it
+only touches and the side it passes each one; :func:`rounded` draws it round circles at them
+(the package rounds a point robot's corners, :mod:`.query`).
 
 Coordinates are the grid's (cells); the caller scales. The search's work follows the region it
 explores (the rectangles within the optimum's ellipse, for a maze the corridors), not the number
@@ -32,7 +37,7 @@ from ..free_grid import Stopped
 from .mesh import RectMesh
 from .result import MAX_NODES, OptimumTooLarge
 
-__all__ = ["IntervalPath", "interval_path", "rounded"]
+__all__ = ["IntervalPath", "corner_sides", "interval_path", "rounded"]
 
 #: Round-off allowance, cells.
 _EPS = 1e-9
