@@ -123,7 +123,7 @@ class ObstacleIndex:
     # Preparation
     # ------------------------------------------------------------------------------------------
     def _prepare_polygons(self) -> None:
-        """Polygon edges, shapes for inside tests, and every edge of the polygons and boxes."""
+        """Polygon edges and shapes for inside tests."""
         if self.polygons:
             a = np.concatenate(self.polygons)
             b = np.concatenate([np.roll(p, -1, axis=0) for p in self.polygons])
@@ -136,11 +136,15 @@ class ObstacleIndex:
             self.edges = np.empty((0, 4))
             self.shapes = np.empty(0, dtype=object)
             self._poly_union = None
-        # The boxes' edges in world coordinates: all first sides, then all second sides, ...
+
+    @property
+    def all_edges(self) -> np.ndarray:
+        """Every edge of the polygons and boxes, ``(ax, ay, bx, by)`` rows: the polygons' first,
+        then the boxes' first sides, second sides, ... (made on each call: on a map of millions
+        of cells it is 80 MB that no check needs)."""
         c = self.box_corners()
         box_edges = np.concatenate([np.hstack([c[:, k], c[:, (k + 1) % 4]]) for k in range(4)])
-        #: Every edge of the polygons and boxes, ``(ax, ay, bx, by)`` rows.
-        self.all_edges = np.vstack([self.edges, box_edges.reshape(-1, 4)])
+        return np.vstack([self.edges, box_edges.reshape(-1, 4)])
 
     def _prepare_grid(self) -> None:
         """The grid over every item grown by its reach."""

@@ -22,6 +22,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from ..errors import ArgumentError, ProblemError, did_you_mean, shown
+from ..gc_pause import cyclic_gc_paused
 from ..validation import (
     MAX_COORDINATE,
     MIN_EXTENT,
@@ -101,8 +102,9 @@ def load_problem(path: str | Path) -> Problem:
         raise ArgumentError(f"load_problem: path must be a file name (str or os.PathLike), got "
                             f"{describe(path)}")  # fmt: skip
     path = Path(path)
-    data = read_yaml_file(path)
-    return problem_from_dict(data, source=str(path), name=path.stem, base=path.parent)
+    with cyclic_gc_paused():  # the parsed document's objects live until the problem is built
+        data = read_yaml_file(path)
+        return problem_from_dict(data, source=str(path), name=path.stem, base=path.parent)
 
 
 def input_files(path: str | Path) -> tuple[str, ...]:

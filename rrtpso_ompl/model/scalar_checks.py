@@ -19,6 +19,7 @@ import time
 import numpy as np
 import shapely
 
+from ..gc_pause import cyclic_gc_paused
 from .geometry import (
     point_in_polygon_xy,
     point_segment_distance_xy,
@@ -60,12 +61,14 @@ class ScalarChecks:
         self.box_frame = index.box_frame
         self._grid = index.grid
         self._indexed = index.indexed
-        self._all_ids = tuple(range(index.n_items))
+        # Every item, for a world too small for its index (a tuple of millions costs 25 MB).
+        self._all_ids = () if index.indexed else tuple(range(index.n_items))
         self._reach_boxes = index.reach_boxes
         self._first_interior = index.first_interior
         self._pair_distance = index.pair_distance
         self._crowd: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # cell -> (ids, their boxes)
-        self._py = _python_items(index)
+        with cyclic_gc_paused():  # a tuple per item: 620,000 on a 4-million-cell map
+            self._py = _python_items(index)
 
     def point_free(self, x: float, y: float) -> bool:
         """Whether the robot disc centred at ``(x, y)`` overlaps no obstacle (bounds unchecked)."""

@@ -29,6 +29,7 @@ from typing import Any, BinaryIO
 import yaml
 
 from ..errors import ProblemError
+from ..gc_pause import cyclic_gc_paused
 from ..validation import short_repr
 
 __all__ = [
@@ -50,6 +51,8 @@ MAX_DEPTH = 100
 #: libyaml's parser when PyYAML was built with it (tens of times faster on big files); the
 #: constructor stays Python's, so values and messages are the same.
 _BaseLoader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+#: Most plain scalars' tags one loader remembers (a bound on its memory).
+_TAG_MEMORY = 4096
 
 
 def file_kind(mode: int) -> str:
@@ -141,6 +144,23 @@ class _SafeLoader(_BaseLoader):
     the file) is known, turns them into ordinary YAML errors with a location.
     """
 
+    def __init__(self, stream: str) -> None:
+        self._tags: dict[str, str] = {}
+        super().__init__(stream)
+
+    def resolve(self, kind: type, value: str, implicit: tuple[bool, bool]) -> str:
+        """The tag of a node; a plain scalar's depends on its text alone (no path resolvers),
+        and a large document repeats its keys and words thousands of times: remembered (up to
+        :data:`_TAG_MEMORY` texts)."""
+        if kind is not yaml.ScalarNode or not implicit[0] or self.yaml_path_resolvers:
+            return super().resolve(kind, value, implicit)
+        tag = self._tags.get(value)
+        if tag is None:
+            tag = super().resolve(kind, value, implicit)
+            if len(self._tags) < _TAG_MEMORY:
+                self._tags[value] = tag
+        return tag
+
     def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:
         try:
             return super().construct_object(node, deep=deep)
@@ -165,12 +185,13 @@ def load_yaml(text: str) -> Any:
     """
     loader = _SafeLoader(text)
     try:
-        node = loader.get_single_node()
-        if node is None:
-            return None
-        if _refuse_duplicate_keys(node):  # only a document with aliases shares nodes
-            _refuse_alias_bombs(node)
-        return loader.construct_document(node)
+        with cyclic_gc_paused():  # a large document's nodes all live until it is built
+            node = loader.get_single_node()
+            if node is None:
+                return None
+            if _refuse_duplicate_keys(node):  # only a document with aliases shares nodes
+                _refuse_alias_bombs(node)
+            return loader.construct_document(node)
     finally:
         loader.dispose()
 
@@ -178,9 +199,11 @@ def load_yaml(text: str) -> Any:
 def _refuse_duplicate_keys(root: yaml.Node) -> bool:
     """Refuse a mapping that writes a key twice, and nesting deeper than MAX_DEPTH; return
     whether any node is shared (aliased)."""
-    # Iterative, and each node once: aliases may share or even contain their own nodes.
+    # Iterative, and each collection once: aliases may share or even contain their own nodes.
+    # Scalars are not stacked (most of a large document): a shared scalar cannot blow up.
     seen_nodes: set[int] = set()
     shared = False
+    scalar = yaml.ScalarNode
     stack = [(root, 0)]
     while stack:
         node, depth = stack.pop()
@@ -189,14 +212,12 @@ def _refuse_duplicate_keys(root: yaml.Node) -> bool:
             continue
         seen_nodes.add(id(node))
         if depth > MAX_DEPTH:
-            raise yaml.constructor.ConstructorError(
-                None, None, f"lists or mappings nested too deeply (more than {MAX_DEPTH} levels)",
-                node.start_mark,
-            )  # fmt: skip
+            raise _too_deep(node)
         if isinstance(node, yaml.MappingNode):
+            children = [n for pair in node.value for n in pair]
             first: dict[tuple[str, str], yaml.Node] = {}
-            for key, value in node.value:
-                if isinstance(key, yaml.ScalarNode) and key.tag != "tag:yaml.org,2002:merge":
+            for key, _ in node.value:
+                if isinstance(key, scalar) and key.tag != "tag:yaml.org,2002:merge":
                     other = first.setdefault((key.tag, key.value), key)
                     if other is not key:
                         raise yaml.constructor.ConstructorError(
@@ -206,10 +227,21 @@ def _refuse_duplicate_keys(root: yaml.Node) -> bool:
                             f"(first written at line {other.start_mark.line + 1})",
                             key.start_mark,
                         )
-                stack.extend(((key, depth + 1), (value, depth + 1)))
         elif isinstance(node, yaml.SequenceNode):
-            stack.extend((child, depth + 1) for child in node.value)
+            children = node.value
+        else:
+            continue
+        if children and depth + 1 > MAX_DEPTH:
+            raise _too_deep(children[-1])  # the child the stack would have met first
+        stack.extend((c, depth + 1) for c in children if not isinstance(c, scalar))
     return shared
+
+
+def _too_deep(node: yaml.Node) -> yaml.YAMLError:
+    return yaml.constructor.ConstructorError(
+        None, None, f"lists or mappings nested too deeply (more than {MAX_DEPTH} levels)",
+        node.start_mark,
+    )  # fmt: skip
 
 
 def _yaml_message(exc: yaml.YAMLError) -> str:

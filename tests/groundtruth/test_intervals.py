@@ -139,25 +139,78 @@ def test_the_search_stops_when_told_and_refuses_too_many_nodes(monkeypatch):
 
 
 def test_discs_goal_discs_and_shapes_keep_the_tangent_search(monkeypatch):
+    from rrtpso_ompl.groundtruth.optimum import query
+
     calls = []
-    real = iv.interval_path
+    real = query.TangentSearch
 
     def spy(*args, **kwargs):
         calls.append(1)
         return real(*args, **kwargs)
 
+    monkeypatch.setattr(query, "TangentSearch", spy)
+    blocked = _grid(4, density=0.1)
+    world = _world(blocked)
+    assert shortest_path_in_world(world, (0.5, 0.5), (19.5, 19.5)).length is not None
+    assert calls == []
+    with_circle = World(world.bounds, circles=[(10.0, 10.0, 0.3)], boxes=world.boxes)
+    for w, tol in ((world.with_robot_radius(0.2), 0.0), (world, 0.3), (with_circle, 0.0)):
+        assert shortest_path_in_world(w, (0.5, 0.5), (19.5, 19.5), tol).length is not None
+        assert calls
+        calls.clear()
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_discs_optimum_is_the_same_with_the_points_bound_and_guess(seed, monkeypatch):
+    """The point's sharp path bounds a disc's from below, and its guess only places the first
+    round: the disc's optimum is the same with them as without (to 1e-9), and valid."""
     from rrtpso_ompl.groundtruth.optimum import query
 
-    monkeypatch.setattr(query, "interval_path", spy)
-    blocked = _grid(4)
-    world = _world(blocked)
-    shortest_path_in_world(world, (0.5, 0.5), (19.5, 19.5))
-    assert calls == [1]
-    shortest_path_in_world(world.with_robot_radius(0.2), (0.5, 0.5), (19.5, 19.5))
-    shortest_path_in_world(world, (0.5, 0.5), (19.5, 19.5), goal_tolerance=0.3)
-    with_circle = World(world.bounds, circles=[(10.0, 10.0, 0.3)], boxes=world.boxes)
-    shortest_path_in_world(with_circle, (0.5, 0.5), (19.5, 19.5))
-    assert calls == [1]
+    blocked = _grid(seed, density=0.15)
+    radius = (0.2, 0.35, 0.45)[seed % 3]
+    world = _world(blocked).with_robot_radius(radius)
+    rng = np.random.default_rng(seed)
+    free = np.argwhere(~blocked)
+    checked = 0
+    for _ in range(4):
+        a, b = free[rng.choice(len(free), 2, replace=False)]
+        start, goal = (a[1] + 0.5, a[0] + 0.5), (b[1] + 0.5, b[0] + 0.5)
+        if not (world.point_clearance(np.array([start, goal])) >= world.threshold).all():
+            continue
+        tol = 0.3 if checked % 2 else 0.0
+        sharp, guess = query._point_path(world, np.array(start), np.array(goal), tol, None, "t")
+        new = shortest_path_in_world(world, start, goal, goal_tolerance=tol)
+        with monkeypatch.context() as m:
+            m.setattr(query, "_point_path", lambda *args: (0.0, 0.0))
+            old = shortest_path_in_world(world, start, goal, goal_tolerance=tol)
+        if old.length is None:
+            assert new.length is None
+            continue
+        checked += 1
+        assert new.length == pytest.approx(old.length, rel=1e-9)
+        assert sharp <= new.length + 1e-9 <= guess * 1.3
+        assert world.path_valid(new.valid_polyline(world))
+    assert checked >= 2
+
+
+def test_no_point_path_proves_that_no_disc_passes(monkeypatch):
+    """A wall of cells touching only at their corners: the raster's 8-connected search passes
+    between them, the point's path search does not (the mesh meets along pieces, and no disc
+    passes a point where two blocked cells touch), and the answer is "no path" without a
+    tangent search."""
+    from rrtpso_ompl.groundtruth.free_grid import FreeGrid
+    from rrtpso_ompl.groundtruth.optimum import query
+
+    blocked = np.zeros((10, 10), dtype=bool)
+    blocked[np.arange(10), 9 - np.arange(10)] = True
+    assert FreeGrid.for_world(_world(blocked).with_robot_radius(0.2), (1.5, 1.5),
+                              (8.5, 8.5)).connected  # fmt: skip
+    world = _world(blocked).with_robot_radius(0.2)
+    sharp, guess = query._point_path(world, np.array([1.5, 1.5]), np.array([8.5, 8.5]), 0.0,
+                                     None, "t")  # fmt: skip
+    assert sharp == guess == math.inf
+    monkeypatch.setattr(query, "TangentSearch", None)  # not reached
+    assert shortest_path_in_world(world, (1.5, 1.5), (8.5, 8.5)).length is None
 
 
 def test_rounded_corners_make_the_tangent_paths_length():

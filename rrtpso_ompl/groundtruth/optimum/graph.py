@@ -3,11 +3,12 @@
 Whether a tangent is free does not depend on the node that leaves along it, so each circle's
 free tangents are found once, for a batch of circles at a time (those the search will likely
 expand next), through filters that each drop only what no path within the bound can use,
-cheapest first: circle pairs beyond the bound or whose step counts to the goal differ by more
-than a free segment between them allows; directions outside the cones; pairs in the shadow of
-the discs near the first circle (:mod:`.shadows`); tangents beyond the bound; the raster's sound
-rejection; then the exact tests (obstacles near the circle first, then the world's). Lengths are
-in the problem's unit.
+cheapest first: on a map's cells alone, circles out of reach of straight runs from the first
+one's centre (:mod:`.sight`); circle pairs beyond the bound or whose step counts to the goal
+differ by more than a free segment between them allows; directions outside the cones; pairs in
+the shadow of the discs near the first circle (:mod:`.shadows`); tangents beyond the bound; the
+raster's sound rejection; then the exact tests (obstacles near the circle first, then the
+world's). Lengths are in the problem's unit.
 """
 
 from __future__ import annotations
@@ -16,10 +17,12 @@ import math
 
 import numpy as np
 
+from ...model.spatial import Grid
 from ...model.world import World
 from ..free_grid import FreeGrid
 from .circles import NodeCircles
 from .shadows import shadowed
+from .sight import Reach
 from .tangents import ANGLE_TOL, TWO_PI, Tangents, cone_pos, tangents_from
 
 __all__ = ["TangentGraph"]
@@ -73,11 +76,17 @@ class TangentGraph:
         self.lo, self.width, self.sure = nodes.lo[keep], nodes.width[keep], nodes.sure[keep]
         self.lb_s, self.lb_g = lb_s[keep], lb_g[keep]
         self.steps = grid.step_ranges(self.circles)
+        self._sieve = _Sieve(self.circles, self.lb_g, self.steps, grid.H)
         self._cache: dict[int, Tangents] = {}
         self._cached = np.zeros(len(self.circles), dtype=bool)
         self._cached[1] = True  # the goal: never expanded
         self._cells_only = (grid.band_ok(world.threshold) and not len(world.circles)
                             and not world.polygons)  # fmt: skip
+        # On a map's cells alone, how far straight runs go from each circle's centre, and the
+        # centres by place (made on the first batch: _local_rows).
+        self._reach: Reach | None = None
+        self._runs: np.ndarray | None = None
+        self._centres: Grid | None = None
 
     def free_tangents(self, i: int, g: float, f: float) -> Tangents:
         """The tangents from circle ``i`` that some path within the bound could use and that are
@@ -127,34 +136,65 @@ class TangentGraph:
 
     def _candidate_pairs(self, batch: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The pairs ``(batch[row], j)`` whose tangents a path within the bound may use, by the
-        distances between the circles and their step counts to the goal."""
+        distances between the circles and their step counts to the goal; on a map's cells
+        alone, first by where straight runs from the circle's centre can go (:mod:`.sight`:
+        the centres within reach, not the whole ellipse)."""
         c = self.circles
-        ci = c[batch]
-        # A first sieve over the whole (batch x circles) matrix, with cheap over-estimates of
-        # distances (|dx| + |dy|) and under-estimates (max(|dx|, |dy|)): the bound through the
-        # pair, and the 8-connected step counts to the goal (see FreeGrid.step_ranges).
-        dx = np.abs(c[None, :, 0] - ci[:, None, 0])
-        dy = np.abs(c[None, :, 1] - ci[:, None, 1])
-        spread = ci[:, None, 2] + c[None, :, 2]
-        reach = np.maximum(dx, dy) + self.lb_g[None, :] <= (
-            self.bound - self.lb_s[batch])[:, None] + spread  # fmt: skip
-        n = (dx + dy + 2.0 * spread) * (1.0 / self.grid.H) + 2.0
-        lo_i, hi_i = self.steps[batch, 2, 0][:, None], self.steps[batch, 2, 1][:, None]
-        lo_j, hi_j = self.steps[None, :, 2, 0], self.steps[None, :, 2, 1]
-        with np.errstate(invalid="ignore"):  # inf - inf: a circle no free path reaches: drop
-            reach &= (lo_j - hi_i <= n) & (lo_i - hi_j <= n)
-        reach[:, 0] = False
-        reach[np.arange(len(batch)), batch] = False
-        row, j = np.nonzero(reach)
-        # Then the exact distances and every step count, pair by pair.
+        local = self._local_rows(batch)
+        row, j = np.empty(0, dtype=np.intp), np.empty(0, dtype=np.intp)
+        wide = batch[~local]
+        if len(wide):
+            row, j = self._sieve.pairs(c[wide], self.bound - self.lb_s[wide], self.steps[wide, 2])
+            row = np.flatnonzero(~local)[row]
+        if local.any():
+            near_row, near_j = self._within_reach(batch, np.flatnonzero(local))
+            row, j = np.concatenate([row, near_row]), np.concatenate([j, near_j])
+        keep = (j != 0) & (j != batch[row])
+        row, j = row[keep], j[keep]
+        # Then the exact distances, and of the pairs within the bound every step count.
         i = batch[row]
         d = c[j, :2] - c[i, :2]
         spread = c[i, 2] + c[j, 2]
         gap = np.hypot(d[:, 0], d[:, 1]) - spread
-        ok = self.lb_s[i] + np.maximum(gap, 0.0) + self.lb_g[j] <= self.bound
-        ok &= self.grid.visible_pairs(self.steps[i], self.steps[j], np.abs(d[:, 0]) + spread,
-                                      np.abs(d[:, 1]) + spread)  # fmt: skip
-        return row[ok], j[ok]
+        near = np.flatnonzero(self.lb_s[i] + np.maximum(gap, 0.0) + self.lb_g[j] <= self.bound)
+        i, j, d, spread = i[near], j[near], d[near], spread[near]
+        ok = self.grid.visible_pairs(self.steps[i], self.steps[j], np.abs(d[:, 0]) + spread,
+                                     np.abs(d[:, 1]) + spread)  # fmt: skip
+        return row[near[ok]], j[ok]
+
+    def _local_rows(self, batch: np.ndarray) -> np.ndarray:
+        """Which circles of ``batch`` have a bounded reach (:mod:`.sight`): on a map's cells
+        alone, those whose straight runs end within :data:`.sight.MAX_SWEEP` cells every way."""
+        if not self._cells_only:
+            return np.zeros(len(batch), dtype=bool)
+        if self._runs is None:
+            g = self.grid
+            self._reach = Reach(~g.blocked, self.world.tol / g.h)
+            c = self.circles
+            self._runs = self._reach.runs((c[:, 0] - g.x0) / g.h, (c[:, 1] - g.y0) / g.h)
+            self._centres = Grid(c[:, :2].min(axis=0), c[:, :2].max(axis=0),
+                                 np.hstack([c[:, :2], c[:, :2]]), cell=8.0 * g.h)  # fmt: skip
+        return np.isfinite(self._runs[batch]).all(axis=1)
+
+    def _within_reach(self, batch: np.ndarray, rows: np.ndarray):
+        """``(row, j)``: the circles ``j`` whose centres the segments from the centres of
+        ``batch[rows]`` may reach (:meth:`.sight.Reach.may_see`), and the goal for each (a
+        tangent into a goal disc is cut short: the segment to its centre need not be free)."""
+        g, c = self.grid, self.circles
+        i = batch[rows]
+        runs = self._runs[i]
+        # How far a segment can go each way: a mostly horizontal one rises no more than it runs,
+        # so leftwards (say) the longest of the left run and the up and down runs.
+        far = np.column_stack([np.maximum(runs[:, 1], runs[:, 2:].max(axis=1)),
+                               np.maximum(runs[:, 3], runs[:, :2].max(axis=1)),
+                               np.maximum(runs[:, 0], runs[:, 2:].max(axis=1)),
+                               np.maximum(runs[:, 2], runs[:, :2].max(axis=1))]) * g.h  # fmt: skip
+        q, j = self._centres.pairs_in_boxes(c[i, :2] - far[:, :2], c[i, :2] + far[:, 2:])
+        d = (c[j, :2] - c[i[q], :2]) / g.h
+        seen = self._reach.may_see(runs[q], d[:, 0], d[:, 1]) & (j != 1)
+        q, j = q[seen], j[seen]
+        return (np.concatenate([rows[q], rows]),
+                np.concatenate([j, np.ones(len(rows), dtype=j.dtype)]))  # fmt: skip
 
     def _usable(self, cand: Tangents) -> Tangents:
         """The tangents within the cones of free directions at both ends, in the bounds, that
@@ -255,6 +295,58 @@ class TangentGraph:
             frac = np.clip(1.0 - self.goal_tol / np.where(n > 0, n, 1.0), 0.0, 1.0)
             end[to_goal] = cand.p[to_goal] + frac[:, None] * d
         return end
+
+
+class _Sieve:
+    """The first sieve of :meth:`TangentGraph._candidate_pairs`, over a batch of circles and
+    every other, with cheap over-estimates of distances (``|dx| + |dy|``) and under-estimates
+    (``max(|dx|, |dy|)``): the bound through the pair, and the 8-connected step counts to the
+    goal (:meth:`~..free_grid.FreeGrid.step_ranges`). The circles are held in the order of
+    their bound to the goal, with the terms of each test that depend on one circle alone
+    folded in advance, so a batch meets only a prefix of them (those whose bound leaves room
+    for a path through a circle of the batch), read in place: it runs once for every 32
+    circles expanded, over every circle of the round's ellipse."""
+
+    def __init__(self, circles: np.ndarray, lb_g: np.ndarray, steps: np.ndarray,
+                 H: float) -> None:  # fmt: skip
+        self.order = np.argsort(lb_g, kind="stable")
+        c = circles[self.order]
+        self.lb_g = lb_g[self.order]
+        self.x, self.y, rho = (np.ascontiguousarray(c[:, k]) for k in range(3))
+        self.rho_max = float(rho.max()) if len(rho) else 0.0
+        self.inv_h = 1.0 / H
+        #: ``max(|dx|, |dy|) + lb_g - rho <= bound - lb_s(i) + rho_i``: the bound through.
+        self.reach = self.lb_g - rho
+        # |steps_j - steps_i| <= (|dx| + |dy| + 2 (rho_i + rho_j)) / H + 2, one side each.
+        s = steps[self.order, 2]
+        self.above = s[:, 0] - 2.0 * rho * self.inv_h
+        self.below = -s[:, 1] - 2.0 * rho * self.inv_h
+
+    def pairs(self, ci: np.ndarray, room: np.ndarray, steps: np.ndarray):
+        """``(row, j)``: the pairs of the batch's circle ``ci[row]`` (``(x, y, rho)`` rows) and
+        circle ``j`` (the graph's numbering) that pass; ``room`` is each batch circle's bound
+        less its bound from the start, ``steps`` its 8-connected step range to the goal, ``(len(ci),
+        2)``."""
+        rho_i = ci[:, 2:3]
+        top = float((room + ci[:, 2]).max()) + self.rho_max
+        m = int(np.searchsorted(self.lb_g, top, side="right"))
+        dx = np.subtract.outer(ci[:, 0], self.x[:m])
+        np.abs(dx, out=dx)
+        dy = np.subtract.outer(ci[:, 1], self.y[:m])
+        np.abs(dy, out=dy)
+        t = np.maximum(dx, dy)
+        t += self.reach[:m]
+        ok = t <= room[:, None] + rho_i
+        dx += dy
+        dx *= self.inv_h  # now (|dx| + |dy|) / H
+        slack = 2.0 * rho_i * self.inv_h + 2.0
+        with np.errstate(invalid="ignore"):  # inf - inf: a circle no free path reaches: drop
+            np.subtract(self.above[:m], dx, out=t)
+            ok &= t <= steps[:, 1:2] + slack
+            np.subtract(self.below[:m], dx, out=t)
+            ok &= t <= slack - steps[:, 0:1]
+        row, k = np.nonzero(ok)
+        return row, self.order[k]
 
 
 def _loosen(bound: float, tol: float) -> float:

@@ -15,6 +15,7 @@ from the bottom.
 from __future__ import annotations
 
 import math
+from array import array
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,8 +37,8 @@ class RectMesh:
 
     Attributes
     ----------
-    x0, x1, y0, y1 : list of int
-        Each rectangle's extent, cells.
+    x0, x1, y0, y1 : array of int
+        Each rectangle's extent, cells (``array("q")``: Python ints when indexed).
     top, bottom : sequence of list of (int, int, int, int)
         Each rectangle's pieces along its top (bottom) edge, left to right: ``(p0, p1,
         neighbour, pid)``, the piece ``[p0, p1]`` of the edge shared with rectangle
@@ -101,8 +102,8 @@ class RectMesh:
         blocked = np.pad(~free, 1, constant_values=True)
         count = (blocked[:-1, :-1].astype(np.int8) + blocked[:-1, 1:] + blocked[1:, :-1]
                  + blocked[1:, 1:])  # fmt: skip
-        return cls(sx0[roots].tolist(), sx1[roots].tolist(), sj[roots].tolist(), y1.tolist(),
-                   top, bottom, cell_rect.reshape(ny, nx), count == 1, pieces)  # fmt: skip
+        return cls(_ints(sx0[roots]), _ints(sx1[roots]), _ints(sj[roots]), _ints(y1), top, bottom,
+                   cell_rect.reshape(ny, nx), count == 1, pieces)  # fmt: skip
 
     def bounds_to(self, x: float, y: float) -> np.ndarray:
         """Lower bounds on the length of every free path from each piece to the point ``(x,
@@ -160,6 +161,15 @@ class RectMesh:
         i1, j1 = min(math.floor(x), nx - 1), min(math.floor(y), ny - 1)
         return sorted({r for r in self.cell_rect[j0 : j1 + 1, i0 : i1 + 1].ravel().tolist()
                        if r >= 0})  # fmt: skip
+
+
+def _ints(a: np.ndarray) -> array:
+    """``a`` as an array of machine integers whose items are Python ints: indexed as fast as a
+    list by the search, at 8 bytes an item rather than about 36 (a list of 680,000 rectangles'
+    extents costs 100 MB as lists)."""
+    out = array("q")
+    out.frombytes(np.ascontiguousarray(a, dtype=np.int64).tobytes())
+    return out
 
 
 def _pieces(sj, sx0, sx1, rid, w: int) -> np.ndarray:

@@ -24,7 +24,7 @@ from ..free_grid import FreeGrid, Stopped, box_lattice
 from .circles import NodeCircles
 from .intervals import corner_sides, interval_path, rounded
 from .mesh import RectMesh
-from .result import OptimumResult, Piece
+from .result import OptimumResult, OptimumTooLarge, Piece
 from .search import TangentSearch
 
 __all__ = ["shortest_path", "shortest_path_in_world"]
@@ -168,10 +168,18 @@ def _search(world: World, start: np.ndarray, goal: np.ndarray, goal_tol: float, 
         return report(None)
     if stop():
         return report(None, stopped=True)
+    try:
+        sharp, guess = _point_path(world, start, goal, goal_tol, terminate, source)
+    except Stopped:
+        return report(None, stopped=True)
+    if sharp == math.inf:  # a proof: no point, hence no disc, passes between them
+        return report(None)
     nodes = NodeCircles.build(world, grid, start, goal, world.robot_radius)
-    lower = float(grid.lower_bound(1, start[None])[0])
+    lower = max(float(grid.lower_bound(1, start[None])[0]), sharp)
     search = None
     kind = "lattice" if grid.blocked is not None else "generic"
+    if guess > lower:
+        lower, kind = guess, "guess"
     for k, bound in enumerate(_bounds(lower, cap, world.tol, kind)):
         search = TangentSearch(world, grid, nodes, goal_tol, bound, source, terminate)
         found = search.run()
@@ -180,6 +188,44 @@ def _search(world: World, start: np.ndarray, goal: np.ndarray, goal_tol: float, 
         if found is not None or bound >= cap:
             return report(found, search, rounds=k + 1)
     return report(None, search)  # pragma: no cover - the last bound is the cap
+
+
+def _point_path(world: World, start: np.ndarray, goal: np.ndarray, goal_tol: float,
+                terminate: Callable[[], bool] | None,
+                source: str) -> tuple[float, float]:  # fmt: skip
+    """On a map alone, a lower bound on the length of a disc's path and a guess at it: the
+    length ``L`` of the point's shortest path through the closure of the free cells (sharp
+    corners, :func:`.intervals.interval_path`), and ``L + R * turn``, ``turn`` its total turning
+    (radians), both less the goal tolerance; ``(inf, inf)`` when no such path exists, ``(0, 0)``
+    for any other world.
+
+    The disc's centre keeps a positive clearance from every blocked cell, so its path is one of
+    the point's: ``L`` bounds it from below. Among a map's many corners the raster's bound is
+    short by up to a fifth (it counts cells); ``L`` is within a percent of a disc's length on
+    rooms and cities and within 5 % in mazes of 4-cell corridors. A disc that follows the
+    point's path round its corners is ``R`` times the turning longer (the offset of a convex
+    chain): the guess, within 4 % of the optimum in mazes of 1-cell corridors, where ``L`` is 19
+    % short. It only places the first round's bound (a round that finds nothing within its bound
+    hands over to the next), so it need not be a bound itself."""
+    if len(world.circles) or world.polygons:
+        return 0.0, 0.0
+    lattice = box_lattice(world)
+    if lattice is None:
+        return 0.0, 0.0
+    (x0, y0), h, blocked = lattice
+    mesh = RectMesh.build(~blocked)
+    a, b = ((start[0] - x0) / h, (start[1] - y0) / h), ((goal[0] - x0) / h, (goal[1] - y0) / h)
+    try:
+        found = interval_path(mesh, a, b, terminate, source)
+    except OptimumTooLarge:
+        return 0.0, 0.0
+    if found is None:
+        return math.inf, math.inf
+    d = np.diff(np.asarray(found.vertices, dtype=float), axis=0) * h
+    heading = np.arctan2(d[:, 1], d[:, 0])
+    turn = float(np.abs(np.mod(np.diff(heading) + math.pi, 2.0 * math.pi) - math.pi).sum())
+    sharp = max(float(np.hypot(d[:, 0], d[:, 1]).sum()) - goal_tol, 0.0)
+    return sharp, sharp + world.robot_radius * turn
 
 
 def _point_on_map(world: World, goal_tol: float):
@@ -258,9 +304,12 @@ def _turned(piece: Piece, frame) -> Piece:
 #: path within its bound proves the optimum longer, and the next one looks further. On a map's
 #: lattice the geodesic bound is a few percent short (it counts cells) and a loose bound costs
 #: little (the step counts and the raster bound the candidates); among circles and polygons it
-#: is often within a fraction of a percent, and the width of the ellipse drives the cost.
+#: is often within a fraction of a percent, and the width of the ellipse drives the cost. From
+#: the guess of :func:`_point_path` (a disc on a map), within 4 % of the optimum on the mazes
+#: measured, one round of 1.05 found the path on every one.
 _ROUND_FACTORS = {
     "lattice": (1.08, 1.3, 2.0, 4.0, 8.0),
+    "guess": (1.05, 1.3, 2.0, 4.0, 8.0),
     "generic": (1.005, 1.02, 1.08, 1.3, 2.0, 4.0, 8.0),
 }
 
