@@ -193,6 +193,25 @@ def test_a_discs_optimum_is_the_same_with_the_points_bound_and_guess(seed, monke
     assert checked >= 2
 
 
+def test_the_points_bound_keeps_to_its_budget(monkeypatch):
+    """Past its budget of expansions the interval search stops (OptimumTooLarge), and a disc's
+    search goes on without the point's bound, to the same optimum."""
+    from rrtpso_ompl.groundtruth.optimum import query
+
+    blocked = _grid(2, density=0.1)
+    mesh = RectMesh.build(~blocked)
+    with pytest.raises(OptimumTooLarge, match="budget of 3 expansions"):
+        iv.interval_path(mesh, (0.5, 0.5), (19.5, 19.5), budget=3)
+    world = _world(blocked).with_robot_radius(0.3)
+    start, goal = np.array([0.5, 0.5]), np.array([19.5, 19.5])
+    full = shortest_path_in_world(world, start, goal)
+    assert full.length is not None
+    assert query._point_path(world, start, goal, 0.0, None, "t")[0] > 0.0
+    monkeypatch.setattr(query, "_point_budget", lambda mesh: 0)
+    assert query._point_path(world, start, goal, 0.0, None, "t") == (0.0, 0.0)
+    assert shortest_path_in_world(world, start, goal).length == pytest.approx(full.length, 1e-12)
+
+
 def test_no_point_path_proves_that_no_disc_passes(monkeypatch):
     """A wall of cells touching only at their corners: the raster's 8-connected search passes
     between them, the point's path search does not (the mesh meets along pieces, and no disc

@@ -64,7 +64,8 @@ class IntervalPath:
 
 
 def interval_path(mesh: RectMesh, start, goal, terminate: Callable[[], bool] | None = None,
-                  source: str = "<world>") -> IntervalPath | None:  # fmt: skip
+                  source: str = "<world>",
+                  budget: int | None = None) -> IntervalPath | None:  # fmt: skip
     """A shortest path from ``start`` to ``goal`` (grid coordinates, both in free cells); None
     when none exists.
 
@@ -73,9 +74,10 @@ def interval_path(mesh: RectMesh, start, goal, terminate: Callable[[], bool] | N
     Stopped
         When ``terminate()`` returns True (polled every :data:`_POLL` expansions).
     OptimumTooLarge
-        When the search would queue more than :data:`~.result.MAX_NODES` nodes.
+        When the search would queue more than :data:`~.result.MAX_NODES` nodes, or expand more
+        than ``budget`` intervals.
     """
-    return _Search(mesh, goal, source).run(start, terminate)
+    return _Search(mesh, goal, source).run(start, terminate, budget)
 
 
 class _Search:
@@ -95,8 +97,10 @@ class _Search:
         self.heap: list = []
         self.pushed = 0
 
-    def run(self, start, terminate) -> IntervalPath | None:
-        """A* from ``start`` until the goal leaves the queue (or the queue is empty)."""
+    def run(self, start, terminate, budget: int | None = None) -> IntervalPath | None:
+        """A* from ``start`` until the goal leaves the queue (or the queue is empty, or more than
+        ``budget`` expansions were made: OptimumTooLarge)."""
+        budget = math.inf if budget is None else budget
         self.open_root(-1, float(start[0]), float(start[1]), 0.0, -2)
         heap, root_g, pop = self.heap, self.root_g, heapq.heappop
         expansions = 0
@@ -113,6 +117,9 @@ class _Search:
             expansions += 1
             if terminate is not None and expansions % _POLL == 0 and terminate():
                 raise Stopped
+            if expansions > budget:
+                raise OptimumTooLarge(f"{self.source}: the interval search passed its budget of "
+                                      f"{budget:,} expansions")  # fmt: skip
             self.expand(g, key, a, b, y, sense, q)
         return None
 

@@ -216,7 +216,7 @@ def _point_path(world: World, start: np.ndarray, goal: np.ndarray, goal_tol: flo
     mesh = RectMesh.build(~blocked)
     a, b = ((start[0] - x0) / h, (start[1] - y0) / h), ((goal[0] - x0) / h, (goal[1] - y0) / h)
     try:
-        found = interval_path(mesh, a, b, terminate, source)
+        found = interval_path(mesh, a, b, terminate, source, _point_budget(mesh))
     except OptimumTooLarge:
         return 0.0, 0.0
     if found is None:
@@ -226,6 +226,15 @@ def _point_path(world: World, start: np.ndarray, goal: np.ndarray, goal_tol: flo
     turn = float(np.abs(np.mod(np.diff(heading) + math.pi, 2.0 * math.pi) - math.pi).sum())
     sharp = max(float(np.hypot(d[:, 0], d[:, 1]).sum()) - goal_tol, 0.0)
     return sharp, sharp + world.robot_radius * turn
+
+
+def _point_budget(mesh: RectMesh) -> int:
+    """The expansions :func:`_point_path` allows the interval search: 8 per wall corner. A maze
+    needs about one per corner (and there the bound saves the tangent search the most), a
+    city's streets 4 to 20; a warehouse's open aisles 40 (1.7 million cells: 100,000
+    expansions, 0.5 s), where the tangent search has few corners and its raster's bound, already
+    close, needs no help."""
+    return 8 * int(np.count_nonzero(mesh.corner)) + 4096
 
 
 def _point_on_map(world: World, goal_tol: float):
