@@ -317,7 +317,10 @@ class FreeGrid:
         starts = np.concatenate([[0], np.cumsum(n)])
         cut = np.searchsorted(starts, np.arange(0, starts[-1], _BAND_CHUNK))
         bounds = np.unique(np.concatenate([cut, [len(a)]]))
-        blocked = self.blocked
+        # The nearest blocked point to a point outside the cells lies on a rim cell's edge, and a
+        # segment that reaches an inner cell (all eight neighbours blocked) has a sample in it or
+        # crossed a rim cell first: only rim cells need the distance formula.
+        rim, inner = self._rim()
         for s0, s1 in itertools.pairwise(bounds.tolist()):
             nn = n[s0:s1]
             seg = np.repeat(np.arange(s0, s1), nn)
@@ -325,9 +328,10 @@ class FreeGrid:
                 nn[seg - s0] - 1, 1)  # fmt: skip
             i = np.floor((a[seg, 0] + t * d[seg, 0] - self.x0) / self.h).astype(np.intp)
             j = np.floor((a[seg, 1] + t * d[seg, 1] - self.y0) / self.h).astype(np.intp)
-            # Only samples with a blocked cell in their window need the window.
+            # Only samples with a rim cell in their window need the window.
             near = self._near_blocked(k)
             inside = (i >= 0) & (i < self.nx) & (j >= 0) & (j < self.ny)
+            out[seg[inside][inner[j[inside], i[inside]]]] = True
             look = np.zeros(len(i), dtype=bool)
             look[inside] = near[j[inside], i[inside]]
             look |= ~inside  # a sample just outside the raster: look anyway
@@ -337,7 +341,7 @@ class FreeGrid:
             ss = np.repeat(seg, len(di))
             inside = (ii >= 0) & (ii < self.nx) & (jj >= 0) & (jj < self.ny)
             ii, jj, ss = ii[inside], jj[inside], ss[inside]
-            hit = blocked[jj, ii]
+            hit = rim[jj, ii]
             ii, jj, ss = ii[hit], jj[hit], ss[hit]
             if not len(ss):
                 continue
@@ -353,13 +357,28 @@ class FreeGrid:
         return out
 
     def _near_blocked(self, k: int) -> np.ndarray:
-        """Cells with a blocked cell within ``k`` cells each way (cached per ``k``)."""
+        """Cells with a rim cell (:meth:`_rim`) within ``k`` cells each way (cached per ``k``)."""
         cache = self.__dict__.setdefault("_near_cache", {})
         if k not in cache:
             from scipy import ndimage  # a map's raster: scipy is loaded for it already
 
-            cache[k] = ndimage.maximum_filter(self.blocked, size=2 * k + 1, mode="constant")
+            cache[k] = ndimage.maximum_filter(self._rim()[0], size=2 * k + 1, mode="constant")
         return cache[k]
+
+    def _rim(self) -> tuple[np.ndarray, np.ndarray]:
+        """The blocked cells with a free cell (or the outside) among their eight neighbours, and
+        the other blocked cells (cached): on a city's solid blocks most cells are inner."""
+        cached = self.__dict__.get("_rim_cache")
+        if cached is None:
+            free = np.pad(~self.blocked, 1, constant_values=True)
+            open_by = np.zeros(self.blocked.shape, dtype=bool)
+            ny, nx = self.blocked.shape
+            for dj in (0, 1, 2):
+                for di in (0, 1, 2):
+                    open_by |= free[dj : dj + ny, di : di + nx]
+            cached = self.__dict__["_rim_cache"] = (self.blocked & open_by,
+                                                    self.blocked & ~open_by)  # fmt: skip
+        return cached
 
     def band_ok(self, threshold: float) -> bool:
         """Whether :meth:`segments_near_blocked` serves this threshold."""

@@ -73,3 +73,28 @@ def test_a_winding_search_has_one_level_per_cell_and_scipys_counts(monkeypatch):
     for ours, theirs in zip(numpy_grid._dist, scipy_grid._dist, strict=True):
         np.testing.assert_array_equal(ours[0], theirs[0])
         np.testing.assert_array_equal(ours[1], theirs[1])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_lattice_test_of_segments_is_the_worlds(seed):
+    """``segments_near_blocked`` (distances to the rim cells only, a sample in an inner cell
+    counting as near) answers as the world's exact test, on solid blocks and thin walls, for
+    segments from free points, through blocks and starting deep inside one."""
+    rng = np.random.default_rng(seed)
+    blocked = np.zeros((40, 40), dtype=bool)
+    for _ in range(12):  # solid blocks, most of whose cells are inner
+        x, y = rng.integers(0, 34, 2)
+        w, h = rng.integers(2, 7, 2)
+        blocked[y : y + h, x : x + w] = True
+    blocked |= rng.random(blocked.shape) < 0.02
+    rows, cols = np.nonzero(blocked)
+    boxes = np.column_stack([cols, rows, cols + 1, rows + 1]).astype(float)
+    radius = (0.3, 1.5, 1.2, 0.05)[seed]
+    world = World(((0.0, 0.0), (40.0, 40.0)), boxes=boxes, robot_radius=radius)
+    grid = FreeGrid.for_world(world, (0.5, 0.5), (39.5, 39.5))
+    assert grid.band_ok(world.threshold) and grid._rim()[1].any()
+    a = rng.uniform(0.0, 40.0, (3000, 2))
+    b = np.clip(a + rng.normal(0.0, 6.0, a.shape), 0.0, 40.0)
+    near = grid.segments_near_blocked(a, b, world.threshold)
+    assert np.array_equal(near, ~world.segments_free(a, b))
+    assert 0.1 < near.mean() < 0.95
