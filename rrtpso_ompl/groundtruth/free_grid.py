@@ -317,10 +317,7 @@ class FreeGrid:
         starts = np.concatenate([[0], np.cumsum(n)])
         cut = np.searchsorted(starts, np.arange(0, starts[-1], _BAND_CHUNK))
         bounds = np.unique(np.concatenate([cut, [len(a)]]))
-        # The nearest blocked point to a point outside the cells lies on a rim cell's edge, and a
-        # segment that reaches an inner cell (all eight neighbours blocked) has a sample in it or
-        # crossed a rim cell first: only rim cells need the distance formula.
-        rim, inner = self._rim()
+        rim, inner = self._rim()  # only rim cells need the distance formula (_rim)
         for s0, s1 in itertools.pairwise(bounds.tolist()):
             nn = n[s0:s1]
             seg = np.repeat(np.arange(s0, s1), nn)
@@ -367,7 +364,11 @@ class FreeGrid:
 
     def _rim(self) -> tuple[np.ndarray, np.ndarray]:
         """The blocked cells with a free cell (or the outside) among their eight neighbours, and
-        the other blocked cells (cached): on a city's solid blocks most cells are inner."""
+        the other blocked cells, the inner ones (cached; on a city's solid blocks most are inner).
+
+        The nearest blocked point to a point outside the cells lies on a rim cell's edge, and a
+        segment that reaches an inner cell has a sample in it or crossed a rim cell first: only
+        rim cells need the distance formula of :meth:`segments_near_blocked`."""
         cached = self.__dict__.get("_rim_cache")
         if cached is None:
             free = np.pad(~self.blocked, 1, constant_values=True)
