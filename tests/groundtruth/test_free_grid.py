@@ -9,7 +9,7 @@ from helpers import PROBLEMS
 from scipy import ndimage
 
 from rrtpso_ompl.groundtruth import free_grid, shortest_path
-from rrtpso_ompl.groundtruth.free_grid import FreeGrid, _window_extreme
+from rrtpso_ompl.groundtruth.free_grid import FreeGrid, _window_cells
 from rrtpso_ompl.model import World, load_problem
 
 
@@ -43,8 +43,9 @@ def test_the_window_extremes_are_scipys_filters(w):
     size = 2 * w + 1
     low = ndimage.minimum_filter(grid, size=size, mode="nearest")
     high = ndimage.maximum_filter(grid, size=size, mode="nearest")
-    np.testing.assert_array_equal(_window_extreme(grid, w, np.minimum), low)
-    np.testing.assert_array_equal(_window_extreme(grid, w, np.maximum), high)
+    window = grid.ravel()[_window_cells(np.arange(grid.size), w, *grid.shape)]
+    np.testing.assert_array_equal(window.min(axis=0).reshape(grid.shape), low)
+    np.testing.assert_array_equal(window.max(axis=0).reshape(grid.shape), high)
 
 
 @pytest.mark.parametrize("name", ["paper_static", "bug_trap", "dense_polygons"])
@@ -98,3 +99,43 @@ def test_the_lattice_test_of_segments_is_the_worlds(seed):
     near = grid.segments_near_blocked(a, b, world.threshold)
     assert np.array_equal(near, ~world.segments_free(a, b))
     assert 0.1 < near.mean() < 0.95
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_sure_near_samples_never_contradict_the_world(seed):
+    """The cheap first pass of ``segments_near_blocked`` (a sample close to the blocked cell
+    nearest its cell) claims only segments the world finds near, finds most of those that come
+    deep, and the window alone still answers as the world does."""
+    rng = np.random.default_rng(seed)
+    blocked = rng.random((48, 48)) < 0.25
+    rows, cols = np.nonzero(blocked)
+    boxes = np.column_stack([cols, rows, cols + 1, rows + 1]).astype(float)
+    world = World(((0.0, 0.0), (48.0, 48.0)), boxes=boxes, robot_radius=(0.4, 1.0, 1.5)[seed])
+    grid = FreeGrid.for_world(world, (0.5, 0.5), (47.5, 47.5))
+    a = rng.uniform(0.0, 48.0, (4000, 2))
+    b = np.clip(a + rng.normal(0.0, 3.0, a.shape), 0.0, 48.0)
+    free = world.segments_free(a, b)
+    deep = grid._deep(a, b, world.threshold)
+    assert not (deep & free).any()
+    assert deep.sum() > 0.5 * (~free).sum()
+    np.testing.assert_array_equal(grid._near_by_window(a, b, world.threshold), ~free)
+
+
+def test_blocks_are_used_only_where_they_keep_the_maps_shape(monkeypatch):
+    """A maze of one-cell corridors merged into blocks of 2 x 2 loses its walls (every block
+    possibly free) and with them the bound; it is searched cell by cell, while open rooms
+    keep their blocks."""
+    monkeypatch.setattr(free_grid, "FAST_SEARCH_CELLS", 400)
+    maze = np.ones((40, 40), dtype=bool)
+    maze[1::2, :] = False  # walls on alternate rows, a gap at alternate ends
+    maze[1::4, -1] = maze[3::4, 0] = True
+    rooms = np.ones((40, 40), dtype=bool)
+    rooms[19:21, :30] = False
+    start, goal = (0.5, 0.5), (0.5, 39.5)
+    fine = FreeGrid((0.0, 0.0), 1.0, maze, start, goal)
+    assert fine.k == 1
+    assert fine.lower_bound(1, np.array([start]))[0] > 19 * 39  # along the corridor
+    monkeypatch.setattr(free_grid, "BLOCK_GROWTH", 2.5)
+    coarse = FreeGrid((0.0, 0.0), 1.0, maze, start, goal)
+    assert coarse.k == 2 and coarse.lower_bound(1, np.array([start]))[0] < 2 * 39
+    assert FreeGrid((0.0, 0.0), 1.0, rooms, start, goal).k == 2
