@@ -29,10 +29,11 @@ boxes, from the world's exact point clearance at the cell centres (clearance is 
 a cell whose centre has clearance ``c`` has none above ``c + h / sqrt(2)``).
 
 scipy is imported only where it is needed: for a map (the distance transform) and for a search
-grid of more than :data:`NUMPY_SEARCH_CELLS` cells (scipy's unweighted shortest paths). A smaller one,
-every raster of a few dozen obstacles without a map, is searched level by level in numpy: the
-same step counts (a breadth-first search's are unique), without the 0.2-0.4 s importing scipy
-costs, several times what ``rrtpso optimum`` of such a problem computes (docs/startup.md).
+grid of more than :data:`NUMPY_SEARCH_CELLS` cells (scipy's unweighted shortest paths). A
+smaller one, every raster of a few dozen obstacles without a map, is searched level by level in
+numpy: the same step counts (a breadth-first search's are unique), without the 0.2-0.4 s
+importing scipy costs, several times what ``rrtpso optimum`` of such a problem computes
+(docs/startup.md).
 """
 
 from __future__ import annotations
