@@ -113,3 +113,30 @@ def test_a_discs_optimum_is_the_same_within_reach(seed, monkeypatch):
         assert new.length == pytest.approx(old.length, rel=1e-9)
         assert world.path_valid(new.valid_polyline(world))
     assert checked >= 2
+
+
+def test_a_mazes_batches_grow_and_keep_the_optimum(monkeypatch):
+    """A maze's corners have few candidates each, so the batches of circles grow beyond the
+    first 32 (their cost is mostly fixed); the optimum is the one found with batches of 32."""
+    from rrtpso_ompl.groundtruth.map_kinds import _maze as perfect_maze
+
+    blocked = perfect_maze(np.random.default_rng(5), 41, 1, 1, 0.0)[::-1]  # rows from the bottom
+    world = _world(blocked, 0.3)
+    start, goal = (1.5, 1.5), (39.5, 39.5)
+    sizes = []
+    prepare = graph.TangentGraph._prepare
+
+    def spy(self, batch):
+        sizes.append(len(batch))
+        return prepare(self, batch)
+
+    monkeypatch.setattr(graph.TangentGraph, "_prepare", spy)
+    grown = shortest_path_in_world(world, start, goal)
+    assert max(sizes) > graph._BATCH
+    monkeypatch.setattr(graph, "_MAX_BATCH", graph._BATCH)
+    sizes.clear()
+    fixed = shortest_path_in_world(world, start, goal)
+    assert max(sizes) == graph._BATCH
+    assert grown.length == pytest.approx(fixed.length, rel=1e-9)
+    assert grown.length > 100.0  # through the maze, not across it
+    assert world.path_valid(grown.valid_polyline(world))

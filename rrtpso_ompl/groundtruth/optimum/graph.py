@@ -32,8 +32,14 @@ __all__ = ["TangentGraph"]
 _NEAR_ALL = 24
 #: Most (tangent, obstacle) pairs of the near-obstacle pass.
 _NEAR_PAIRS = 2_000_000
-#: Most circles whose tangents one vectorised pass finds.
+#: Circles whose tangents one vectorised pass finds: at first, and at least, :data:`_BATCH`;
+#: then as many as make about :data:`_BATCH_PAIRS` candidate pairs at the rate seen so far, up
+#: to :data:`_MAX_BATCH`. A pass has a fixed cost (a few milliseconds of numpy calls): a maze's
+#: corners have 15 candidates each, where rooms, cities and warehouses have 40 to 700, and
+#: passes of 32 made two thirds of a 1024 x 1024 maze's search (docs/optimum-scaling.md).
 _BATCH = 32
+_BATCH_PAIRS = 8192
+_MAX_BATCH = 512
 #: The raster's rejection is run when at least this share of its cells is core.
 _RASTER_WORTH = 0.02
 
@@ -78,6 +84,8 @@ class TangentGraph:
         self.steps = grid.step_ranges(self.circles)
         self._sieve = _Sieve(self.circles, self.lb_g, self.steps, grid.H)
         self._cache: dict[int, Tangents] = {}
+        self._batch = _BATCH
+        self._seen = np.zeros(2, dtype=np.int64)  # circles prepared, their candidate pairs
         self._cached = np.zeros(len(self.circles), dtype=bool)
         self._cached[1] = True  # the goal: never expanded
         self._cells_only = (grid.band_ok(world.threshold) and not len(world.circles)
@@ -94,19 +102,19 @@ class TangentGraph:
 
         Whether a tangent segment is free does not depend on the node it leaves from, so each
         circle's are found once, and together with those of the circles the search will likely
-        expand next (up to :data:`_BATCH` in one vectorised pass, which costs little more than
-        a pass over one): those whose lower bound from the start is nearest to ``g`` and whose
-        lower bound through them is below or near ``f``.
+        expand next (a batch of :data:`_BATCH` or more in one vectorised pass, which costs
+        little more than a pass over one): those whose lower bound from the start is nearest to
+        ``g`` and whose lower bound through them is below or near ``f``.
         """
         cached = self._cache.get(i)
         if cached is not None:
             return cached
         todo = np.flatnonzero(~self._cached)
         todo = todo[todo != i]
-        if len(todo) >= _BATCH:
+        if len(todo) >= self._batch:
             key = np.abs(self.lb_s[todo] - g) + np.maximum(
                 self.lb_s[todo] + self.lb_g[todo] - f, 0.0)  # fmt: skip
-            todo = todo[np.argpartition(key, _BATCH - 2)[: _BATCH - 1]]
+            todo = todo[np.argpartition(key, self._batch - 2)[: self._batch - 1]]
         self._prepare(np.concatenate([[i], todo]).astype(np.intp))
         return self._cache[i]
 
@@ -122,6 +130,9 @@ class TangentGraph:
         test of the whole segment.
         """
         row, j = self._candidate_pairs(batch)
+        self._seen += (len(batch), len(row))
+        rate = self._seen[1] / self._seen[0]  # candidate pairs per circle
+        self._batch = int(np.clip(_BATCH_PAIRS / max(rate, 1.0), _BATCH, _MAX_BATCH))
         row, j = self._directions_ok(batch, row, j)
         row, j = shadowed(self.world, self.circles, batch, row, j)
         cand = self._usable(tangents_from(self.circles, batch[row], j))
