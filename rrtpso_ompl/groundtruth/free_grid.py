@@ -45,6 +45,7 @@ import numpy as np
 
 from ..model.geometry import segment_box_distance
 from ..model.world import World
+from .gates import Gates
 
 __all__ = ["FreeGrid", "Stopped", "box_lattice"]
 
@@ -73,6 +74,9 @@ MAX_SEARCH_CELLS = 4_200_000
 NUMPY_SEARCH_CELLS = 10_000
 #: Most cells of a raster on the lattice of a world's boxes (else the generic raster is used).
 MAX_LATTICE_CELLS = 30_000_000
+#: The gates' bounds are scaled by this, below 1 by far more than their round-off (a bound a
+#: hair too high could cost the optimum that hair).
+_ROUND = 1.0 - 1e-12
 #: Most samples one call of :meth:`FreeGrid.blocked_segments` takes at once (memory bound).
 _SAMPLE_CHUNK = 2_000_000
 
@@ -122,7 +126,12 @@ class FreeGrid:
         #: blocked cells), else None (set by :meth:`for_world`).
         self.blocked: np.ndarray | None = None
         # The search grid: blocks of k x k cells, a block possibly free when any of its cells is.
-        k, coarse = _search_blocks(self.free)
+        k, coarse, narrow = _search_blocks(self.free)
+        #: Whether blocks of cells would not keep the raster's shape (corridors a cell or two
+        #: wide): then, on a map, the gates between its cells bound a disc's paths too.
+        self.narrow = narrow
+        #: The gates' bounds to the goal (:mod:`.gates`), or None (set by :meth:`for_world`).
+        self.gates: Gates | None = None
         self.k = k
         self.H = k * self.h
         self.cny, self.cnx = coarse.shape
@@ -158,6 +167,10 @@ class FreeGrid:
             _poll(terminate)
             grid = cls(origin, h, free, start, goal, goal_tolerance, terminate)
             grid.blocked = blocked
+            if grid.narrow and _covers(origin, h, blocked.shape, world.bounds):
+                _poll(terminate)
+                rel = (np.asarray(goal, dtype=float) - origin) / h
+                grid.gates = Gates.where_pinched(blocked, thr / h, rel, goal_tolerance / h)
             return grid
         (xmin, ymin), (xmax, ymax) = world.bounds
         # A few cells per obstacle: a handful of obstacles needs no fine raster (its set-up,
@@ -212,6 +225,9 @@ class FreeGrid:
         lb = np.maximum(euclid, self._geodesic(which, self._cells(p)))
         if which == 1 and self.goal_tolerance > 0:
             lb = np.maximum(lb - self.goal_tolerance, 0.0)
+        if which == 1 and self.gates is not None:
+            rel = (p.reshape(-1, 2) - (self.x0, self.y0)) / self.h
+            lb = np.maximum(lb, (self.gates.bound(rel) * self.h * _ROUND).reshape(lb.shape))
         return lb
 
     def circle_lower_bound(self, which: int, circles: np.ndarray) -> np.ndarray:
@@ -228,6 +244,13 @@ class FreeGrid:
             cells = self._cells(c[small, :2])
             near = _window_cells(cells, w, self.cny, self.cnx)
             least = self._geodesic(which, near).min(axis=0)
+            if which == 1 and self.gates is not None:
+                g = self.gates
+                w = math.ceil(float(c[small, 2].max()) / self.h)
+                i = np.clip((c[small, 0] - self.x0) // self.h, 0, g.nx - 1).astype(np.intp)
+                j = np.clip((c[small, 1] - self.y0) // self.h, 0, g.ny - 1).astype(np.intp)
+                near = _window_cells(j * g.nx + i, w, g.ny, g.nx)
+                least = np.maximum(least, g.cell_bound[near].min(axis=0) * self.h * _ROUND)
             out[small] = np.maximum(euclid[small], least)
         if which == 1 and self.goal_tolerance > 0:
             out = np.maximum(out - self.goal_tolerance, 0.0)
@@ -529,21 +552,33 @@ def _block_any(free: np.ndarray, k: int) -> np.ndarray:
     return f.reshape(f.shape[0] // k, k, f.shape[1] // k, k).any(axis=(1, 3))
 
 
-def _search_blocks(free: np.ndarray) -> tuple[int, np.ndarray]:
-    """The block side ``k`` of the search grid and that grid (:func:`_block_any`): the side of
+def _covers(origin, h: float, shape, bounds) -> bool:
+    """Whether the lattice's cells cover the bounds (no path can go round them)."""
+    (xmin, ymin), (xmax, ymax) = bounds
+    ny, nx = shape
+    slack = 1e-9 * h
+    across = origin[0] <= xmin + slack and origin[0] + nx * h >= xmax - slack
+    up = origin[1] <= ymin + slack and origin[1] + ny * h >= ymax - slack
+    return across and up
+
+
+def _search_blocks(free: np.ndarray) -> tuple[int, np.ndarray, bool]:
+    """The block side ``k`` of the search grid, that grid (:func:`_block_any`) and whether the
+    raster is narrow (blocks of the fast side, at least 2, would not keep its shape): the side of
     :data:`FAST_SEARCH_CELLS` where its blocks keep the map's shape (:data:`BLOCK_GROWTH`), else
     the smallest within :data:`MAX_SEARCH_CELLS` and :data:`MAX_SEARCH_FREE` (at most ``sqrt(cells
     / MAX_SEARCH_FREE) + 1`` sides tried)."""
-    k = math.ceil(math.sqrt(free.size / FAST_SEARCH_CELLS))
-    if k > 1:
-        coarse = _block_any(free, k)
-        if np.count_nonzero(coarse) * k * k <= BLOCK_GROWTH * np.count_nonzero(free):
-            return k, coarse
+    fast = math.ceil(math.sqrt(free.size / FAST_SEARCH_CELLS))
+    k = max(2, fast)
+    coarse = _block_any(free, k)
+    narrow = np.count_nonzero(coarse) * k * k > BLOCK_GROWTH * np.count_nonzero(free)
+    if fast > 1 and not narrow:
+        return k, coarse, narrow
     k = max(1, math.ceil(math.sqrt(free.size / MAX_SEARCH_CELLS)))
     while True:
         coarse = _block_any(free, k)
         if coarse.size <= MAX_SEARCH_CELLS and np.count_nonzero(coarse) <= MAX_SEARCH_FREE:
-            return k, coarse
+            return k, coarse, narrow
         k += 1
 
 

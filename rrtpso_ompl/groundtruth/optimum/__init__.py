@@ -25,17 +25,20 @@ LaValle, *Planning Algorithms*, 2006, section 6.2.4; Latombe 1991 for the polygo
    a superset of the free space. Breadth-first step counts over them from the start's cell and
    the goal's give *geodesic lower bounds* (a maze's corridors, not the straight line), used as
    A\*'s heuristic and for pruning; they also prove a problem unsolvable when the goal's cell is
-   not reached. The heuristic is admissible but not consistent, so a node whose cost improves
-   after its expansion is expanded again; A\* with an admissible heuristic and re-expansion
-   returns the optimum.
+   not reached. On a map of narrow corridors, where a disc's gates between cells are short,
+   the bound through those gates (:mod:`..gates`: within a few percent of a disc's path in
+   one-cell corridors, where the raster's is a fifth short) is the larger one. The heuristic is
+   admissible but not consistent, so a node whose cost improves after its expansion is expanded
+   again; A\* with an admissible heuristic and re-expansion returns the optimum.
 4. **Pruning that keeps exactness.** The search runs in rounds of growing bounds ``C`` (multiples
    of the lower bound at the start): a circle that no path within ``C`` can touch (the geodesic
    ellipse ``LB_start + LB_goal <= C``) is never a candidate, nor is a tangent that no path within
    ``C`` can use; a round that finds nothing proves the optimum longer than its bound, and the next
-   looks further. On a map alone, the point's shortest path between the query's points (the
-   interval search below) bounds the disc's from below and proves it unsolvable when there is none;
-   its length plus ``R`` times its turning, a guess within 4 % of the disc's optimum on the mazes
-   measured, places the first round's bound (a guess can cost a round, never the answer). A tangent
+   looks further. On a map alone without the gates, the point's shortest path between the query's
+   points (the interval search below) bounds the disc's from below and proves it unsolvable when
+   there is none; its length plus ``R`` times its turning, a guess within 4 % of the disc's
+   optimum on the mazes measured, places the first round's bound (a guess can cost a round,
+   never the answer). A tangent
    is free or not whatever node leaves along it, so each circle's free tangents are found once, for
    a batch of circles at a time (those A\* will likely expand next), through filters that each drop
    only what could not be used, cheapest first: circle pairs beyond the bound (a batch meets only

@@ -168,14 +168,16 @@ def _search(world: World, start: np.ndarray, goal: np.ndarray, goal_tol: float, 
         return report(None)
     if stop():
         return report(None, stopped=True)
-    try:
-        sharp, guess = _point_path(world, start, goal, goal_tol, terminate, source)
-    except Stopped:
-        return report(None, stopped=True)
-    if sharp == math.inf:  # a proof: no point, hence no disc, passes between them
+    sharp = guess = 0.0
+    if grid.gates is None:  # else the gates' bound is closer than the point's guess
+        try:
+            sharp, guess = _point_path(world, start, goal, goal_tol, terminate, source)
+        except Stopped:
+            return report(None, stopped=True)
+    lower = max(float(grid.lower_bound(1, start[None])[0]), sharp)
+    if lower == math.inf:  # a proof: no point (no chain of gates) passes between them
         return report(None)
     nodes = NodeCircles.build(world, grid, start, goal, world.robot_radius)
-    lower = max(float(grid.lower_bound(1, start[None])[0]), sharp)
     search = None
     kind = "lattice" if grid.blocked is not None else "generic"
     if guess > lower:

@@ -1,0 +1,123 @@
+"""The gates between a map's cells (groundtruth/gates.py): a lower bound on a disc's path that is
+never above the exact optimum, close to it in one-cell corridors, and the optimum the same with
+the bound as without it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rrtpso_ompl.groundtruth import free_grid
+from rrtpso_ompl.groundtruth.gates import Gates
+from rrtpso_ompl.groundtruth.map_kinds import _maze as perfect_maze
+from rrtpso_ompl.groundtruth.optimum import shortest_path_in_world
+from rrtpso_ompl.model import World
+
+
+def _world(blocked: np.ndarray, radius: float) -> World:
+    rows, cols = np.nonzero(blocked)
+    boxes = np.column_stack([cols, rows, cols + 1, rows + 1]).astype(float)
+    ny, nx = blocked.shape
+    return World(((0, 0), (nx, ny)), boxes=boxes, robot_radius=radius)
+
+
+def _queries(world: World, blocked: np.ndarray, rng: np.random.Generator, n: int):
+    """Up to ``n`` start (anywhere in a free cell) and goal (a free cell's centre) pairs the
+    disc can stand on."""
+    free = np.argwhere(~blocked)
+    for _ in range(4 * n):
+        (ra, ca), (rb, cb) = free[rng.choice(len(free), 2, replace=False)]
+        start = np.array([ca, ra]) + rng.uniform(0.15, 0.85, 2)
+        goal = np.array([cb + 0.5, rb + 0.5])
+        if (world.point_clearance(np.array([start, goal])) >= world.threshold).all():
+            yield start, goal
+            n -= 1
+            if not n:
+                return
+
+
+def test_a_corridors_gates_keep_the_clearance_from_its_walls():
+    blocked = np.ones((3, 6), dtype=bool)
+    blocked[1, :] = False  # a corridor along row 1
+    blocked[2, 3] = False  # and a side opening above cell (1, 3)
+    gates = Gates(blocked, 0.3, (5.5, 1.5))
+    # Vertical edges x = 1..5 along the corridor, then the horizontal edge y = 2 at i = 3.
+    np.testing.assert_allclose(gates.lo, [1.3, 1.3, 1.3, 1.3, 1.3, 3.3])
+    np.testing.assert_allclose(gates.hi, [1.7, 1.7, 1.7, 1.7, 1.7, 3.7])
+    blocked[2, 3] = True
+    gates = Gates(blocked, 0.3, (5.5, 1.5))
+    np.testing.assert_allclose(gates.to_goal, [4.5, 3.5, 2.5, 1.5, 0.5])  # a cell per gate
+    assert gates.bound(np.array([[0.5, 1.5]]))[0] == pytest.approx(5.0)
+    assert gates.bound(np.array([[5.2, 1.4]]))[0] == pytest.approx(np.hypot(0.3, 0.1))
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_the_bound_is_never_above_the_optimum(seed):
+    """On perfect mazes of one-cell corridors with loops, and on random walls with pinches, for
+    discs of 0.05 to 0.45 cells, goals with and without a tolerance: the bound at the start is at
+    most the exact optimum; in the mazes within 15 % of it (median), closer than the raster's."""
+    rng = np.random.default_rng(seed)
+    if seed % 2:
+        blocked = perfect_maze(rng, 25, 1, 1, 0.3)[::-1].copy()
+    else:
+        blocked = rng.random((20, 20)) < 0.3
+    world = _world(blocked, float(rng.uniform(0.05, 0.45)))
+    ratios, raster = [], []
+    for start, goal in _queries(world, blocked, rng, 6):
+        tol = float(rng.choice([0.0, 0.7]))
+        found = shortest_path_in_world(world, start, goal, tol)
+        bound = Gates(blocked, world.threshold, goal, tol).bound(start[None])[0]
+        if found.length is None:
+            continue
+        assert bound <= found.length * (1.0 + 1e-12)
+        grid = free_grid.FreeGrid.for_world(world, start, goal, tol)
+        grid.gates = None
+        ratios.append(bound / found.length)
+        raster.append(grid.lower_bound(1, start[None])[0] / found.length)
+    assert ratios
+    if seed % 2:  # in the mazes, well above the raster's bound
+        assert np.median(ratios) > 0.85
+        assert np.median(ratios) > np.median(raster) + 0.05
+
+
+def test_a_diagonal_pinch_has_no_gate():
+    """Two blocked cells that meet at a corner close the way between them for any disc."""
+    blocked = np.zeros((4, 4), dtype=bool)
+    blocked[:2, :2] = True
+    blocked[2:, 2:] = True
+    blocked[1, 1] = False  # the free cells (1, 1) and (2, 2) meet only at the corner (2, 2)
+    gates = Gates(blocked, 0.05, (2.5, 2.5))
+    assert gates.bound(np.array([[1.5, 1.5]]))[0] == np.inf
+    world = _world(blocked, 0.05)
+    assert shortest_path_in_world(world, (1.5, 1.5), (2.5, 2.5)).length is None
+
+
+def test_gates_are_built_only_where_most_are_pinched():
+    maze = perfect_maze(np.random.default_rng(1), 21, 1, 1, 0.0)
+    assert Gates.where_pinched(maze, 0.3, (1.5, 1.5)) is not None
+    wide = perfect_maze(np.random.default_rng(1), 21, 4, 1, 0.0)  # four-cell corridors
+    assert Gates.where_pinched(wide, 0.3, (1.5, 1.5)) is None
+    assert Gates.where_pinched(np.zeros((10, 10), dtype=bool), 0.3, (1.5, 1.5)) is None
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_optimum_is_the_same_without_the_gates(seed, monkeypatch):
+    """The gates only tighten the search's bounds: the same optimum (to 1e-9) without them,
+    and a valid path."""
+    rng = np.random.default_rng(seed)
+    blocked = perfect_maze(rng, 31, 1, 1, 0.2)[::-1].copy()
+    world = _world(blocked, 0.35)
+    checked = 0
+    for start, goal in _queries(world, blocked, rng, 4):
+        with_gates = shortest_path_in_world(world, start, goal)
+        assert free_grid.FreeGrid.for_world(world, start, goal).gates is not None
+        with monkeypatch.context() as m:
+            m.setattr(Gates, "where_pinched", classmethod(lambda cls, *args: None))
+            without = shortest_path_in_world(world, start, goal)
+        if without.length is None:
+            assert with_gates.length is None
+            continue
+        checked += 1
+        assert with_gates.length == pytest.approx(without.length, rel=1e-9)
+        assert world.path_valid(with_gates.valid_polyline(world))
+    assert checked >= 2
