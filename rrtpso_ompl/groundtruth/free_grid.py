@@ -130,7 +130,8 @@ class FreeGrid:
         #: Whether blocks of cells would not keep the raster's shape (corridors a cell or two
         #: wide): then, on a map, the gates between its cells bound a disc's paths too.
         self.narrow = narrow
-        #: The gates' bounds to the goal (:mod:`.gates`), or None (set by :meth:`for_world`).
+        #: The gates' bounds to the start and the goal (:mod:`.gates`), or None (set by
+        #: :meth:`for_world`).
         self.gates: Gates | None = None
         self.k = k
         self.H = k * self.h
@@ -169,8 +170,11 @@ class FreeGrid:
             grid.blocked = blocked
             if grid.narrow and _covers(origin, h, blocked.shape, world.bounds):
                 _poll(terminate)
-                rel = (np.asarray(goal, dtype=float) - origin) / h
-                grid.gates = Gates.where_pinched(blocked, thr / h, rel, goal_tolerance / h)
+                targets = [
+                    ((np.asarray(start, dtype=float) - origin) / h, 0.0),
+                    ((np.asarray(goal, dtype=float) - origin) / h, goal_tolerance / h),
+                ]
+                grid.gates = Gates.where_pinched(blocked, thr / h, targets)  # start, goal
             return grid
         (xmin, ymin), (xmax, ymax) = world.bounds
         # A few cells per obstacle: a handful of obstacles needs no fine raster (its set-up,
@@ -225,9 +229,10 @@ class FreeGrid:
         lb = np.maximum(euclid, self._geodesic(which, self._cells(p)))
         if which == 1 and self.goal_tolerance > 0:
             lb = np.maximum(lb - self.goal_tolerance, 0.0)
-        if which == 1 and self.gates is not None:
+        if self.gates is not None:
             rel = (p.reshape(-1, 2) - (self.x0, self.y0)) / self.h
-            lb = np.maximum(lb, (self.gates.bound(rel) * self.h * _ROUND).reshape(lb.shape))
+            gated = self.gates.bound(which, rel) * self.h * _ROUND
+            lb = np.maximum(lb, gated.reshape(lb.shape))
         return lb
 
     def circle_lower_bound(self, which: int, circles: np.ndarray) -> np.ndarray:
@@ -244,13 +249,14 @@ class FreeGrid:
             cells = self._cells(c[small, :2])
             near = _window_cells(cells, w, self.cny, self.cnx)
             least = self._geodesic(which, near).min(axis=0)
-            if which == 1 and self.gates is not None:
+            if self.gates is not None:
                 g = self.gates
                 w = math.ceil(float(c[small, 2].max()) / self.h)
                 i = np.clip((c[small, 0] - self.x0) // self.h, 0, g.nx - 1).astype(np.intp)
                 j = np.clip((c[small, 1] - self.y0) // self.h, 0, g.ny - 1).astype(np.intp)
                 near = _window_cells(j * g.nx + i, w, g.ny, g.nx)
-                least = np.maximum(least, g.cell_bound[near].min(axis=0) * self.h * _ROUND)
+                gated = g.cell_bound[which][near].min(axis=0) * self.h * _ROUND
+                least = np.maximum(least, gated)
             out[small] = np.maximum(euclid[small], least)
         if which == 1 and self.goal_tolerance > 0:
             out = np.maximum(out - self.goal_tolerance, 0.0)

@@ -44,7 +44,7 @@ PINCHED = 0.5
 
 
 class Gates:
-    """The gates of a lattice's free cells for a disc, and the bounds through them to the goal.
+    """The gates of a lattice's free cells for a disc, and the bounds through them to targets.
 
     Parameters
     ----------
@@ -52,32 +52,31 @@ class Gates:
         Blocked cells, row ``j`` from the bottom (cell ``(j, i)`` is ``[i, i + 1] x [j, j + 1]``).
     thr : float
         The clearance the centre keeps from every blocked cell, cells.
-    goal : (2,) array_like
-        The goal, cells.
-    goal_tolerance : float
-        Radius of the goal disc, cells.
+    targets : sequence of ((2,) array_like, float)
+        The points bounds are to (the start, the goal) and the radius of the disc round each
+        that a path may end in, cells.
     """
 
-    def __init__(self, blocked: np.ndarray, thr: float, goal, goal_tolerance: float = 0.0,
-                 gates=None) -> None:  # fmt: skip
+    def __init__(self, blocked: np.ndarray, thr: float, targets, gates=None) -> None:
         blocked = np.asarray(blocked, dtype=bool)
         self.ny, self.nx = blocked.shape
-        self.goal = np.asarray(goal, dtype=float)
-        self.goal_tolerance = float(goal_tolerance)
+        self.targets = [(np.asarray(p, dtype=float), float(tol)) for p, tol in targets]
         self.lo, self.hi, self.side = gates if gates is not None else _gates(blocked, float(thr))
-        self._goal = self._goal_cells()
-        self.to_goal = self._search()
-        #: Per cell, the least bound over its gates (0 in the goal disc's cells), cells.
-        self.cell_bound = np.full(self.ny * self.nx, np.inf)
-        for k in range(4):
-            has = self.side[k] >= 0
-            self.cell_bound[has] = np.minimum(self.cell_bound[has],
-                                              self.to_goal[self.side[k][has]])  # fmt: skip
-        self.cell_bound[self._goal] = 0.0
+        self._home = [self._cells_near(p, tol) for p, tol in self.targets]
+        #: Per target, a lower bound on the length of a path from a crossing of each gate to it.
+        self.to = self._search()
+        #: Per target and cell, the least bound over the cell's gates (0 in the target's cells).
+        self.cell_bound = []
+        for to, home in zip(self.to, self._home, strict=True):
+            least = np.full(self.ny * self.nx, np.inf)
+            for k in range(4):
+                has = self.side[k] >= 0
+                least[has] = np.minimum(least[has], to[self.side[k][has]])
+            least[home] = 0.0
+            self.cell_bound.append(least)
 
     @classmethod
-    def where_pinched(cls, blocked: np.ndarray, thr: float, goal,
-                      goal_tolerance: float = 0.0) -> Gates | None:  # fmt: skip
+    def where_pinched(cls, blocked: np.ndarray, thr: float, targets) -> Gates | None:
         """The gates, when at least :data:`MIN_PINCHED` of them are at most :data:`PINCHED`
         long (the bound is worth its search), else None."""
         gates = _gates(np.asarray(blocked, dtype=bool), float(thr))
@@ -85,12 +84,13 @@ class Gates:
         pinched = np.count_nonzero(hi - lo <= PINCHED)
         if not len(lo) or pinched < MIN_PINCHED * len(lo):
             return None
-        return cls(blocked, thr, goal, goal_tolerance, gates)
+        return cls(blocked, thr, targets, gates)
 
     # ------------------------------------------------------------------------------------------
-    def bound(self, p: np.ndarray) -> np.ndarray:
-        """Lower bound on the length of a free path from each point ``(n, 2)`` to the goal disc,
-        cells (``inf`` where its cell has no gate and no part of the disc)."""
+    def bound(self, which: int, p: np.ndarray) -> np.ndarray:
+        """Lower bound on the length of a free path from each point ``(n, 2)`` to target
+        ``which``, cells (``inf`` where the point's cell has no gate and no part of the
+        target)."""
         p = np.asarray(p, dtype=float).reshape(-1, 2)
         i = np.clip(np.floor(p[:, 0]), 0, self.nx - 1).astype(np.intp)
         j = np.clip(np.floor(p[:, 1]), 0, self.ny - 1).astype(np.intp)
@@ -101,47 +101,53 @@ class Gates:
             has = np.flatnonzero(g >= 0)
             gk = g[has]
             d = _to_gate(k, gk, i[has], j[has], p[has, 0], p[has, 1], self.lo, self.hi)
-            out[has] = np.minimum(out[has], d + self.to_goal[gk])
-        home = np.isin(cell, self._goal)  # the path may end in its own cell
-        direct = np.hypot(p[:, 0] - self.goal[0], p[:, 1] - self.goal[1]) - self.goal_tolerance
-        out[home] = np.minimum(out[home], np.maximum(direct[home], 0.0))
+            out[has] = np.minimum(out[has], d + self.to[which][gk])
+        home = np.isin(cell, self._home[which])  # the path may end in its own cell
+        (tx, ty), tol = self.targets[which]
+        direct = np.maximum(np.hypot(p[:, 0] - tx, p[:, 1] - ty) - tol, 0.0)
+        out[home] = np.minimum(out[home], direct[home])
         return out
 
     # ------------------------------------------------------------------------------------------
-    def _goal_cells(self) -> np.ndarray:
-        """Flat indices of the cells within the goal disc's reach (its box, borders included)."""
-        r = self.goal_tolerance + 1e-9
-        i = np.arange(max(int(np.floor(self.goal[0] - r)), 0),
-                      min(int(np.floor(self.goal[0] + r)), self.nx - 1) + 1)  # fmt: skip
-        j = np.arange(max(int(np.floor(self.goal[1] - r)), 0),
-                      min(int(np.floor(self.goal[1] + r)), self.ny - 1) + 1)  # fmt: skip
+    def _cells_near(self, p: np.ndarray, tol: float) -> np.ndarray:
+        """Flat indices of the cells within ``tol`` of ``p`` (its box, borders included)."""
+        r = tol + 1e-9
+        i = np.arange(
+            max(int(np.floor(p[0] - r)), 0), min(int(np.floor(p[0] + r)), self.nx - 1) + 1
+        )
+        j = np.arange(
+            max(int(np.floor(p[1] - r)), 0), min(int(np.floor(p[1] + r)), self.ny - 1) + 1
+        )
         return (j[:, None] * self.nx + i[None, :]).ravel()
 
-    def _search(self) -> np.ndarray:
-        """Shortest chains of gates to the goal disc (scipy's Dijkstra from a source joined to
-        the gates of the disc's cells by their distances to it)."""
+    def _search(self) -> list[np.ndarray]:
+        """Shortest chains of gates to each target (scipy's Dijkstra, from a source per target
+        joined to the gates of the target's cells by their distances to its disc)."""
         from scipy.sparse import csr_matrix
         from scipy.sparse.csgraph import dijkstra
 
-        n = len(self.lo)
+        n, m = len(self.lo), len(self.targets)
         nbr, weight = _neighbours(self.side, self.lo, self.hi, self.ny, self.nx)
         ok = nbr >= 0
-        first = np.full(n, np.inf)  # each gate of the disc's cells once, at its least cost
-        cells = self._goal
-        for k in range(4):
-            g = self.side[k][cells]
-            has = g >= 0
-            j, i = np.divmod(cells[has], self.nx)
-            d = _to_gate(k, g[has], i, j, self.goal[0], self.goal[1], self.lo, self.hi)
-            np.minimum.at(first, g[has], np.maximum(d - self.goal_tolerance, 0.0))
-        start = np.flatnonzero(np.isfinite(first))
-        counts = np.concatenate([ok.sum(axis=1), [len(start)]])
-        indptr = np.zeros(n + 2, dtype=np.int64)
-        np.cumsum(counts, out=indptr[1:])
-        indices = np.concatenate([nbr[ok], start]).astype(np.int32)
-        data = np.concatenate([weight[ok], first[start]])
-        graph = csr_matrix((data, indices, indptr.astype(np.int32)), shape=(n + 1, n + 1))
-        return dijkstra(graph, directed=True, indices=n)[:n]
+        counts, indices, data = [ok.sum(axis=1)], [nbr[ok]], [weight[ok]]
+        for (point, tol), cells in zip(self.targets, self._home, strict=True):
+            first = np.full(n, np.inf)  # each gate of the target's cells once, at its least cost
+            for k in range(4):
+                g = self.side[k][cells]
+                has = g >= 0
+                j, i = np.divmod(cells[has], self.nx)
+                d = _to_gate(k, g[has], i, j, point[0], point[1], self.lo, self.hi)
+                np.minimum.at(first, g[has], np.maximum(d - tol, 0.0))
+            start = np.flatnonzero(np.isfinite(first))
+            counts.append([len(start)])
+            indices.append(start)
+            data.append(first[start])
+        indptr = np.zeros(n + m + 1, dtype=np.int64)
+        np.cumsum(np.concatenate(counts), out=indptr[1:])
+        graph = csr_matrix((np.concatenate(data), np.concatenate(indices).astype(np.int32),
+                            indptr.astype(np.int32)), shape=(n + m, n + m))  # fmt: skip
+        dist = dijkstra(graph, directed=True, indices=np.arange(n, n + m))
+        return [row[:n] for row in np.atleast_2d(dist)]
 
 
 def _to_gate(k: int, g, i, j, x, y, lo, hi) -> np.ndarray:

@@ -40,15 +40,15 @@ def test_a_corridors_gates_keep_the_clearance_from_its_walls():
     blocked = np.ones((3, 6), dtype=bool)
     blocked[1, :] = False  # a corridor along row 1
     blocked[2, 3] = False  # and a side opening above cell (1, 3)
-    gates = Gates(blocked, 0.3, (5.5, 1.5))
+    gates = Gates(blocked, 0.3, [((5.5, 1.5), 0.0)])
     # Vertical edges x = 1..5 along the corridor, then the horizontal edge y = 2 at i = 3.
     np.testing.assert_allclose(gates.lo, [1.3, 1.3, 1.3, 1.3, 1.3, 3.3])
     np.testing.assert_allclose(gates.hi, [1.7, 1.7, 1.7, 1.7, 1.7, 3.7])
     blocked[2, 3] = True
-    gates = Gates(blocked, 0.3, (5.5, 1.5))
-    np.testing.assert_allclose(gates.to_goal, [4.5, 3.5, 2.5, 1.5, 0.5])  # a cell per gate
-    assert gates.bound(np.array([[0.5, 1.5]]))[0] == pytest.approx(5.0)
-    assert gates.bound(np.array([[5.2, 1.4]]))[0] == pytest.approx(np.hypot(0.3, 0.1))
+    gates = Gates(blocked, 0.3, [((5.5, 1.5), 0.0)])
+    np.testing.assert_allclose(gates.to[0], [4.5, 3.5, 2.5, 1.5, 0.5])  # a cell per gate
+    assert gates.bound(0, np.array([[0.5, 1.5]]))[0] == pytest.approx(5.0)
+    assert gates.bound(0, np.array([[5.2, 1.4]]))[0] == pytest.approx(np.hypot(0.3, 0.1))
 
 
 @pytest.mark.parametrize("seed", range(8))
@@ -66,10 +66,13 @@ def test_the_bound_is_never_above_the_optimum(seed):
     for start, goal in _queries(world, blocked, rng, 6):
         tol = float(rng.choice([0.0, 0.7]))
         found = shortest_path_in_world(world, start, goal, tol)
-        bound = Gates(blocked, world.threshold, goal, tol).bound(start[None])[0]
+        gates = Gates(blocked, world.threshold, [(start, 0.0), (goal, tol)])
+        bound = gates.bound(1, start[None])[0]
         if found.length is None:
             continue
         assert bound <= found.length * (1.0 + 1e-12)
+        if tol == 0.0:  # the path backwards, from the goal to the start
+            assert gates.bound(0, goal[None])[0] <= found.length * (1.0 + 1e-12)
         grid = free_grid.FreeGrid.for_world(world, start, goal, tol)
         grid.gates = None
         ratios.append(bound / found.length)
@@ -86,18 +89,18 @@ def test_a_diagonal_pinch_has_no_gate():
     blocked[:2, :2] = True
     blocked[2:, 2:] = True
     blocked[1, 1] = False  # the free cells (1, 1) and (2, 2) meet only at the corner (2, 2)
-    gates = Gates(blocked, 0.05, (2.5, 2.5))
-    assert gates.bound(np.array([[1.5, 1.5]]))[0] == np.inf
+    gates = Gates(blocked, 0.05, [((2.5, 2.5), 0.0)])
+    assert gates.bound(0, np.array([[1.5, 1.5]]))[0] == np.inf
     world = _world(blocked, 0.05)
     assert shortest_path_in_world(world, (1.5, 1.5), (2.5, 2.5)).length is None
 
 
 def test_gates_are_built_only_where_most_are_pinched():
     maze = perfect_maze(np.random.default_rng(1), 21, 1, 1, 0.0)
-    assert Gates.where_pinched(maze, 0.3, (1.5, 1.5)) is not None
+    assert Gates.where_pinched(maze, 0.3, [((1.5, 1.5), 0.0)]) is not None
     wide = perfect_maze(np.random.default_rng(1), 21, 4, 1, 0.0)  # four-cell corridors
-    assert Gates.where_pinched(wide, 0.3, (1.5, 1.5)) is None
-    assert Gates.where_pinched(np.zeros((10, 10), dtype=bool), 0.3, (1.5, 1.5)) is None
+    assert Gates.where_pinched(wide, 0.3, [((1.5, 1.5), 0.0)]) is None
+    assert Gates.where_pinched(np.zeros((10, 10), dtype=bool), 0.3, [((1.5, 1.5), 0.0)]) is None
 
 
 @pytest.mark.parametrize("seed", range(3))
