@@ -62,6 +62,8 @@ class Gates:
         self.ny, self.nx = blocked.shape
         self.targets = [(np.asarray(p, dtype=float), float(tol)) for p, tol in targets]
         self.lo, self.hi, self.side = gates if gates is not None else _gates(blocked, float(thr))
+        self._corners = np.pad(blocked, 1, constant_values=False)  # padded: the diagonal cells
+        self._thr = float(thr)
         self._home = [self._cells_near(p, tol) for p, tol in self.targets]
         #: Per target, a lower bound on the length of a path from a crossing of each gate to it.
         self.to = self._search()
@@ -127,7 +129,7 @@ class Gates:
         from scipy.sparse.csgraph import dijkstra
 
         n, m = len(self.lo), len(self.targets)
-        nbr, weight = _neighbours(self.side, self.lo, self.hi, self.ny, self.nx)
+        nbr, weight = _neighbours(self.side, self.lo, self.hi, self._corners, self._thr)
         ok = nbr >= 0
         counts, indices, data = [ok.sum(axis=1)], [nbr[ok]], [weight[ok]]
         for (point, tol), cells in zip(self.targets, self._home, strict=True):
@@ -198,10 +200,12 @@ def _gates(blocked: np.ndarray, thr: float):
     return lo, hi, side.reshape(4, ny * nx)
 
 
-def _neighbours(side: np.ndarray, lo: np.ndarray, hi: np.ndarray, ny: int, nx: int):
+def _neighbours(side: np.ndarray, lo: np.ndarray, hi: np.ndarray, pad: np.ndarray, thr: float):
     """Each gate's neighbours (the other gates of the two cells it separates) and its distance
-    to each: ``(n, 6)`` arrays, -1 where there is none."""
+    to each: ``(n, 6)`` arrays, -1 where there is none. ``pad`` is the blocked cells with a free
+    border."""
     n = len(lo)
+    nx = pad.shape[1] - 2
     nbr = np.full((n, 6), -1, dtype=np.int32)
     weight = np.zeros((n, 6))
     slot = np.zeros(n, dtype=np.int8)
@@ -213,7 +217,7 @@ def _neighbours(side: np.ndarray, lo: np.ndarray, hi: np.ndarray, ny: int, nx: i
             gb = side[b]
             both = np.flatnonzero((ga >= 0) & (gb >= 0))
             j, i = np.divmod(both, nx)
-            w = _distance(a, b, ga[both], gb[both], lo, hi, i, j)
+            w = _distance(a, b, ga[both], gb[both], lo, hi, i, j, pad, thr)
             rows = ga[both]
             nbr[rows, slot[rows]] = gb[both]
             weight[rows, slot[rows]] = w
@@ -221,8 +225,11 @@ def _neighbours(side: np.ndarray, lo: np.ndarray, hi: np.ndarray, ny: int, nx: i
     return nbr, weight
 
 
-def _distance(a: int, b: int, ga, gb, lo, hi, i, j) -> np.ndarray:
-    """Distance between gate ``ga`` on side ``a`` and ``gb`` on side ``b`` of cells ``(j, i)``."""
+def _distance(a: int, b: int, ga, gb, lo, hi, i, j, pad, thr: float) -> np.ndarray:
+    """Length of the shortest way between gate ``ga`` on side ``a`` and ``gb`` on side ``b`` of
+    cells ``(j, i)`` within the cell: a cell across, or round the corner the two sides share,
+    which it keeps ``thr`` from when the cell diagonally across it is blocked (tangents and an
+    arc; the least at the gates' ends nearest the corner, the way growing with either)."""
     if {a, b} in ({_W, _E}, {_S, _N}):  # opposite sides: a cell across, offset along
         gap = np.maximum(np.maximum(lo[gb] - hi[ga], lo[ga] - hi[gb]), 0.0)
         return np.hypot(1.0, gap)
@@ -231,4 +238,13 @@ def _distance(a: int, b: int, ga, gb, lo, hi, i, j) -> np.ndarray:
     north = _N in (a, b)
     dy = (j + 1.0 - hi[v]) if north else (lo[v] - j)
     dx = (i + 1.0 - hi[h]) if east else (lo[h] - i)
-    return np.hypot(dx, dy)
+    chord = np.hypot(dx, dy)
+    corner = pad[j + 1 + (1 if north else -1), i + 1 + (1 if east else -1)]
+    # The chord passes the corner closer than thr: round it (tangent, arc, tangent).
+    tight = corner & (dx * dy < thr * chord) & (thr > 0.0)
+    if not tight.any():
+        return chord
+    x, y = np.maximum(dx[tight], thr), np.maximum(dy[tight], thr)
+    arc = 0.5 * np.pi - np.arccos(thr / x) - np.arccos(thr / y)
+    chord[tight] = np.sqrt(x * x - thr * thr) + np.sqrt(y * y - thr * thr) + thr * arc
+    return chord

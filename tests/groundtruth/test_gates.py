@@ -51,6 +51,21 @@ def test_a_corridors_gates_keep_the_clearance_from_its_walls():
     assert gates.bound(0, np.array([[5.2, 1.4]]))[0] == pytest.approx(np.hypot(0.3, 0.1))
 
 
+def test_round_a_walls_corner_the_bound_is_the_discs_arc():
+    """An L-shaped corridor: through the turn's cell the way between its two gates keeps the
+    clearance from the wall's corner (a quarter circle of radius 0.3), which the exact optimum
+    also does."""
+    blocked = np.ones((4, 3), dtype=bool)
+    blocked[1, :] = False  # along row 1 ...
+    blocked[1:, 2] = False  # ... and up column 2
+    start, goal = np.array([0.5, 1.5]), np.array([2.5, 3.5])
+    gates = Gates(blocked, 0.3, [(goal, 0.0)])
+    bound = gates.bound(0, start[None])[0]
+    assert bound == pytest.approx(0.5 + 1.0 + 0.15 * np.pi + 1.0 + 0.5)
+    exact = shortest_path_in_world(_world(blocked, 0.3), start, goal).length
+    assert bound <= exact < bound + 0.1
+
+
 @pytest.mark.parametrize("seed", range(8))
 def test_the_bound_is_never_above_the_optimum(seed):
     """On perfect mazes of one-cell corridors with loops, and on random walls with pinches, for
