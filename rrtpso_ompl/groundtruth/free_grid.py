@@ -67,6 +67,10 @@ FAST_SEARCH_CELLS = 300_000
 BLOCK_GROWTH = 1.1
 MAX_SEARCH_FREE = 1_200_000
 MAX_SEARCH_CELLS = 4_200_000
+#: Most possibly-free cells of a raster searched cell by cell on request (the optimum's search,
+#: when the point's path shows that blocks lost the map's walls: docs/benchmarking.md): a map of
+#: 2048 x 2048 cells, whatever its share of free ones (0.45 GB for the search at its peak).
+MAX_REFINED_FREE = 4_200_000
 #: Most cells of a search grid searched in numpy, level by level (:func:`_numpy_steps`), rather
 #: than with scipy: a level costs a few numpy calls, and a search has at most one level per cell,
 #: so even a winding one stays below the cost of importing scipy (a 100 x 100 serpentine, 5,000
@@ -111,7 +115,8 @@ class FreeGrid:
     """
 
     def __init__(self, origin, h: float, free: np.ndarray, start, goal,
-                 goal_tolerance: float = 0.0, terminate=None) -> None:  # fmt: skip
+                 goal_tolerance: float = 0.0, terminate=None,
+                 cell_by_cell: bool = False) -> None:  # fmt: skip
         self.x0, self.y0 = float(origin[0]), float(origin[1])
         self.h = float(h)
         self.free = np.asarray(free, dtype=bool)
@@ -126,7 +131,11 @@ class FreeGrid:
         #: blocked cells), else None (set by :meth:`for_world`).
         self.blocked: np.ndarray | None = None
         # The search grid: blocks of k x k cells, a block possibly free when any of its cells is.
-        k, coarse, narrow = _search_blocks(self.free)
+        k, coarse, narrow = _search_blocks(self.free, cell_by_cell)
+        n_free = int(np.count_nonzero(self.free))
+        #: Whether the raster went into blocks for its size alone (more possibly-free cells
+        #: than :data:`MAX_SEARCH_FREE`) and could be searched cell by cell on request.
+        self.refinable = k > 1 and MAX_SEARCH_FREE < n_free <= MAX_REFINED_FREE
         #: Whether blocks of cells would not keep the raster's shape (corridors a cell or two
         #: wide): then, on a map, the gates between its cells bound a disc's paths too.
         self.narrow = narrow
@@ -142,7 +151,7 @@ class FreeGrid:
     # ------------------------------------------------------------------------------------------
     @classmethod
     def for_world(cls, world: World, start, goal, goal_tolerance: float = 0.0,
-                  terminate=None) -> FreeGrid:  # fmt: skip
+                  terminate=None, cell_by_cell: bool = False) -> FreeGrid:  # fmt: skip
         """The raster of a world: the lattice of its boxes when they have one (a map's cells;
         then :attr:`blocked` holds the cells the boxes cover), else 32 to :data:`GENERIC_CELLS`
         cells per side (more with more obstacles) through the world's exact clearance.
@@ -166,7 +175,7 @@ class FreeGrid:
                 d = ndimage.distance_transform_edt(free)
                 free &= (d - 0.5 + 0.5 * _SQRT2) * h >= thr - 4.0 * world.tol
             _poll(terminate)
-            grid = cls(origin, h, free, start, goal, goal_tolerance, terminate)
+            grid = cls(origin, h, free, start, goal, goal_tolerance, terminate, cell_by_cell)
             grid.blocked = blocked
             if grid.narrow and _covers(origin, h, blocked.shape, world.bounds):
                 _poll(terminate)
@@ -190,7 +199,7 @@ class FreeGrid:
         clear = world.point_clearance(centres, cap=cap).reshape(ny, nx)
         free = clear + half_diag >= thr - 4.0 * world.tol
         _poll(terminate)
-        return cls((xmin, ymin), h, free, start, goal, goal_tolerance, terminate)
+        return cls((xmin, ymin), h, free, start, goal, goal_tolerance, terminate, cell_by_cell)
 
     # ------------------------------------------------------------------------------------------
     @property
@@ -568,22 +577,24 @@ def _covers(origin, h: float, shape, bounds) -> bool:
     return across and up
 
 
-def _search_blocks(free: np.ndarray) -> tuple[int, np.ndarray, bool]:
+def _search_blocks(free: np.ndarray, cell_by_cell: bool = False) -> tuple[int, np.ndarray, bool]:
     """The block side ``k`` of the search grid, that grid (:func:`_block_any`) and whether the
     raster is narrow (blocks of the fast side, at least 2, would not keep its shape): the side of
     :data:`FAST_SEARCH_CELLS` where its blocks keep the map's shape (:data:`BLOCK_GROWTH`), else
-    the smallest within :data:`MAX_SEARCH_CELLS` and :data:`MAX_SEARCH_FREE` (at most ``sqrt(cells
-    / MAX_SEARCH_FREE) + 1`` sides tried)."""
+    the smallest within :data:`MAX_SEARCH_CELLS` and :data:`MAX_SEARCH_FREE` possibly-free cells
+    (:data:`MAX_REFINED_FREE` when asked for ``cell_by_cell``; at most ``sqrt(cells / limit) + 1``
+    sides tried)."""
     fast = math.ceil(math.sqrt(free.size / FAST_SEARCH_CELLS))
     k = max(2, fast)
     coarse = _block_any(free, k)
     narrow = np.count_nonzero(coarse) * k * k > BLOCK_GROWTH * np.count_nonzero(free)
-    if fast > 1 and not narrow:
+    if fast > 1 and not narrow and not cell_by_cell:
         return k, coarse, narrow
+    limit = MAX_REFINED_FREE if cell_by_cell else MAX_SEARCH_FREE
     k = max(1, math.ceil(math.sqrt(free.size / MAX_SEARCH_CELLS)))
     while True:
         coarse = _block_any(free, k)
-        if coarse.size <= MAX_SEARCH_CELLS and np.count_nonzero(coarse) <= MAX_SEARCH_FREE:
+        if coarse.size <= MAX_SEARCH_CELLS and np.count_nonzero(coarse) <= limit:
             return k, coarse, narrow
         k += 1
 

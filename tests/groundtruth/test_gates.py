@@ -1,6 +1,7 @@
 """The gates between a map's cells (groundtruth/gates.py): a lower bound on a disc's path that is
 never above the exact optimum, close to it in one-cell corridors, and the optimum the same with
-the bound as without it."""
+the bound as without it; and the raster searched again cell by cell where its blocks lost the
+map's walls."""
 
 from __future__ import annotations
 
@@ -139,3 +140,37 @@ def test_the_optimum_is_the_same_without_the_gates(seed, monkeypatch):
         assert with_gates.length == pytest.approx(without.length, rel=1e-9)
         assert world.path_valid(with_gates.valid_polyline(world))
     assert checked >= 2
+
+
+def test_blocks_that_lose_the_walls_are_refined(monkeypatch):
+    """Rooms with one-cell walls, in blocks of 4 x 4 cells for their size: the blocks lose the
+    walls (the raster's bound is the straight line) and the point's path shows it, so the raster
+    is searched again cell by cell; the optimum is the one of the raster searched cell by cell
+    from the start."""
+    from rrtpso_ompl.groundtruth.optimum import query
+
+    blocked = np.zeros((64, 64), dtype=bool)
+    blocked[16::16, :] = True  # walls across, a door at alternate ends
+    for row in range(16, 64, 16):
+        door = 1 if (row // 16) % 2 else 61
+        blocked[row, door : door + 2] = False
+    world = _world(blocked, 0.4)
+    start, goal = (32.5, 2.5), (32.5, 61.5)
+    monkeypatch.setattr(free_grid, "FAST_SEARCH_CELLS", 256)  # blocks of 4 x 4
+    monkeypatch.setattr(free_grid, "MAX_SEARCH_FREE", 256)
+    grids = []
+    build = free_grid.FreeGrid.for_world
+
+    def spy(*args, **kwargs):
+        grids.append(build(*args, **kwargs))
+        return grids[-1]
+
+    monkeypatch.setattr(query.FreeGrid, "for_world", spy)
+    refined = shortest_path_in_world(world, start, goal)
+    assert [g.k for g in grids] == [4, 1]
+    monkeypatch.setattr(free_grid, "MAX_SEARCH_FREE", 10**7)
+    monkeypatch.setattr(free_grid, "FAST_SEARCH_CELLS", 10**7)
+    fine = shortest_path_in_world(world, start, goal)
+    assert grids[-1].k == 1 and len(grids) == 3
+    assert refined.length == pytest.approx(fine.length, rel=1e-9)
+    assert refined.length > 3 * 59  # through the doors, not across the walls

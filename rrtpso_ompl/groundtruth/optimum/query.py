@@ -174,6 +174,12 @@ def _search(world: World, start: np.ndarray, goal: np.ndarray, goal_tol: float, 
             sharp, guess = _point_path(world, start, goal, goal_tol, terminate, source)
         except Stopped:
             return report(None, stopped=True)
+    if grid.refinable and sharp > _REFINE * float(grid.lower_bound(1, start[None])[0]):
+        grid = None  # blocks of cells lost the map's walls (rooms', a maze's): cell by cell
+        try:
+            grid = FreeGrid.for_world(world, start, goal, goal_tol, terminate, cell_by_cell=True)
+        except Stopped:
+            return report(None, stopped=True)
     lower = max(float(grid.lower_bound(1, start[None])[0]), sharp)
     if lower == math.inf:  # a proof: no point (no chain of gates) passes between them
         return report(None)
@@ -311,6 +317,13 @@ def _turned(piece: Piece, frame) -> Piece:
                    center=back(piece.center), angle=piece.angle + frame.yaw)  # fmt: skip
 
 
+#: When the point's path is this many times the raster's bound at the start and the raster went
+#: into blocks for its size alone (:attr:`.FreeGrid.refinable`), the blocks lost the map's walls
+#: (rooms of 2048 x 2048 cells with one-cell walls: 1.25; a maze of four-cell corridors: 75),
+#: and it is searched again cell by cell: those rooms 29-50 s -> 17 s, the maze over 300 s ->
+#: 17 s. Below a million free cells the raster's shape chose already (rooms of 1024 x 1024 cells
+#: at 1.21 keep their blocks, which cost less than the search they would save).
+_REFINE = 1.15
 #: The rounds' bounds, as multiples of the lower bound on the optimum: a round that finds no
 #: path within its bound proves the optimum longer, and the next one looks further. On a map's
 #: lattice the geodesic bound is a few percent short (it counts cells) and a loose bound costs
