@@ -25,7 +25,9 @@ LaValle, *Planning Algorithms*, 2006, section 6.2.4; Latombe 1991 for the polygo
    a superset of the free space. Breadth-first step counts over them from the start's cell and
    the goal's give *geodesic lower bounds* (a maze's corridors, not the straight line), used as
    A\*'s heuristic and for pruning; they also prove a problem unsolvable when the goal's cell is
-   not reached. On a map of narrow corridors, where a disc's gates between cells are short,
+   not reached. A raster that went into blocks of cells for its size alone is searched again
+   cell by cell when the point's path (below) shows that the blocks lost the map's walls. On a
+   map of narrow corridors, where a disc's gates between cells are short,
    the bound through those gates (:mod:`..gates`: within a few percent of a disc's path in
    one-cell corridors, where the raster's is a fifth short) is the larger one. The heuristic is
    admissible but not consistent, so a node whose cost improves after its expansion is expanded
