@@ -365,7 +365,7 @@ class FreeGrid:
             return out
         fi, fj = self._nearest_blocked()
         margin = threshold - 1e-9 * self.h  # round-off of the samples: never a false "near"
-        for seg, px, py in self._samples(a, b, self.h):
+        for seg, px, py in _samples(a, b, self.h):
             i = np.floor((px - self.x0) / self.h).astype(np.intp)
             j = np.floor((py - self.y0) / self.h).astype(np.intp)
             inside = (i >= 0) & (i < self.nx) & (j >= 0) & (j < self.ny)
@@ -389,22 +389,6 @@ class FreeGrid:
                                                         idx[0].astype(np.int32))  # fmt: skip
         return cached
 
-    @staticmethod
-    def _samples(a: np.ndarray, b: np.ndarray, spacing: float, chunk: int = 0):
-        """Points along each segment at most ``spacing`` apart, ends included, in chunks of
-        about ``chunk`` (:data:`_SAMPLE_CHUNK`) points: ``(segment, x, y)`` arrays."""
-        d = b - a
-        n = np.ceil(np.hypot(d[:, 0], d[:, 1]) / spacing).astype(np.intp) + 1
-        starts = np.concatenate([[0], np.cumsum(n)])
-        cut = np.searchsorted(starts, np.arange(0, starts[-1], chunk or _SAMPLE_CHUNK))
-        bounds = np.unique(np.concatenate([cut, [len(a)]]))
-        for s0, s1 in itertools.pairwise(bounds.tolist()):
-            nn = n[s0:s1]
-            seg = np.repeat(np.arange(s0, s1), nn)
-            t = (np.arange(nn.sum()) - np.repeat(np.cumsum(nn) - nn, nn)) / np.maximum(
-                nn[seg - s0] - 1, 1)  # fmt: skip
-            yield seg, a[seg, 0] + t * d[seg, 0], a[seg, 1] + t * d[seg, 1]
-
     def _near_by_window(self, a: np.ndarray, b: np.ndarray, threshold: float) -> np.ndarray:
         """:meth:`segments_near_blocked` through the windows of cells around the samples."""
         out = np.zeros(len(a), dtype=bool)
@@ -414,7 +398,7 @@ class FreeGrid:
         off = np.arange(-k, k + 1)
         di, dj = (v.ravel() for v in np.meshgrid(off, off))
         rim, inner = self._rim()  # only rim cells need the distance formula (_rim)
-        for seg, px, py in self._samples(a, b, self.h, _BAND_CHUNK):
+        for seg, px, py in _samples(a, b, self.h, _BAND_CHUNK):
             i = np.floor((px - self.x0) / self.h).astype(np.intp)
             j = np.floor((py - self.y0) / self.h).astype(np.intp)
             # Only samples with a rim cell in their window need the window.
@@ -565,6 +549,22 @@ def _block_any(free: np.ndarray, k: int) -> np.ndarray:
     py, px = -ny % k, -nx % k
     f = np.pad(free, ((0, py), (0, px)), constant_values=False)
     return f.reshape(f.shape[0] // k, k, f.shape[1] // k, k).any(axis=(1, 3))
+
+
+def _samples(a: np.ndarray, b: np.ndarray, spacing: float, chunk: int = 0):
+    """Points along each segment at most ``spacing`` apart, ends included, in chunks of
+    about ``chunk`` (:data:`_SAMPLE_CHUNK`) points: ``(segment, x, y)`` arrays."""
+    d = b - a
+    n = np.ceil(np.hypot(d[:, 0], d[:, 1]) / spacing).astype(np.intp) + 1
+    starts = np.concatenate([[0], np.cumsum(n)])
+    cut = np.searchsorted(starts, np.arange(0, starts[-1], chunk or _SAMPLE_CHUNK))
+    bounds = np.unique(np.concatenate([cut, [len(a)]]))
+    for s0, s1 in itertools.pairwise(bounds.tolist()):
+        nn = n[s0:s1]
+        seg = np.repeat(np.arange(s0, s1), nn)
+        t = (np.arange(nn.sum()) - np.repeat(np.cumsum(nn) - nn, nn)) / np.maximum(
+            nn[seg - s0] - 1, 1)  # fmt: skip
+        yield seg, a[seg, 0] + t * d[seg, 0], a[seg, 1] + t * d[seg, 1]
 
 
 def _covers(origin, h: float, shape, bounds) -> bool:
