@@ -363,8 +363,10 @@ class FreeGrid:
         out = np.zeros(len(a), dtype=bool)
         if self.blocked is None or not self.blocked.any() or not len(a):
             return out
-        fi, fj = self._nearest_blocked()
         margin = threshold - 1e-9 * self.h  # round-off of the samples: never a false "near"
+        if margin <= 0.0:
+            return out
+        fi, fj = self._nearest_blocked()
         for seg, px, py in _samples(a, b, self.h):
             i = np.floor((px - self.x0) / self.h).astype(np.intp)
             j = np.floor((py - self.y0) / self.h).astype(np.intp)

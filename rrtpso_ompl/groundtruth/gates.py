@@ -9,16 +9,17 @@ the cells at the two ends of a unit edge can come within ``thr`` of it (the two 
 free), so its gate is the edge less ``thr`` at each end where one of the two cells there is
 blocked: exact for ``thr`` up to a cell, a superset beyond (which keeps every bound a bound).
 
-Between two crossings a path stays in one cell, so it is at least as long as the distance
-between the two gates it crossed there; from a crossing of gate ``g`` on it is at least the
-least sum of such distances over chains of gates from ``g`` to a cell of the goal disc, plus the
-distance from that cell's gate to the disc (:attr:`Gates.to_goal`: a shortest-path search over
-the gates). A path through a cell's corner crosses an edge at its end: two gates reach a corner
-only when all four cells there are free, and then they are 0 apart, as the path's step is. In a
-corridor the gates are its middle: the distance between a cell's gates is a cell along it, the
-chord round a corner: a few percent short of the disc's path. In the open a path crosses gates
-that meet at corners for nothing, and the raster's bound is the better one; both are bounds, so
-the search takes the larger.
+Between two crossings a path stays in one cell, so it is at least as long as the shortest way
+in that cell between the two gates it crossed there: a cell across, or round the corner the two
+sides share, keeping ``thr`` from it (tangent, arc, tangent) when the cell diagonally across is
+blocked. From a crossing of gate ``g`` on, a path to a target (the goal disc, or the start) is at
+least the least sum of such ways over chains of gates from ``g`` to a cell of the target, plus
+the distance from that cell's gate to it (:attr:`Gates.to`: a shortest-path search over the
+gates). A path through a cell's corner crosses an edge at its end: two gates reach a corner only
+when all four cells there are free, and then they are 0 apart, as the path's step is. In a
+corridor the gates are its middle and the bound comes within a fraction of a percent of the
+disc's path; in the open a chain slides along whole gates for nothing, and the raster's bound is
+the better one. Both are bounds, so the search takes the larger.
 
 The centre stays in the bounds: the gates serve only where the lattice covers them (no path goes
 round the map). Obstacles besides the cells only lengthen paths. Units: cells, the lattice's
@@ -36,7 +37,7 @@ _W, _E, _S, _N = range(4)
 #: :meth:`Gates.where_pinched` builds the gates only where at least :data:`MIN_PINCHED` of them
 #: are at most :data:`PINCHED` cells long. A chain of gates slides along each gate free of charge,
 #: so the bound is as good as the gates are short: a disc of 0.4 cells in one-cell corridors
-#: has gates of 0.2 and a bound within 3 % of its path (the raster's: 20 %); in four-cell
+#: has gates of 0.2 and a bound within 0.3 % of its path (the raster's: 20 %); in four-cell
 #: corridors and rooms most gates are whole and the bound near 0, and a point robot's gates are
 #: all whole. The search over the gates costs 0.5 s per million cells.
 MIN_PINCHED = 0.5
