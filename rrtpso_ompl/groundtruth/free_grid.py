@@ -333,7 +333,8 @@ class FreeGrid:
             out[alive[self._hits(a[alive], b[alive], spacing)]] = True
         return out
 
-    def segments_near_blocked(self, a: np.ndarray, b: np.ndarray, threshold: float) -> np.ndarray:
+    def segments_near_blocked(self, a: np.ndarray, b: np.ndarray, threshold: float,
+                              exact: bool = True) -> np.ndarray:  # fmt: skip
         """Which segments come closer than ``threshold`` to a blocked cell (booleans): the exact
         test of a world made only of the lattice's boxes, straight from the cells.
 
@@ -343,7 +344,8 @@ class FreeGrid:
         found there is the world's own segment-box formula, so the answer is the world's
         (``World.segments_free`` is its negation, bounds apart). Only for thresholds of up to
         :data:`MAX_BAND` cells minus a half (:attr:`band_ok`). A first pass (:meth:`_deep`)
-        settles, without the windows, most segments that come well inside the threshold.
+        settles, without the windows, most segments that come well inside the threshold; with
+        ``exact`` False only that pass runs (a "near" is sure, a "free" is not).
         """
         a = np.asarray(a, dtype=float).reshape(-1, 2)
         b = np.asarray(b, dtype=float).reshape(-1, 2)
@@ -351,8 +353,9 @@ class FreeGrid:
         if not len(a) or self.blocked is None:
             return out
         out = self._deep(a, b, threshold)  # most that are near, cheaply
-        keep = np.flatnonzero(~out)
-        out[keep] = self._near_by_window(a[keep], b[keep], threshold)
+        if exact:
+            keep = np.flatnonzero(~out)
+            out[keep] = self._near_by_window(a[keep], b[keep], threshold)
         return out
 
     def _deep(self, a: np.ndarray, b: np.ndarray, threshold: float) -> np.ndarray:

@@ -139,3 +139,34 @@ def test_blocks_are_used_only_where_they_keep_the_maps_shape(monkeypatch):
     coarse = FreeGrid((0.0, 0.0), 1.0, maze, start, goal)
     assert coarse.k == 2 and coarse.lower_bound(1, np.array([start]))[0] < 2 * 39
     assert FreeGrid((0.0, 0.0), 1.0, rooms, start, goal).k == 2
+
+
+def test_testing_tangents_piece_by_piece_gives_the_whole_segments_answer():
+    """The search tests long tangents piece by piece from their start (optimum/graph.py's
+    ``_in_stages``): a segment is near a blocked cell where one of its pieces is, so the answer
+    is the whole segment's, for segments of up to 300 cells, and the cheap pass alone never says
+    "near" where the whole test says free."""
+    from rrtpso_ompl.groundtruth.optimum.graph import _in_stages
+
+    rng = np.random.default_rng(7)
+    blocked = np.zeros((320, 320), dtype=bool)
+    for _ in range(60):  # city-like blocks with streets between
+        x, y = rng.integers(0, 300, 2)
+        w, h = rng.integers(4, 30, 2)
+        blocked[y : y + h, x : x + w] = True
+    rows, cols = np.nonzero(blocked)
+    boxes = np.column_stack([cols, rows, cols + 1, rows + 1]).astype(float)
+    world = World(((0.0, 0.0), (320.0, 320.0)), boxes=boxes, robot_radius=1.5)
+    grid = FreeGrid.for_world(world, (0.5, 0.5), (319.5, 319.5))
+    a = rng.uniform(0.0, 320.0, (3000, 2))
+    angle = rng.uniform(0.0, 2.0 * np.pi, 3000)
+    b = np.clip(a + rng.uniform(1.0, 300.0, (3000, 1)) * np.column_stack(
+        [np.cos(angle), np.sin(angle)]), 0.0, 320.0)  # fmt: skip
+    whole = grid.segments_near_blocked(a, b, world.threshold)
+    pieces = _in_stages(lambda p, q: grid.segments_near_blocked(p, q, world.threshold),
+                        a, b, grid.h)  # fmt: skip
+    np.testing.assert_array_equal(pieces, whole)
+    cheap = _in_stages(lambda p, q: grid.segments_near_blocked(p, q, world.threshold, False),
+                       a, b, grid.h)  # fmt: skip
+    assert not (cheap & ~whole).any() and cheap.sum() > 0.5 * whole.sum()
+    assert 0.2 < whole.mean() < 0.99

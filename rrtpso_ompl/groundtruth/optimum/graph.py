@@ -230,12 +230,18 @@ class TangentGraph:
         """The free tangents among ``cand``: the raster's sound rejection, then the exact test
         (straight from the cells in a world of the lattice's cells alone)."""
         w = self.world
-        if len(cand.j) and self.grid.core_share >= _RASTER_WORTH:
-            cand = cand.take(np.flatnonzero(~self.grid.blocked_segments(cand.p, cand.q)))
+        g = self.grid
         if len(cand.j) and self._cells_only:
-            # A world of the lattice's cells alone: the exact test straight from the cells.
-            near = self.grid.segments_near_blocked(cand.p, cand.q, w.threshold)
+            # A world of the lattice's cells alone: the exact test straight from the cells, its
+            # cheap first pass piece by piece (sharper than the raster's rejection), then the
+            # windows round the samples of those it left.
+            near = _in_stages(lambda a, b: g.segments_near_blocked(a, b, w.threshold, False),
+                              cand.p, cand.q, g.h)  # fmt: skip
+            cand = cand.take(np.flatnonzero(~near))
+            near = g.segments_near_blocked(cand.p, cand.q, w.threshold)
             return cand.take(np.flatnonzero(~near))
+        if len(cand.j) and g.core_share >= _RASTER_WORTH:
+            cand = cand.take(np.flatnonzero(~_in_stages(g.blocked_segments, cand.p, cand.q, g.h)))
         if len(cand.j):
             cand = cand.take(np.flatnonzero(~self.blocked_near(cand)))
         if len(cand.j):
@@ -358,6 +364,34 @@ class _Sieve:
             ok &= t <= slack - steps[:, 0:1]
         row, k = np.nonzero(ok)
         return row, self.order[k]
+
+
+#: Where the segment tests of :func:`_in_stages` cut the tangents, in cells from their start.
+_STAGES = (16.0, 64.0, 256.0)
+
+
+def _in_stages(test, p: np.ndarray, q: np.ndarray, h: float) -> np.ndarray:
+    """Which segments ``p``-``q`` ``test`` finds blocked, tested piece by piece from ``p``: the
+    first 16 cells of every segment, then the next pieces (to 64, 256 cells, the rest) of those
+    not yet blocked. A segment is blocked where one of its pieces is, so the answer is the
+    test's (a piece's ends are off the segment by round-off, far below the touch tolerance);
+    a tangent leaves its circle at ``p``, and of those a city's search rejected, two thirds
+    came too near within 16 cells of it, where testing whole tangents of 200 cells on average
+    cost most of the search."""
+    d = q - p
+    length = np.hypot(d[:, 0], d[:, 1]) / h
+    out = np.zeros(len(p), dtype=bool)
+    t0 = np.zeros(len(p))
+    for end in (*_STAGES, math.inf):
+        t1 = np.minimum(end / np.maximum(length, 1e-300), 1.0)
+        live = np.flatnonzero(~out & (t0 < 1.0))
+        if not len(live):
+            break
+        a = p[live] + t0[live, None] * d[live]
+        b = np.where((t1[live] >= 1.0)[:, None], q[live], p[live] + t1[live, None] * d[live])
+        out[live] = test(np.where((t0[live] <= 0.0)[:, None], p[live], a), b)
+        t0 = t1
+    return out
 
 
 def _loosen(bound: float, tol: float) -> float:
