@@ -238,7 +238,8 @@ class TangentGraph:
             near = _in_stages(lambda a, b: g.segments_near_blocked(a, b, w.threshold, False),
                               cand.p, cand.q, g.h)  # fmt: skip
             cand = cand.take(np.flatnonzero(~near))
-            near = g.segments_near_blocked(cand.p, cand.q, w.threshold)
+            near = _in_stages(lambda a, b: g.segments_near_blocked(a, b, w.threshold),
+                              cand.p, cand.q, g.h)  # fmt: skip
             return cand.take(np.flatnonzero(~near))
         if len(cand.j) and g.core_share >= _RASTER_WORTH:
             cand = cand.take(np.flatnonzero(~_in_stages(g.blocked_segments, cand.p, cand.q, g.h)))
