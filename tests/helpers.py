@@ -320,3 +320,37 @@ def exact_length(world, start, goal) -> float:
     p.start, p.goal, p.goal_tolerance, p.name, p.source = start, goal, 0.0, "t", "t"
     p.bounds = world.bounds
     return shortest_path(p, world, upper_bound=math.inf).length
+
+
+def cells_world(blocked: np.ndarray, radius: float = 0.0):
+    """A world of a grid's blocked unit cells (rows from the bottom; boxes on the lattice, as a
+    map's), its bounds the grid, for a robot of ``radius`` cells."""
+    from rrtpso_ompl.model import World
+
+    rows, cols = np.nonzero(blocked)
+    boxes = np.column_stack([cols, rows, cols + 1, rows + 1]).astype(float)
+    ny, nx = blocked.shape
+    return World(((0.0, 0.0), (float(nx), float(ny))), boxes=boxes, robot_radius=radius)
+
+
+def assert_same_optimum_without(world, queries, monkeypatch, patch) -> int:
+    """For each ``(start, goal)``: the exact optimum is the one found with ``patch(m)`` applied
+    (to a ``monkeypatch`` context ``m``: a part of the search turned off), to 1e-9, and its
+    path is valid; both or neither find one. Returns how many had a path."""
+    import pytest
+
+    from rrtpso_ompl.groundtruth.optimum import shortest_path_in_world
+
+    checked = 0
+    for start, goal in queries:
+        new = shortest_path_in_world(world, start, goal)
+        with monkeypatch.context() as m:
+            patch(m)
+            old = shortest_path_in_world(world, start, goal)
+        if old.length is None:
+            assert new.length is None
+            continue
+        checked += 1
+        assert new.length == pytest.approx(old.length, rel=1e-9)
+        assert world.path_valid(new.valid_polyline(world))
+    return checked

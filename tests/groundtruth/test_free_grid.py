@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers import PROBLEMS
+from helpers import PROBLEMS, cells_world
 from scipy import ndimage
 
 from rrtpso_ompl.groundtruth import free_grid, shortest_path
@@ -88,10 +88,7 @@ def test_the_lattice_test_of_segments_is_the_worlds(seed):
         w, h = rng.integers(2, 7, 2)
         blocked[y : y + h, x : x + w] = True
     blocked |= rng.random(blocked.shape) < 0.02
-    rows, cols = np.nonzero(blocked)
-    boxes = np.column_stack([cols, rows, cols + 1, rows + 1]).astype(float)
-    radius = (0.3, 1.5, 1.2, 0.05)[seed]
-    world = World(((0.0, 0.0), (40.0, 40.0)), boxes=boxes, robot_radius=radius)
+    world = cells_world(blocked, (0.3, 1.5, 1.2, 0.05)[seed])
     grid = FreeGrid.for_world(world, (0.5, 0.5), (39.5, 39.5))
     assert grid.band_ok(world.threshold) and grid._rim()[1].any()
     a = rng.uniform(0.0, 40.0, (3000, 2))
@@ -108,9 +105,7 @@ def test_the_sure_near_samples_never_contradict_the_world(seed):
     deep, and the window alone still answers as the world does."""
     rng = np.random.default_rng(seed)
     blocked = rng.random((48, 48)) < 0.25
-    rows, cols = np.nonzero(blocked)
-    boxes = np.column_stack([cols, rows, cols + 1, rows + 1]).astype(float)
-    world = World(((0.0, 0.0), (48.0, 48.0)), boxes=boxes, robot_radius=(0.4, 1.0, 1.5)[seed])
+    world = cells_world(blocked, (0.4, 1.0, 1.5)[seed])
     grid = FreeGrid.for_world(world, (0.5, 0.5), (47.5, 47.5))
     a = rng.uniform(0.0, 48.0, (4000, 2))
     b = np.clip(a + rng.normal(0.0, 3.0, a.shape), 0.0, 48.0)
@@ -154,9 +149,7 @@ def test_testing_tangents_piece_by_piece_gives_the_whole_segments_answer():
         x, y = rng.integers(0, 300, 2)
         w, h = rng.integers(4, 30, 2)
         blocked[y : y + h, x : x + w] = True
-    rows, cols = np.nonzero(blocked)
-    boxes = np.column_stack([cols, rows, cols + 1, rows + 1]).astype(float)
-    world = World(((0.0, 0.0), (320.0, 320.0)), boxes=boxes, robot_radius=1.5)
+    world = cells_world(blocked, 1.5)
     grid = FreeGrid.for_world(world, (0.5, 0.5), (319.5, 319.5))
     a = rng.uniform(0.0, 320.0, (3000, 2))
     angle = rng.uniform(0.0, 2.0 * np.pi, 3000)

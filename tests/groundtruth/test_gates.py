@@ -7,19 +7,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers import assert_same_optimum_without, cells_world
 
 from rrtpso_ompl.groundtruth import free_grid
 from rrtpso_ompl.groundtruth.gates import Gates
 from rrtpso_ompl.groundtruth.map_kinds import _maze as perfect_maze
 from rrtpso_ompl.groundtruth.optimum import shortest_path_in_world
 from rrtpso_ompl.model import World
-
-
-def _world(blocked: np.ndarray, radius: float) -> World:
-    rows, cols = np.nonzero(blocked)
-    boxes = np.column_stack([cols, rows, cols + 1, rows + 1]).astype(float)
-    ny, nx = blocked.shape
-    return World(((0, 0), (nx, ny)), boxes=boxes, robot_radius=radius)
 
 
 def _queries(world: World, blocked: np.ndarray, rng: np.random.Generator, n: int):
@@ -63,7 +57,7 @@ def test_round_a_walls_corner_the_bound_is_the_discs_arc():
     gates = Gates(blocked, 0.3, [(goal, 0.0)])
     bound = gates.bound(0, start[None])[0]
     assert bound == pytest.approx(0.5 + 1.0 + 0.15 * np.pi + 1.0 + 0.5)
-    exact = shortest_path_in_world(_world(blocked, 0.3), start, goal).length
+    exact = shortest_path_in_world(cells_world(blocked, 0.3), start, goal).length
     assert bound <= exact < bound + 0.1
 
 
@@ -77,7 +71,7 @@ def test_the_bound_is_never_above_the_optimum(seed):
         blocked = perfect_maze(rng, 25, 1, 1, 0.3)[::-1].copy()
     else:
         blocked = rng.random((20, 20)) < 0.3
-    world = _world(blocked, float(rng.uniform(0.05, 0.45)))
+    world = cells_world(blocked, float(rng.uniform(0.05, 0.45)))
     ratios, raster = [], []
     for start, goal in _queries(world, blocked, rng, 6):
         tol = float(rng.choice([0.0, 0.7]))
@@ -107,7 +101,7 @@ def test_a_diagonal_pinch_has_no_gate():
     blocked[1, 1] = False  # the free cells (1, 1) and (2, 2) meet only at the corner (2, 2)
     gates = Gates(blocked, 0.05, [((2.5, 2.5), 0.0)])
     assert gates.bound(0, np.array([[1.5, 1.5]]))[0] == np.inf
-    world = _world(blocked, 0.05)
+    world = cells_world(blocked, 0.05)
     assert shortest_path_in_world(world, (1.5, 1.5), (2.5, 2.5)).length is None
 
 
@@ -125,21 +119,15 @@ def test_the_optimum_is_the_same_without_the_gates(seed, monkeypatch):
     and a valid path."""
     rng = np.random.default_rng(seed)
     blocked = perfect_maze(rng, 31, 1, 1, 0.2)[::-1].copy()
-    world = _world(blocked, 0.35)
-    checked = 0
-    for start, goal in _queries(world, blocked, rng, 4):
-        with_gates = shortest_path_in_world(world, start, goal)
+    world = cells_world(blocked, 0.35)
+    queries = list(_queries(world, blocked, rng, 4))
+    for start, goal in queries:
         assert free_grid.FreeGrid.for_world(world, start, goal).gates is not None
-        with monkeypatch.context() as m:
-            m.setattr(Gates, "where_pinched", classmethod(lambda cls, *args: None))
-            without = shortest_path_in_world(world, start, goal)
-        if without.length is None:
-            assert with_gates.length is None
-            continue
-        checked += 1
-        assert with_gates.length == pytest.approx(without.length, rel=1e-9)
-        assert world.path_valid(with_gates.valid_polyline(world))
-    assert checked >= 2
+
+    def without_gates(m):
+        m.setattr(Gates, "where_pinched", classmethod(lambda cls, *args: None))
+
+    assert assert_same_optimum_without(world, queries, monkeypatch, without_gates) >= 2
 
 
 def test_blocks_that_lose_the_walls_are_refined(monkeypatch):
@@ -154,7 +142,7 @@ def test_blocks_that_lose_the_walls_are_refined(monkeypatch):
     for row in range(16, 64, 16):
         door = 1 if (row // 16) % 2 else 61
         blocked[row, door : door + 2] = False
-    world = _world(blocked, 0.4)
+    world = cells_world(blocked, 0.4)
     start, goal = (32.5, 2.5), (32.5, 61.5)
     monkeypatch.setattr(free_grid, "FAST_SEARCH_CELLS", 256)  # blocks of 4 x 4
     monkeypatch.setattr(free_grid, "MAX_SEARCH_FREE", 256)

@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers import cells_world
 
 from rrtpso_ompl.groundtruth.free_grid import Stopped
 from rrtpso_ompl.groundtruth.optimum import OptimumTooLarge, shortest_path_in_world
@@ -33,10 +34,7 @@ def _grid(seed: int, size: int = 20, density: float = 0.22) -> np.ndarray:
 
 def _world(blocked: np.ndarray) -> World:
     """A point robot's world of unit cells (boxes on the lattice, as a map's)."""
-    rows, cols = np.nonzero(blocked)
-    boxes = np.column_stack([cols, rows, cols + 1, rows + 1]).astype(float)
-    ny, nx = blocked.shape
-    return World(((0, 0), (nx, ny)), boxes=boxes)
+    return cells_world(blocked)
 
 
 def _tangent(world: World, start, goal):

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers import assert_same_optimum_without, cells_world
 
 from rrtpso_ompl.groundtruth.optimum import graph, shortest_path_in_world
 from rrtpso_ompl.groundtruth.optimum import query as query_module
 from rrtpso_ompl.groundtruth.optimum.sight import MAX_SWEEP, Reach
-from rrtpso_ompl.model import World
 
 
 def _maze(seed: int, size: int = 24) -> np.ndarray:
@@ -77,13 +77,6 @@ def test_runs_are_cut_at_the_walls_and_unbounded_in_the_open():
     assert runs[1, 1] == 10.0  # back to the wall's right side
 
 
-def _world(blocked: np.ndarray, radius: float) -> World:
-    rows, cols = np.nonzero(blocked)
-    boxes = np.column_stack([cols, rows, cols + 1, rows + 1]).astype(float)
-    ny, nx = blocked.shape
-    return World(((0, 0), (nx, ny)), boxes=boxes, robot_radius=radius)
-
-
 @pytest.mark.parametrize("seed", range(6))
 def test_a_discs_optimum_is_the_same_within_reach(seed, monkeypatch):
     """The disc's optimum on a maze with the candidates within reach and the point's bounds is
@@ -91,28 +84,22 @@ def test_a_discs_optimum_is_the_same_within_reach(seed, monkeypatch):
     blocked = _maze(seed, 20)
     blocked[:, :2] = blocked[9:11, :] = False  # ways along the left side and across
     radius = (0.2, 0.3, 0.45)[seed % 3]
-    world = _world(blocked, radius)
+    world = cells_world(blocked, radius)
     rng = np.random.default_rng(seed)
     free = np.argwhere(~blocked)
-    checked = 0
+    queries = []
     for _ in range(12):
         (ra, ca), (rb, cb) = free[rng.choice(len(free), 2, replace=False)]
         start, goal = (ca + 0.5, ra + 0.5), (cb + 0.5, rb + 0.5)
-        if not (world.point_clearance(np.array([start, goal])) >= world.threshold).all():
-            continue
-        new = shortest_path_in_world(world, start, goal)
-        with monkeypatch.context() as m:
-            m.setattr(query_module, "_point_path", lambda *args: (0.0, 0.0))
-            m.setattr(graph.TangentGraph, "_local_rows",
-                      lambda self, batch: np.zeros(len(batch), dtype=bool))  # fmt: skip
-            old = shortest_path_in_world(world, start, goal)
-        if old.length is None:
-            assert new.length is None
-            continue
-        checked += 1
-        assert new.length == pytest.approx(old.length, rel=1e-9)
-        assert world.path_valid(new.valid_polyline(world))
-    assert checked >= 2
+        if (world.point_clearance(np.array([start, goal])) >= world.threshold).all():
+            queries.append((start, goal))
+
+    def without_either(m):
+        m.setattr(query_module, "_point_path", lambda *args: (0.0, 0.0))
+        m.setattr(graph.TangentGraph, "_local_rows",
+                  lambda self, batch: np.zeros(len(batch), dtype=bool))  # fmt: skip
+
+    assert assert_same_optimum_without(world, queries, monkeypatch, without_either) >= 2
 
 
 def test_a_mazes_batches_grow_and_keep_the_optimum(monkeypatch):
@@ -121,7 +108,7 @@ def test_a_mazes_batches_grow_and_keep_the_optimum(monkeypatch):
     from rrtpso_ompl.groundtruth.map_kinds import _maze as perfect_maze
 
     blocked = perfect_maze(np.random.default_rng(5), 41, 1, 1, 0.0)[::-1]  # rows from the bottom
-    world = _world(blocked, 0.3)
+    world = cells_world(blocked, 0.3)
     start, goal = (1.5, 1.5), (39.5, 39.5)
     sizes = []
     prepare = graph.TangentGraph._prepare
