@@ -334,7 +334,8 @@ class FreeGrid:
         return out
 
     def segments_near_blocked(self, a: np.ndarray, b: np.ndarray, threshold: float,
-                              exact: bool = True) -> np.ndarray:  # fmt: skip
+                              exact: bool = True,
+                              sure_pass: bool = True) -> np.ndarray:  # fmt: skip
         """Which segments come closer than ``threshold`` to a blocked cell (booleans): the exact
         test of a world made only of the lattice's boxes, straight from the cells.
 
@@ -345,14 +346,16 @@ class FreeGrid:
         (``World.segments_free`` is its negation, bounds apart). Only for thresholds of up to
         :data:`MAX_BAND` cells minus a half (:attr:`band_ok`). A first pass (:meth:`_deep`)
         settles, without the windows, most segments that come well inside the threshold; with
-        ``exact`` False only that pass runs (a "near" is sure, a "free" is not).
+        ``exact`` False only that pass runs (a "near" is sure, a "free" is not), with
+        ``sure_pass`` False only the windows (for segments that pass has seen).
         """
         a = np.asarray(a, dtype=float).reshape(-1, 2)
         b = np.asarray(b, dtype=float).reshape(-1, 2)
         out = np.zeros(len(a), dtype=bool)
         if not len(a) or self.blocked is None:
             return out
-        out = self._deep(a, b, threshold)  # most that are near, cheaply
+        if sure_pass:
+            out = self._deep(a, b, threshold)  # most that are near, cheaply
         if exact:
             keep = np.flatnonzero(~out)
             out[keep] = self._near_by_window(a[keep], b[keep], threshold)

@@ -162,4 +162,9 @@ def test_testing_tangents_piece_by_piece_gives_the_whole_segments_answer():
     cheap = _in_stages(lambda p, q: grid.segments_near_blocked(p, q, world.threshold, False),
                        a, b, grid.h)  # fmt: skip
     assert not (cheap & ~whole).any() and cheap.sum() > 0.5 * whole.sum()
+    rest = np.flatnonzero(~cheap)  # the search's second pass: the windows alone on the rest
+    windows = _in_stages(lambda p, q: grid.segments_near_blocked(p, q, world.threshold,
+                                                                 sure_pass=False),
+                         a[rest], b[rest], grid.h)  # fmt: skip
+    np.testing.assert_array_equal(windows, whole[rest])
     assert 0.2 < whole.mean() < 0.99

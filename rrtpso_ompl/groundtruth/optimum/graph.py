@@ -227,8 +227,10 @@ class TangentGraph:
         return cand.take(np.flatnonzero(ok))
 
     def _free(self, cand: Tangents) -> Tangents:
-        """The free tangents among ``cand``: the raster's sound rejection, then the exact test
-        (straight from the cells in a world of the lattice's cells alone)."""
+        """The free tangents among ``cand``: in a world of the lattice's cells alone, the exact
+        test straight from the cells (its sure "near" pass, then its windows, each piece by
+        piece: :func:`_in_stages`); elsewhere the raster's sound rejection, then the exact tests
+        against the obstacles near the circle and the world's."""
         w = self.world
         g = self.grid
         if len(cand.j) and self._cells_only:
@@ -238,7 +240,8 @@ class TangentGraph:
             near = _in_stages(lambda a, b: g.segments_near_blocked(a, b, w.threshold, False),
                               cand.p, cand.q, g.h)  # fmt: skip
             cand = cand.take(np.flatnonzero(~near))
-            near = _in_stages(lambda a, b: g.segments_near_blocked(a, b, w.threshold),
+            near = _in_stages(lambda a, b: g.segments_near_blocked(a, b, w.threshold,
+                                                                   sure_pass=False),
                               cand.p, cand.q, g.h)  # fmt: skip
             return cand.take(np.flatnonzero(~near))
         if len(cand.j) and g.core_share >= _RASTER_WORTH:
